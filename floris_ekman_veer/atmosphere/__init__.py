@@ -1,0 +1,1 @@
+"""Atmospheric boundary layer physics (no FLORIS import)."""
