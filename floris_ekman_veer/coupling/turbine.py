@@ -1,0 +1,294 @@
+"""Actuator-disk turbine for FLORIS 4.7, defined by its local thrust coefficient C_T'.
+
+The LES of Narasimhan, Gayme & Meneveau (JRSE 2025, Section 3) represents the turbine by an
+actuator disk with a fixed local thrust coefficient C_T' = 1.33 (D = z_h = 100 m). This module
+turns that disk into a FLORIS *operation model*, so that the paper's single-turbine and
+two-turbine power cases can be run through FLORIS, and registers it in FLORIS's
+``TURBINE_MODEL_MAP["operation_model"]`` under the name ``"actuator-disk"``.
+
+Momentum theory of the disk
+---------------------------
+A disk of fixed C_T' in a wind U, yawed by beta (FLORIS's yaw angle, which is the paper's beta,
+MODEL_NOTES B.1), feels the disk-normal force F = 1/2 rho A C_T' u_n^2 with the disk-normal
+velocity u_n = (1 - a) U cos(beta). One-dimensional momentum balance F = 1/2 rho A U^2 4a(1 - a)
+then gives (Shapiro, Gayme & Meneveau 2018; Bastankhah et al. 2022)
+
+    a(beta)   = C_T' cos^2(beta) / (4 + C_T' cos^2(beta)),
+    C_T(beta) = 16 C_T' / (4 + C_T' cos^2(beta))^2,
+
+where C_T(beta) is the thrust coefficient *on the un-yawed basis* that the paper's formulas take:
+they apply cos^2(beta) and cos^3(beta) themselves, and the paper's Eq. (ind_factor),
+a = (1 - sqrt(1 - C_T cos^2 beta))/2, evaluated with C_T(beta), returns exactly a(beta) above.
+Un-yawed: a = C_T'/(4 + C_T') = 0.24953 and C_T = 4a(1 - a) = 0.74906 for C_T' = 1.33; at
+beta = 20 deg, C_T(beta) = 0.79478 (MODEL_NOTES B.10).
+
+The power is the disk-normal force times the disk-normal velocity,
+
+    P = 1/2 rho A C_T' [(1 - a(beta)) U_disk cos(beta)]^3,
+
+which at beta = 0 is the paper's Eq. (P0_ref) for U_disk = U_h, and Eq. (P_hyp) with the
+disk velocity of Eq. (Ud), U_d = (1 - a) U_disk, in a wake. U_disk is the *plain* area average of
+the streamwise velocity over FLORIS's rotor points, as Eq. (Ud) prescribes: not FLORIS's default
+cubic mean, which belongs to power curves and would overstate the disk's power in shear.
+
+Yaw convention handed to the wake model (the decision)
+-------------------------------------------------------
+``thrust_coefficient`` returns ct_i = C_T(beta) cos(beta): C_T' is held fixed under yaw, as in the
+paper's LES and in the authors' own figures, and the value is packed in the convention of FLORIS's
+cosine-loss model (ct_i = C_T cos beta). So the wake model keeps doing what it does for every FLORIS
+turbine, C_T = ct_i / cos(beta), and obtains the yawed-disk C_T(beta) its formulas expect (and
+a(beta) from Eq. ind_factor). It must not divide by cos^2 or use ct_i directly as C_T (at 20 deg
+that would be 0.7468 instead of 0.7948). FLORIS's own Gaussian model, which multiplies ct_i by
+cos(beta), sees the disk-normal thrust coefficient C_T(beta) cos^2(beta) = 4a(1 - a): consistent
+too. The alternative, holding C_T (not C_T') at its un-yawed 0.7491, would describe a controller
+that raises C_T' under yaw, which is not the disk of the LES being reproduced.
+
+``axial_induction`` returns a(beta), the disk-normal induction of the paper's Eq. (ind_factor).
+(FLORIS's cosine-loss model returns a/cos(beta) from its own formula; the velocity models that use
+the induction, e.g. Jensen, take it as the disk's deficit, which is a(beta).)
+
+power_thrust_table keys
+-----------------------
+``ct_prime`` (> 0), ``rotor_diameter`` [m] (the operation model is never told the turbine's
+diameter by FLORIS, so the area enters here, as for FLORIS's controller-dependent model; it must
+equal the turbine's ``rotor_diameter``), ``ref_air_density`` [kg/m^3], ``ref_tilt`` (must be 0:
+the disk has no tilt, and FLORIS then always passes tilt 0 for these turbines), and the arrays
+``wind_speed``, ``power`` [kW], ``thrust_coefficient`` that FLORIS's Turbine insists on. The
+arrays are descriptive (FLORIS's previewer and utilities read them); they are checked against
+ct_prime, rotor_diameter and ref_air_density on every call so a stale table cannot disagree with
+the analytic model; build them with :func:`actuator_disk_power_thrust_table`. The density in the
+power is FLORIS's flow ``air_density`` (power is linear in it), as FLORIS's own models correct
+their tables from ``ref_air_density``. Not modelled: tilt, cut-in/out, rated power, derating
+setpoints, AWC (the LES disk has none of these); |yaw| must stay below 90 deg.
+
+Registration: call :func:`register_operation_model` before FLORIS builds a farm using the model
+(in every process, including ParFlorisModel workers).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from attrs import define
+from floris.core.rotor_velocity import average_velocity
+from floris.core.turbine import turbine as _floris_turbine
+from floris.core.turbine.operation_models import BaseOperationModel
+from floris.type_dec import NDArrayFloat
+
+OPERATION_MODEL_NAME = "actuator-disk"
+
+#: Default wind-speed samples of the descriptive power/thrust arrays [m/s].
+DEFAULT_WIND_SPEEDS = np.arange(0.0, 31.0, 1.0)
+
+# The descriptive arrays are compared with the analytic model at this relative tolerance: loose
+# enough for tables written to YAML with ~8 significant digits, tight enough to catch a table
+# left behind after ct_prime, rotor_diameter or ref_air_density were edited.
+_TABLE_RTOL = 1e-6
+
+
+def induction_factor(ct_prime, yaw_angles=0.0):
+    """Disk-normal induction a(beta) = C_T' cos^2 beta / (4 + C_T' cos^2 beta) (yaw in degrees).
+
+    Equals the paper's Eq. (ind_factor) evaluated with C_T = :func:`disk_thrust_coefficient`.
+    """
+    c2 = np.cos(np.radians(yaw_angles)) ** 2
+    return ct_prime * c2 / (4.0 + ct_prime * c2)
+
+
+def disk_thrust_coefficient(ct_prime, yaw_angles=0.0):
+    """The paper's C_T (un-yawed basis) of a fixed-C_T' disk: 16 C_T' / (4 + C_T' cos^2 beta)^2.
+
+    At beta = 0 this is 4a(1 - a) with a = C_T'/(4 + C_T'); C_T cos^2 beta is the disk-normal
+    force over 1/2 rho A U^2.
+    """
+    c2 = np.cos(np.radians(yaw_angles)) ** 2
+    return 16.0 * ct_prime / (4.0 + ct_prime * c2) ** 2
+
+
+def _check_positive(name, value):
+    value = float(value)
+    if not np.isfinite(value) or value <= 0.0:
+        raise ValueError(f"actuator-disk: {name} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def actuator_disk_power_thrust_table(
+    ct_prime: float,
+    rotor_diameter: float,
+    ref_air_density: float = 1.225,
+    wind_speed=DEFAULT_WIND_SPEEDS,
+) -> dict:
+    """A FLORIS power_thrust_table for the disk, with arrays consistent with Eq. (P0_ref).
+
+    power [kW] = 1/2 rho_ref (pi D^2/4) C_T' ((1 - a) U)^3 / 1000 and thrust_coefficient = 4a(1 - a)
+    at each wind speed U (the un-yawed disk in uniform inflow).
+    """
+    ct_prime = _check_positive("ct_prime", ct_prime)
+    rotor_diameter = _check_positive("rotor_diameter", rotor_diameter)
+    ref_air_density = _check_positive("ref_air_density", ref_air_density)
+    ws = np.asarray(wind_speed, dtype=float)
+    return {
+        "ct_prime": ct_prime,
+        "rotor_diameter": rotor_diameter,
+        "ref_air_density": ref_air_density,
+        "ref_tilt": 0.0,
+        "wind_speed": ws.tolist(),
+        "power": _tabulated_power_kw(ct_prime, rotor_diameter, ref_air_density, ws).tolist(),
+        "thrust_coefficient": np.full(ws.shape, disk_thrust_coefficient(ct_prime)).tolist(),
+    }
+
+
+def actuator_disk_turbine(
+    ct_prime: float = 1.33,
+    rotor_diameter: float = 100.0,
+    hub_height: float = 100.0,
+    ref_air_density: float = 1.225,
+    turbine_type: str = "actuator_disk_les",
+    wind_speed=DEFAULT_WIND_SPEEDS,
+) -> dict:
+    """A complete FLORIS turbine definition (dict) for the disk; defaults are the paper's LES."""
+    hub_height = _check_positive("hub_height", hub_height)
+    return {
+        "turbine_type": turbine_type,
+        "rotor_diameter": float(rotor_diameter),
+        "hub_height": hub_height,
+        # FLORIS requires a TSR; the disk has no rotor, and no wake model in use reads it.
+        "TSR": 8.0,
+        "operation_model": OPERATION_MODEL_NAME,
+        "power_thrust_table": actuator_disk_power_thrust_table(
+            ct_prime, rotor_diameter, ref_air_density, wind_speed
+        ),
+    }
+
+
+def _tabulated_power_kw(ct_prime, rotor_diameter, air_density, wind_speed):
+    area = np.pi * rotor_diameter**2 / 4.0
+    u_d = (1.0 - induction_factor(ct_prime)) * np.asarray(wind_speed, dtype=float)
+    return 0.5 * air_density * area * ct_prime * u_d**3 / 1e3
+
+
+def _disk_parameters(power_thrust_table: dict) -> tuple[float, float]:
+    """Validate the table; return (ct_prime, rotor_diameter)."""
+    for key in ("ct_prime", "rotor_diameter", "ref_air_density"):
+        if key not in power_thrust_table:
+            raise ValueError(
+                f"actuator-disk: power_thrust_table needs '{key}' (build the table with "
+                "floris_ekman_veer.coupling.turbine.actuator_disk_power_thrust_table)"
+            )
+    ct_prime = _check_positive("ct_prime", power_thrust_table["ct_prime"])
+    diameter = _check_positive("rotor_diameter", power_thrust_table["rotor_diameter"])
+    rho_ref = _check_positive("ref_air_density", power_thrust_table["ref_air_density"])
+    if float(power_thrust_table.get("ref_tilt", 0.0)) != 0.0:
+        raise ValueError("actuator-disk: the disk has no tilt; ref_tilt must be 0")
+
+    ws = np.asarray(power_thrust_table["wind_speed"], dtype=float)
+    power = np.asarray(power_thrust_table["power"], dtype=float)
+    ct = np.asarray(power_thrust_table["thrust_coefficient"], dtype=float)
+    expected_power = _tabulated_power_kw(ct_prime, diameter, rho_ref, ws)
+    if (
+        power.shape != ws.shape
+        or ct.shape != ws.shape
+        or not np.allclose(power, expected_power, rtol=_TABLE_RTOL, atol=1e-9)
+        or not np.allclose(ct, disk_thrust_coefficient(ct_prime), rtol=_TABLE_RTOL, atol=0.0)
+    ):
+        raise ValueError(
+            "actuator-disk: the power/thrust_coefficient arrays of power_thrust_table do not match "
+            f"ct_prime={ct_prime}, rotor_diameter={diameter}, ref_air_density={rho_ref}; "
+            "regenerate them with actuator_disk_power_thrust_table()"
+        )
+    return ct_prime, diameter
+
+
+def _disk_average(velocities, average_method, cubature_weights):
+    # Eq. (Ud) averages u itself over the disk; keep FLORIS's cubature weights when the grid has
+    # them, but never its cubic averages.
+    method = "simple-cubature" if "cubature" in str(average_method) else "simple-mean"
+    return average_velocity(velocities, method=method, cubature_weights=cubature_weights)
+
+
+def _cos_yaw(yaw_angles):
+    # Past 90 deg the disk would face away from the wind; treat it as edge-on (no thrust, no
+    # power) instead of producing negative thrust and power.
+    return np.clip(np.cos(np.radians(yaw_angles)), 0.0, None)
+
+
+@define
+class ActuatorDiskTurbine(BaseOperationModel):
+    """FLORIS operation model of an actuator disk with fixed local thrust coefficient C_T'.
+
+    Static methods with FLORIS's operation-model signatures; see the module docstring for the
+    momentum theory, the yaw convention and the power_thrust_table keys.
+    """
+
+    @staticmethod
+    def power(
+        power_thrust_table: dict,
+        velocities: NDArrayFloat,
+        air_density: float,
+        yaw_angles: NDArrayFloat,
+        average_method: str = "cubic-mean",
+        cubature_weights: NDArrayFloat | None = None,
+        **_,
+    ) -> NDArrayFloat:
+        """P = 1/2 rho A C_T' [(1 - a(beta)) U_disk cos beta]^3 in W (Eqs. P0_ref, P_hyp, Ud)."""
+        ct_prime, diameter = _disk_parameters(power_thrust_table)
+        u_disk = _disk_average(velocities, average_method, cubature_weights)
+        # A disk-averaged speed below zero only arises from over-subtracted wake deficits; such a
+        # disk extracts nothing rather than producing negative power.
+        u_disk = np.clip(u_disk, 0.0, None)
+        u_normal = (1.0 - induction_factor(ct_prime, yaw_angles)) * u_disk * _cos_yaw(yaw_angles)
+        area = np.pi * diameter**2 / 4.0
+        return 0.5 * air_density * area * ct_prime * u_normal**3
+
+    @staticmethod
+    def thrust_coefficient(
+        power_thrust_table: dict,
+        velocities: NDArrayFloat,
+        yaw_angles: NDArrayFloat,
+        average_method: str = "cubic-mean",
+        cubature_weights: NDArrayFloat | None = None,
+        **_,
+    ) -> NDArrayFloat:
+        """ct_i = C_T(beta) cos beta, so that ct_i / cos beta is the paper's C_T(beta).
+
+        Independent of the wind speed: the disk's C_T' is constant.
+        """
+        ct_prime, _diameter = _disk_parameters(power_thrust_table)
+        shape = _disk_average(velocities, average_method, cubature_weights)
+        ct = disk_thrust_coefficient(ct_prime, yaw_angles) * _cos_yaw(yaw_angles)
+        return ct * np.ones_like(shape)
+
+    @staticmethod
+    def axial_induction(
+        power_thrust_table: dict,
+        velocities: NDArrayFloat,
+        yaw_angles: NDArrayFloat,
+        average_method: str = "cubic-mean",
+        cubature_weights: NDArrayFloat | None = None,
+        **_,
+    ) -> NDArrayFloat:
+        """a(beta) = C_T' cos^2 beta / (4 + C_T' cos^2 beta), the paper's Eq. (ind_factor)."""
+        ct_prime, _diameter = _disk_parameters(power_thrust_table)
+        shape = _disk_average(velocities, average_method, cubature_weights)
+        return induction_factor(ct_prime, yaw_angles) * np.ones_like(shape)
+
+
+def register_operation_model() -> type[ActuatorDiskTurbine]:
+    """Register :class:`ActuatorDiskTurbine` as FLORIS operation model ``"actuator-disk"``.
+
+    Idempotent. Raises ValueError if that name already maps to another class (a reloaded copy of
+    this very class, same module and qualified name, is replaced by the current one).
+    """
+    registry = _floris_turbine.TURBINE_MODEL_MAP["operation_model"]
+    existing = registry.get(OPERATION_MODEL_NAME)
+    if existing is not None and existing is not ActuatorDiskTurbine:
+        same_origin = (
+            getattr(existing, "__module__", None) == ActuatorDiskTurbine.__module__
+            and getattr(existing, "__qualname__", None) == ActuatorDiskTurbine.__qualname__
+        )
+        if not same_origin:
+            raise ValueError(
+                f"FLORIS operation model '{OPERATION_MODEL_NAME}' is already registered as "
+                f"{existing!r}; refusing to overwrite it with {ActuatorDiskTurbine!r}"
+            )
+    registry[OPERATION_MODEL_NAME] = ActuatorDiskTurbine
+    return ActuatorDiskTurbine
