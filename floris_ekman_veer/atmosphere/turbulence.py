@@ -1,0 +1,93 @@
+"""Streamwise turbulence intensity and wake expansion rate from the ABL state.
+
+Paper Section 2.3: the Townsend-Perry logarithmic law for the streamwise variance,
+Eq. (upup_var) ``<u'u'>/u*^2 = -A1 ln(z/h) + B1``, gives the turbulence intensity
+Eq. (Iu_model) and, through ``k_w = alpha' I_u`` merged smoothly with the
+mixing-layer floor of stable flows, the wake expansion rate Eq. (kw_CNBL_SBL_model).
+
+These are pure numpy functions of the ABL scalars (u*, h, U_h); `EkmanABL` exposes them
+as methods, and the FLORIS wake model calls `wake_expansion_rate` with its own (user
+configurable) constants.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Townsend-Perry constant A1 (paper Section 2.3).
+TOWNSEND_PERRY_A1 = 1.25
+#: Flow-dependent intercept B1 of the variance law, fitted to the paper's LES.
+TOWNSEND_PERRY_B1 = 0.6
+#: Proportionality k_w = alpha' I_u (paper: 0.33, within the 0.3-0.35 of field data).
+ALPHA_PRIME = 0.33
+#: Expansion rate of the wake's own mixing layer, the floor in low-turbulence flows.
+MIXING_LAYER_FLOOR = 0.021
+#: Exponent of the smooth maximum in Eq. (kw_CNBL_SBL_model).
+MERGE_EXPONENT = 6.0
+
+
+def _variance_factor(height, boundary_layer_height, A1, B1):
+    """sqrt(A1 ln(h/z) + B1), Eq. (upup_var), zero at and above the ABL top.
+
+    Above h the flow is the laminar geostrophic wind: no boundary-layer turbulence.
+    The law itself is valid only inside the ABL (for z > h e^{B1/A1} its bracket would
+    turn negative), so heights z >= h return 0 by definition, not by clipping.
+    """
+    height = np.asarray(height, dtype=float)
+    inside = height < boundary_layer_height
+    ratio = np.where(inside, boundary_layer_height / np.where(inside, height, 1.0), 1.0)
+    return np.where(inside, np.sqrt(A1 * np.log(ratio) + B1), 0.0)
+
+
+def streamwise_turbulence_intensity(
+    height,
+    friction_velocity,
+    boundary_layer_height,
+    reference_speed,
+    A1: float = TOWNSEND_PERRY_A1,
+    B1: float = TOWNSEND_PERRY_B1,
+):
+    """I_u = [A1 ln(h/z) + B1]^(1/2) u*/U_ref, Eq. (Iu_model); 0 for z >= h.
+
+    ``reference_speed`` is U_h in the paper (hub-height speed); any positive speed works.
+    Heights must be positive (the caller checks them against the roughness length).
+    """
+    return (
+        _variance_factor(height, boundary_layer_height, A1, B1)
+        * np.asarray(friction_velocity, dtype=float)
+        / np.asarray(reference_speed, dtype=float)
+    )
+
+
+def wake_expansion_rate(
+    friction_velocity,
+    boundary_layer_height,
+    hub_height,
+    hub_speed,
+    A1: float = TOWNSEND_PERRY_A1,
+    B1: float = TOWNSEND_PERRY_B1,
+    alpha_prime: float = ALPHA_PRIME,
+    floor: float = MIXING_LAYER_FLOOR,
+    n: float = MERGE_EXPONENT,
+):
+    """k_w = [floor^n + (alpha' I_u(z_h))^n]^(1/n), Eq. (kw_CNBL_SBL_model).
+
+    The smooth maximum keeps k_w from falling below the mixing-layer spreading rate of
+    weakly turbulent (stable) inflow, following Vahidi & Porte-Agel (2022).
+
+    Raises:
+        ValueError: if a hub is at or above the boundary-layer top, where the variance
+            law (and the wake model's picture of a turbine inside the ABL) does not hold.
+    """
+    hub_height = np.asarray(hub_height, dtype=float)
+    if np.any(hub_height >= boundary_layer_height):
+        raise ValueError(
+            "hub_height must lie below the boundary-layer height h (valid range: "
+            f"z0 < hub_height < h); got hub_height={np.max(hub_height):.6g} m and "
+            f"h={np.min(boundary_layer_height):.6g} m. The wake expansion model of "
+            "Eq. (kw_CNBL_SBL_model) describes turbines inside the ABL only."
+        )
+    turbulent = alpha_prime * streamwise_turbulence_intensity(
+        hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1
+    )
+    return (floor**n + turbulent**n) ** (1.0 / n)
