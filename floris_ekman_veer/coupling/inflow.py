@@ -1,0 +1,608 @@
+"""Ekman inflow for every FLORIS wake model, defined once in the input dictionary.
+
+FLORIS 4.7 builds its inflow as a power law (times optional speed multipliers) and has no
+extension point for another profile. This module is the one place where the package reaches
+into FLORIS to replace that inflow; everything it patches is listed in :func:`install_inflow_hook`.
+
+Configuration
+-------------
+The atmosphere lives in the FLORIS input at::
+
+    wake:
+      wake_velocity_parameters:
+        ekman_veer:
+          atmosphere:
+            coriolis_parameter: 1.0e-4
+            roughness_length: 0.1
+            cooling_rate: -1.0
+            brunt_vaisala_frequency: 6.1e-3
+            reference_potential_temperature: 265.0
+
+i.e. the keyword inputs of :class:`~floris_ekman_veer.atmosphere.ekman.EkmanABL` without the
+geostrophic wind. The block is read whatever ``velocity_model`` is selected (FLORIS only builds the
+selected model's block, so the entry may sit there next to ``gauss``, ``cc``, ``jensen``,
+``turbopark``...), and because it is part of the input dictionary it survives ``set()``,
+``copy()``, ``as_dict()``/YAML, ParFlorisModel workers and UncertainFlorisModel. Without the block
+(or without its ``atmosphere`` key) every wrapper calls FLORIS's own method and nothing else:
+results are bitwise those of plain FLORIS.
+
+Per condition, the ABL is driven by FLORIS's wind speed at ``reference_wind_height``:
+``EkmanABL.from_reference_wind(wind_speeds[:, None, None, None], reference_wind_height, **atm)``,
+solved once for all conditions in one vectorised call. Any atmosphere value may instead be a list
+of length ``n_findex`` (e.g. a day/night cycle of cooling rates); it binds by position to FLORIS's
+conditions. Tools that tile, deduplicate or re-order conditions (UncertainFlorisModel, the yaw
+optimisers) cannot carry such lists and reject them with a ValueError; ParFlorisModel and the
+visualisation methods slice them.
+
+What the hook sets
+------------------
+* ``u_initial_sorted`` (and ``u_sorted``) = the hub-aligned streamwise component U(z) of the
+  analytic profile at every grid height, in the frame rotated so that V(reference_wind_height) = 0:
+  FLORIS's wind direction is read as the direction at its reference height, and
+  U(reference_wind_height) equals FLORIS's wind speed. Points below the roughness length get 0.
+  ``wind_shear`` is ignored (the atmosphere defines the shear); 2-D/3-D heterogeneous speed
+  multipliers, if also given, multiply the profile.
+* ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U (analytic; 0 below z0). GCH's
+  secondary steering uses it.
+* ``v_initial_sorted`` stays zero. FLORIS's solvers read ``v`` as *wake-induced* transverse
+  velocity: GCH derives an effective yaw from the rotor-averaged ``v`` (secondary steering) and
+  feeds ``v``/``w`` into the yaw-added-recovery term. Ambient veer in ``v_initial`` would therefore
+  be mistaken for wake-induced sidewash of every turbine, even a lone unyawed one. Measured on a
+  3 x 1 row (NREL 5 MW, 7 D spacing, 8 m/s at 90 m, stable atmosphere of the module example with
+  about 9 deg of veer across the rotor, GCH, zero yaw): putting the hub-aligned V(z) into
+  ``v_initial_sorted`` changes the turbine powers by up to about 1.2 % (it yaws the
+  wakes of unyawed turbines through secondary steering) and it changes them for any wind
+  direction, also without wakes; see ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The
+  veer reaches this package's own deflection model through :func:`solved_atmosphere` instead.
+* Turbulence intensities remain FLORIS's inputs (see
+  :func:`floris_ekman_veer.coupling.comparison.builtin_inflow_settings` for values consistent with
+  the atmosphere).
+
+For wake models
+---------------
+``solved_atmosphere(flow_field)`` returns the EkmanABL solved for that flow field's conditions
+(attributes shaped ``(n_findex, 1, 1, 1)``); call it from ``prepare_function(grid, flow_field)``.
+The ABL is solved when the model is built (to validate the input) and cached by content, so each
+flow-field initialisation reuses it: one solve per distinct (atmosphere, wind speeds, reference
+height), never per turbine or per model. Deep copies made by the full-flow solvers are re-initialised
+through the same hook and get their own entry.
+
+Mechanism
+---------
+Class-level wrappers: ``FlowField.initialize_velocity_field`` replaces the inflow when an
+atmosphere is active in a ``contextvars.ContextVar``; the Core entry points that (directly or through
+the full-flow solvers) initialise flow fields set that variable from the Core's own wake parameters.
+``Core.__attrs_post_init__`` validates the block at build time (FlorisModel construction, ``set()``,
+``copy()``), so bad input fails early with the offending key named.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import functools
+import inspect
+import re
+import threading
+import weakref
+from collections import OrderedDict
+from collections.abc import Mapping
+
+import attrs
+import floris
+import numpy as np
+
+
+SUPPORTED_FLORIS = ((4, 7), (4, 8))  # [lower, upper): the hook relies on 4.7 internals
+
+
+def _check_floris_version(version: str) -> None:
+    """Raise ImportError unless ``version`` is in [4.7, 4.8)."""
+    match = re.match(r"(\d+)\.(\d+)", version)
+    lower, upper = SUPPORTED_FLORIS
+    if match is None or not lower <= (int(match[1]), int(match[2])) < upper:
+        raise ImportError(
+            f"floris_ekman_veer.coupling.inflow patches FLORIS internals and supports "
+            f"floris>={lower[0]}.{lower[1]},<{upper[0]}.{upper[1]}, but floris {version} is "
+            f"installed. Install a supported FLORIS (pip install 'floris>=4.7,<4.8')."
+        )
+
+
+_check_floris_version(floris.__version__)
+
+from floris.core import Core, FlowField  # noqa: E402  (only after the version check)
+from floris.floris_model import FlorisModel  # noqa: E402
+
+
+PARAMETER_BLOCK = "ekman_veer"
+ATMOSPHERE_KEY = "atmosphere"
+CONFIG_PATH = f"wake.wake_velocity_parameters.{PARAMETER_BLOCK}.{ATMOSPHERE_KEY}"
+
+# Inputs of which at most one may be given (EkmanABL's contract).
+EXCLUSIVE_INPUTS = (
+    ("coriolis_parameter", "latitude"),
+    ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length"),
+    ("brunt_vaisala_frequency", "lapse_rate"),
+)
+
+
+def _abl_class():
+    # Imported on use so that this module (and FLORIS's unconfigured behaviour) does not depend
+    # on the ABL solver being importable.
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+    return EkmanABL
+
+
+def _abl_inputs() -> tuple[frozenset[str], frozenset[str]]:
+    """(allowed, required) EkmanABL keyword inputs, minus the geostrophic wind (FLORIS's wind
+    speed drives the ABL)."""
+    parameters = [
+        p for p in inspect.signature(_abl_class()).parameters.values()
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and p.name != "geostrophic_wind"
+    ]
+    return (
+        frozenset(p.name for p in parameters),
+        frozenset(p.name for p in parameters if p.default is p.empty),
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Reading and validating the atmosphere block
+
+
+def read_atmosphere(wake_velocity_parameters: Mapping | None) -> Mapping | None:
+    """The raw atmosphere mapping of a ``wake_velocity_parameters`` dict, or None if absent."""
+    block = (wake_velocity_parameters or {}).get(PARAMETER_BLOCK)
+    if block is None:
+        return None
+    if not isinstance(block, Mapping):
+        raise ValueError(f"wake.wake_velocity_parameters.{PARAMETER_BLOCK} must be a mapping")
+    atmosphere = block.get(ATMOSPHERE_KEY)
+    if atmosphere is not None and not isinstance(atmosphere, Mapping):
+        raise ValueError(
+            f"{CONFIG_PATH} must be a mapping of EkmanABL inputs, got {type(atmosphere).__name__}"
+        )
+    return atmosphere
+
+
+@attrs.frozen(eq=False)
+class AtmosphereSpec:
+    """A validated atmosphere block.
+
+    Attributes:
+        inputs: EkmanABL keyword inputs; scalars as floats, per-condition lists as arrays shaped
+            ``(n_conditions, 1, 1, 1)`` so that they broadcast against FLORIS's 4-D grids.
+        n_conditions: Length of the per-condition lists, or None if every value is a scalar.
+        key: Hashable fingerprint of ``inputs`` (for the solve cache).
+    """
+
+    inputs: dict
+    n_conditions: int | None
+    key: tuple
+
+    @classmethod
+    def from_mapping(cls, atmosphere: Mapping) -> AtmosphereSpec:
+        """Validate keys and values (not yet against FLORIS's conditions)."""
+        given = {k: v for k, v in atmosphere.items() if v is not None}
+        if "geostrophic_wind" in given:
+            raise ValueError(
+                f"{CONFIG_PATH}.geostrophic_wind is not allowed: FLORIS's wind speed at "
+                "reference_wind_height drives the ABL (EkmanABL.from_reference_wind)"
+            )
+        allowed, required = _abl_inputs()
+        unknown = sorted(set(given) - allowed)
+        if unknown:
+            raise ValueError(f"{CONFIG_PATH}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+        missing = sorted(required - set(given))
+        if missing:
+            raise ValueError(f"{CONFIG_PATH}: missing required key(s) {missing}")
+        for group in EXCLUSIVE_INPUTS:
+            clash = [k for k in group if k in given]
+            if len(clash) > 1:
+                raise ValueError(
+                    f"{CONFIG_PATH}: contradictory keys {clash}, give at most one of {list(group)}"
+                )
+        inputs, lengths = {}, {}
+        for name, value in given.items():
+            array = _as_float_array(name, value)
+            if array.ndim == 0:
+                inputs[name] = float(array)
+            else:
+                lengths[name] = array.size
+                inputs[name] = array.reshape(-1, 1, 1, 1)
+        if len(set(lengths.values())) > 1:
+            raise ValueError(
+                f"{CONFIG_PATH}: per-condition lists must all have length n_findex; got {lengths}"
+            )
+        n_conditions = next(iter(lengths.values()), None)
+        key = tuple(sorted(
+            (k, v if isinstance(v, float) else v.tobytes()) for k, v in inputs.items()
+        ))
+        return cls(inputs=inputs, n_conditions=n_conditions, key=key)
+
+    def check_conditions(self, n_findex: int) -> None:
+        """Raise ValueError if per-condition lists do not have length ``n_findex``.
+
+        ``n_findex = 0`` (an input file whose conditions are set later with ``set()``) passes.
+        """
+        if self.n_conditions is not None and n_findex and self.n_conditions != n_findex:
+            per_condition = sorted(k for k, v in self.inputs.items() if not isinstance(v, float))
+            raise ValueError(
+                f"{CONFIG_PATH}: per-condition values {per_condition} have length "
+                f"{self.n_conditions} but FLORIS has n_findex = {n_findex} conditions; give "
+                "lists of length n_findex or scalars (replace the atmosphere and the conditions "
+                "together with floris_ekman_veer.coupling.inflow.set_atmosphere)"
+            )
+
+    def sliced(self, index) -> dict:
+        """A plain atmosphere mapping (lists, YAML-safe) restricted to conditions ``index``."""
+        return {
+            k: v if isinstance(v, float) else v.reshape(-1)[index].tolist()
+            for k, v in self.inputs.items()
+        }
+
+
+def _as_float_array(name: str, value) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{CONFIG_PATH}.{name} must be a number or a list of numbers, got {value!r}"
+        ) from None
+    if isinstance(value, bool) or array.ndim > 1 or not np.all(np.isfinite(array)):
+        raise ValueError(
+            f"{CONFIG_PATH}.{name} must be a finite number or a 1-D list of finite numbers "
+            f"(one per condition), got {value!r}"
+        )
+    return array
+
+
+def atmosphere_of(core: Core) -> AtmosphereSpec | None:
+    """The validated atmosphere of a Core (checked against its n_findex), or None."""
+    atmosphere = read_atmosphere(core.wake.wake_velocity_parameters)
+    if atmosphere is None:
+        return None
+    spec = AtmosphereSpec.from_mapping(atmosphere)
+    spec.check_conditions(core.flow_field.n_findex)
+    return spec
+
+
+# ---------------------------------------------------------------------------------------------
+# Solving (cached by content) and the profile on a grid
+
+
+_SOLVE_CACHE: OrderedDict = OrderedDict()
+_SOLVE_CACHE_SIZE = 32
+_SOLVE_LOCK = threading.Lock()
+
+
+def solve(spec: AtmosphereSpec, wind_speeds, reference_height: float):
+    """EkmanABL for every condition: ``|(U, V)(reference_height)| = wind_speeds``.
+
+    One vectorised ``from_reference_wind`` call with speeds shaped ``(n_findex, 1, 1, 1)``; the
+    result is cached by (atmosphere, wind speeds, reference height), so building a model,
+    initialising its flow fields and the wake models' look-ups share one solve.
+    """
+    wind_speeds = np.asarray(wind_speeds, dtype=float).reshape(-1)
+    reference_height = float(reference_height)
+    spec.check_conditions(wind_speeds.size)
+    key = (spec.key, wind_speeds.tobytes(), reference_height)
+    with _SOLVE_LOCK:
+        if key in _SOLVE_CACHE:
+            _SOLVE_CACHE.move_to_end(key)
+            return _SOLVE_CACHE[key]
+    if not np.all(wind_speeds > 0.0):
+        raise ValueError(
+            f"flow_field.wind_speeds must be > 0 when {CONFIG_PATH} is given (they drive the "
+            f"ABL solve); got minimum {wind_speeds.min()}"
+        )
+    z0 = spec.inputs.get("roughness_length")
+    if z0 is not None and np.any(reference_height <= np.asarray(z0)):
+        raise ValueError(
+            f"flow_field.reference_wind_height = {reference_height} m must be above "
+            f"{CONFIG_PATH}.roughness_length (max {np.max(z0)} m)"
+        )
+    try:
+        abl = _abl_class().from_reference_wind(
+            wind_speeds[:, None, None, None], reference_height, **spec.inputs
+        )
+    except ValueError as error:
+        raise ValueError(f"{CONFIG_PATH}: {error}") from error
+    with _SOLVE_LOCK:
+        _SOLVE_CACHE[key] = abl
+        while len(_SOLVE_CACHE) > _SOLVE_CACHE_SIZE:
+            _SOLVE_CACHE.popitem(last=False)
+    return abl
+
+
+def inflow_profile(abl, z, reference_height: float):
+    """Hub-aligned streamwise velocity U(z) and dU/dz at heights ``z``.
+
+    The frame is rotated so that V(reference_height) = 0; heights below the roughness length give
+    U = dU/dz = 0. ``z`` broadcasts against the ABL's ``(n_findex, 1, 1, 1)`` shape; the result
+    has the broadcast shape. The profile is evaluated only at the distinct heights of ``z`` (a
+    rotor grid of 100 turbines of one hub height has 3 of them, whatever n_findex and however
+    FLORIS sorted the turbines) and gathered back, which gives the same numbers as evaluating at
+    every point, at a fraction of the cost.
+    """
+    z = np.asarray(z, dtype=float)
+    n_conditions = np.shape(abl.friction_velocity)[0] if np.ndim(abl.friction_velocity) else 1
+    shape = np.broadcast_shapes(np.shape(abl.friction_velocity), z.shape)
+    heights, inverse, reduced_shape = _distinct_heights(z)
+    if n_conditions * heights.size >= z.size:
+        U, dUdz = _profile_and_gradient(abl, z, reference_height)
+        return np.broadcast_to(U, shape), np.broadcast_to(dUdz, shape)
+    U, dUdz = _profile_and_gradient(abl, heights.reshape(1, 1, 1, -1), reference_height)
+    rows = np.arange(n_conditions).reshape(-1, 1, 1, 1)
+    inverse = inverse.reshape(reduced_shape)
+    U = np.broadcast_to(U, (n_conditions, 1, 1, heights.size)).reshape(n_conditions, -1)
+    dUdz = np.broadcast_to(dUdz, (n_conditions, 1, 1, heights.size)).reshape(n_conditions, -1)
+    return (
+        np.broadcast_to(U[rows, inverse], shape),
+        np.broadcast_to(dUdz[rows, inverse], shape),
+    )
+
+
+def _distinct_heights(z: np.ndarray):
+    """Distinct values of ``z`` after dropping the axes along which it is constant.
+
+    Returns (sorted distinct heights, inverse indices, shape of the reduced array). Dropping
+    constant axes first (the condition axis, the rotor's horizontal axis: cheap comparisons)
+    keeps the sort small.
+    """
+    reduced = z
+    for axis in range(z.ndim):
+        if reduced.shape[axis] > 1:
+            first = reduced.take([0], axis=axis)
+            if np.array_equal(np.broadcast_to(first, reduced.shape), reduced):
+                reduced = first
+    heights, inverse = np.unique(reduced, return_inverse=True)
+    return heights, inverse, reduced.shape
+
+
+# Relative height step of the centred difference for dU/dz: truncation ~ step^2 (1e-8 relative
+# for the log law), round-off ~ 1e-16 U / (step z) (1e-12 relative at hub height).
+_GRADIENT_STEP = 1e-4
+
+
+def _profile_and_gradient(abl, z, reference_height):
+    # dU/dz of the hub-aligned U by a centred difference of EkmanABL.hub_aligned_velocity (the
+    # ABL class exposes no analytic gradient); one-sided where the lower point would fall below
+    # z0, and 0 below z0. Across the kinks at 0.2 h and h the difference averages the two slopes
+    # within +-1e-4 z of the kink.
+    U, _ = abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
+    z0 = np.asarray(abl.roughness_length)
+    upper_z = z * (1.0 + _GRADIENT_STEP)
+    lower_z = np.maximum(z * (1.0 - _GRADIENT_STEP), z0)
+    upper, _ = abl.hub_aligned_velocity(upper_z, reference_height, below_roughness="zero")
+    lower, _ = abl.hub_aligned_velocity(lower_z, reference_height, below_roughness="zero")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dUdz = np.where(z >= z0, (upper - lower) / (upper_z - lower_z), 0.0)
+    return U, dUdz
+
+
+# ---------------------------------------------------------------------------------------------
+# What the wake models call
+
+
+_ACTIVE: contextvars.ContextVar = contextvars.ContextVar("ekman_veer_atmosphere", default=None)
+_SOLVED: dict = {}  # id(flow_field) -> (weakref to the flow field, EkmanABL)
+
+
+def _remember(flow_field: FlowField, abl) -> None:
+    key = id(flow_field)
+    # FlowField is unhashable (attrs eq), so key on id and guard against id reuse with a weakref
+    # whose callback drops the entry when the flow field is collected.
+    _SOLVED[key] = (weakref.ref(flow_field, lambda _, key=key: _SOLVED.pop(key, None)), abl)
+
+
+def solved_atmosphere(flow_field: FlowField):
+    """The EkmanABL solved for ``flow_field``'s conditions (attributes ``(n_findex, 1, 1, 1)``).
+
+    For wake models' ``prepare_function(grid, flow_field)``. Returns the instance built when the
+    flow field was last initialised (no new solve). Raises ValueError if no atmosphere is
+    configured.
+    """
+    entry = _SOLVED.get(id(flow_field))
+    if entry is not None and entry[0]() is flow_field:
+        return entry[1]
+    spec = _ACTIVE.get()
+    if spec is None:
+        raise ValueError(
+            f"the ekman_veer models need {CONFIG_PATH} in the FLORIS input (EkmanABL inputs "
+            "without the wind speed); none is configured"
+        )
+    abl = solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)
+    _remember(flow_field, abl)
+    return abl
+
+
+# ---------------------------------------------------------------------------------------------
+# The wrappers
+
+
+_ORIGINALS: dict = {}
+
+
+def _initialize_velocity_field(self: FlowField, grid) -> None:
+    original = _ORIGINALS[(FlowField, "initialize_velocity_field")]
+    spec = _ACTIVE.get()
+    if spec is None:
+        return original(self, grid)
+    abl = solve(spec, self.wind_speeds, self.reference_wind_height)
+    # FLORIS's own initialisation with zero shear sets v, w, the TI fields and
+    # u_initial = wind speed x heterogeneous speed-ups; only u needs the profile. (dudz from a
+    # zero shear is 0 * z**-1, which warns at z = 0; it is overwritten.)
+    wind_shear = self.wind_shear
+    self.wind_shear = 0.0
+    try:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            original(self, grid)
+    finally:
+        self.wind_shear = wind_shear
+    U, dUdz = inflow_profile(abl, grid.z_sorted, self.reference_wind_height)
+    shape = self.u_initial_sorted.shape
+    if self.het_map is not None:
+        speed_ups = self.u_initial_sorted / self.wind_speeds[:, None, None, None]
+        U, dUdz = speed_ups * U, speed_ups * dUdz
+    self.u_initial_sorted = np.broadcast_to(U, shape).copy()
+    self.dudz_initial_sorted = np.broadcast_to(dUdz, shape).copy()
+    self.u_sorted = self.u_initial_sorted.copy()
+    _remember(self, abl)
+
+
+def _with_core_atmosphere(method):
+    """Run a Core method with the Core's atmosphere (or None) active for flow-field set-ups."""
+
+    @functools.wraps(method)
+    def wrapper(self: Core, *args, **kwargs):
+        token = _ACTIVE.set(atmosphere_of(self))
+        try:
+            return method(self, *args, **kwargs)
+        finally:
+            _ACTIVE.reset(token)
+
+    return wrapper
+
+
+def _validating_post_init(method):
+    """Validate the atmosphere when a Core is built (FlorisModel(), set(), copy())."""
+
+    @functools.wraps(method)
+    def wrapper(self: Core) -> None:
+        method(self)
+        spec = atmosphere_of(self)
+        # reference_wind_height = -1 is FLORIS's "use the hub height" sentinel; FlorisModel
+        # replaces it through set(), which builds (and validates) again.
+        # No conditions yet (n_findex = 0): nothing to solve until set() gives them.
+        if (
+            spec is not None
+            and self.flow_field.n_findex
+            and abs(self.flow_field.reference_wind_height + 1.0) > 1e-6
+        ):
+            solve(spec, self.flow_field.wind_speeds, self.flow_field.reference_wind_height)
+
+    return wrapper
+
+
+@contextlib.contextmanager
+def _replaced_atmosphere(core: Core, atmosphere: Mapping | None):
+    """Temporarily swap a Core's atmosphere mapping (None removes it) for a rebuild from it."""
+    wake = core.wake
+    old = wake.wake_velocity_parameters
+    block = {k: v for k, v in (old.get(PARAMETER_BLOCK) or {}).items() if k != ATMOSPHERE_KEY}
+    if atmosphere is not None:
+        block[ATMOSPHERE_KEY] = dict(atmosphere)
+    new = {k: v for k, v in old.items() if k != PARAMETER_BLOCK}
+    if block:
+        new[PARAMETER_BLOCK] = block
+    wake.wake_velocity_parameters = new
+    try:
+        yield
+    finally:
+        # On success the model holds a new Core built from `new`; restoring the old Core's dict
+        # keeps anyone still holding that Core consistent, and undoes everything on failure.
+        wake.wake_velocity_parameters = old
+
+
+def set_atmosphere(fmodel, atmosphere: Mapping | None, **set_kwargs) -> None:
+    """Replace the atmosphere (None removes it) and call ``fmodel.set(**set_kwargs)`` at once.
+
+    Needed when the number of conditions changes together with per-condition atmosphere lists
+    (neither change alone would be consistent). Works for FlorisModel, ParFlorisModel and
+    UncertainFlorisModel. On error the model is left unchanged.
+    """
+    with _replaced_atmosphere(fmodel.core, atmosphere):
+        fmodel.set(**set_kwargs)
+
+
+def _slicing_set_for_viz(method):
+    """FlorisModel.set_for_viz keeps one condition: keep that condition's atmosphere too."""
+
+    @functools.wraps(method)
+    def wrapper(self, findex: int, solver_settings: dict) -> None:
+        spec = atmosphere_of(self.core)
+        if spec is None or spec.n_conditions is None:
+            return method(self, findex, solver_settings)
+        with _replaced_atmosphere(self.core, spec.sliced(slice(findex, findex + 1))):
+            return method(self, findex, solver_settings)
+
+    return wrapper
+
+
+def reject_per_condition_atmosphere(core: Core, tool: str) -> None:
+    """Raise ValueError if ``core`` carries per-condition atmosphere lists (for tools that tile,
+    deduplicate or re-order FLORIS's conditions, so that positions no longer match)."""
+    spec = atmosphere_of(core)
+    if spec is not None and spec.n_conditions is not None:
+        raise ValueError(
+            f"{tool} expands, deduplicates or re-orders FLORIS's conditions, so the per-condition "
+            f"lists in {CONFIG_PATH} cannot follow them. Use scalar atmosphere values and build "
+            f"one {tool} per atmosphere."
+        )
+
+
+def _rejecting_per_condition(method, tool: str, fmodel_of):
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        reject_per_condition_atmosphere(fmodel_of(self, *args, **kwargs).core, tool)
+        return method(self, *args, **kwargs)
+
+    return wrapper
+
+
+def _patch(owner, name: str, make_wrapper) -> None:
+    if (owner, name) in _ORIGINALS:
+        return
+    original = owner.__dict__[name]
+    _ORIGINALS[(owner, name)] = original
+    setattr(owner, name, make_wrapper(original))
+
+
+def install_inflow_hook() -> None:
+    """Install the class-level wrappers (idempotent). Without an atmosphere block they are no-ops.
+
+    Patched: ``FlowField.initialize_velocity_field``; ``Core.__attrs_post_init__`` (validation),
+    ``Core.initialize_domain``, ``steady_state_atmospheric_condition``, ``solve_for_viz``,
+    ``solve_for_points``, ``solve_for_velocity_deficit_profiles`` (atmosphere context);
+    ``FlorisModel.set_for_viz`` (slices per-condition lists); ``UncertainFlorisModel._set_uncertain``
+    and ``YawOptimization.__init__`` (reject per-condition lists); ParFlorisModel's condition
+    splitting (see :mod:`floris_ekman_veer.coupling.parallel`).
+    """
+    from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
+    from floris.uncertain_floris_model import UncertainFlorisModel
+
+    from floris_ekman_veer.coupling import parallel
+
+    _patch(FlowField, "initialize_velocity_field", lambda _: _initialize_velocity_field)
+    _patch(Core, "__attrs_post_init__", _validating_post_init)
+    for name in (
+        "initialize_domain",
+        "steady_state_atmospheric_condition",
+        "solve_for_viz",
+        "solve_for_points",
+        "solve_for_velocity_deficit_profiles",
+    ):
+        _patch(Core, name, _with_core_atmosphere)
+    _patch(FlorisModel, "set_for_viz", _slicing_set_for_viz)
+    _patch(
+        UncertainFlorisModel, "_set_uncertain",
+        lambda m: _rejecting_per_condition(m, "UncertainFlorisModel", lambda s: s.fmodel_unexpanded),
+    )
+    _patch(
+        YawOptimization, "__init__",
+        lambda m: _rejecting_per_condition(m, "a yaw optimiser", lambda s, fmodel, *a, **k: fmodel),
+    )
+    parallel.install_parallel_hook(_patch)
+
+
+def uninstall_inflow_hook() -> None:
+    """Restore every patched FLORIS method (for tests and for comparisons with plain FLORIS)."""
+    for (owner, name), original in list(_ORIGINALS.items()):
+        setattr(owner, name, original)
+        del _ORIGINALS[(owner, name)]
+
+
+def is_installed() -> bool:
+    return bool(_ORIGINALS)

@@ -1,0 +1,86 @@
+"""ParFlorisModel support: registration in every worker, per-condition atmospheres split.
+
+ParFlorisModel (FLORIS 4.7) sends each worker ``(fmodel_dict, set_args)`` and the worker builds a
+plain ``FlorisModel(fmodel_dict)``. Two things must hold there:
+
+* The package's models and the inflow hook must be installed in the worker. With the ``fork``
+  start method they are inherited; with ``spawn`` or ``forkserver`` (the default on macOS and
+  Windows, and from Python 3.14 on Linux) the worker starts from a fresh interpreter that imports
+  only FLORIS, and a model registered in the parent is missing (MODEL_NOTES C.4). ParFlorisModel
+  offers no pool initializer, so the dictionary sent to each worker is a :class:`WorkerDict`,
+  whose unpickling calls :func:`prepare_worker` before FLORIS sees it.
+* Per-condition atmosphere lists (length n_findex of the parent) are cut to the worker's share of
+  conditions, and so are the flow-field condition arrays of that dictionary, so that the worker's
+  ``FlorisModel(fmodel_dict)`` is self-consistent before ``set(**set_args)`` is applied.
+
+For a pool of your own, pass ``initializer=prepare_worker``.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from floris_ekman_veer.coupling.inflow import (
+    ATMOSPHERE_KEY,
+    PARAMETER_BLOCK,
+    atmosphere_of,
+    install_inflow_hook,
+)
+
+
+def prepare_worker() -> None:
+    """Register the package's FLORIS models and install the inflow hook (idempotent)."""
+    import floris_ekman_veer
+
+    register = getattr(floris_ekman_veer, "register", None)
+    if callable(register):
+        register()
+    install_inflow_hook()
+
+
+def _unpickle_worker_dict(data: dict) -> dict:
+    prepare_worker()
+    return data
+
+
+class WorkerDict(dict):
+    """A FLORIS input dict that prepares the receiving process when it is unpickled."""
+
+    def __reduce__(self):
+        return _unpickle_worker_dict, (dict(self),)
+
+
+# Flow-field entries that are per condition in FloriS's input dict.
+_CONDITION_KEYS = ("wind_directions", "wind_speeds", "turbulence_intensities")
+
+
+def _splitting_preprocessing(method):
+    @functools.wraps(method)
+    def wrapper(self):
+        multiargs = method(self)
+        spec = atmosphere_of(self.core)
+        per_condition = spec is not None and spec.n_conditions is not None
+        result, start = [], 0
+        for fmodel_dict, set_args in multiargs:
+            # ParFlorisModel splits conditions into contiguous, ordered chunks (np.array_split).
+            share = slice(start, start + len(set_args["wind_speeds"]))
+            start = share.stop
+            if per_condition:
+                flow_field = fmodel_dict["flow_field"]
+                for key in _CONDITION_KEYS:
+                    flow_field[key] = np.asarray(flow_field[key])[share].tolist()
+                block = fmodel_dict["wake"]["wake_velocity_parameters"][PARAMETER_BLOCK]
+                block[ATMOSPHERE_KEY] = spec.sliced(share)
+            result.append((WorkerDict(fmodel_dict), set_args))
+        return result
+
+    return wrapper
+
+
+def install_parallel_hook(patch) -> None:
+    """Wrap ParFlorisModel's condition splitting (called by ``install_inflow_hook``)."""
+    from floris.par_floris_model import ParFlorisModel
+
+    patch(ParFlorisModel, "_preprocessing", _splitting_preprocessing)

@@ -1,0 +1,73 @@
+"""Shared fixtures: the inflow hook and FLORIS inputs carrying an Ekman atmosphere."""
+
+import copy
+
+import pytest
+from floris import FlorisModel
+
+from floris_ekman_veer.coupling import inflow
+
+#: The stable atmosphere of the issue's example (EkmanABL inputs without the wind speed).
+STABLE_ATMOSPHERE = {
+    "coriolis_parameter": 1.0e-4,
+    "roughness_length": 0.1,
+    "cooling_rate": -0.25,
+    "brunt_vaisala_frequency": 6.1e-3,
+    "reference_potential_temperature": 265.0,
+}
+
+# Model choices of FLORIS's example inputs (examples/inputs/*.yaml), on FLORIS's default farm.
+EXAMPLE_WAKES = {
+    "gauss": dict(velocity_model="gauss", deflection_model="gauss",
+                  combination_model="sosfs", turbulence_model="crespo_hernandez", gch=False),
+    "gch": dict(velocity_model="gauss", deflection_model="gauss",
+                combination_model="sosfs", turbulence_model="crespo_hernandez", gch=True),
+    "cc": dict(velocity_model="cc", deflection_model="gauss",
+               combination_model="sosfs", turbulence_model="crespo_hernandez", gch=False),
+    "jensen": dict(velocity_model="jensen", deflection_model="jimenez",
+                   combination_model="fls", turbulence_model="crespo_hernandez", gch=False),
+    "turbopark": dict(velocity_model="turbopark", deflection_model="gauss",
+                      combination_model="fls", turbulence_model="crespo_hernandez", gch=False),
+    "empirical_gauss": dict(velocity_model="empirical_gauss", deflection_model="empirical_gauss",
+                            combination_model="sosfs", turbulence_model="wake_induced_mixing",
+                            gch=False),
+}
+
+
+def make_config(
+    wake: str = "gch",
+    atmosphere: dict | None = STABLE_ATMOSPHERE,
+    layout_x=(0.0, 630.0, 1260.0),
+    layout_y=(0.0, 0.0, 0.0),
+    wind_speeds=(8.0,),
+    wind_directions=(270.0,),
+    reference_wind_height: float = 90.0,
+) -> dict:
+    """FLORIS's default input with one of the example wake set-ups and (optionally) the
+    atmosphere block at wake.wake_velocity_parameters.ekman_veer.atmosphere."""
+    config = FlorisModel.get_defaults()
+    choice = dict(EXAMPLE_WAKES[wake])
+    gch = choice.pop("gch")
+    config["wake"]["model_strings"].update(choice)
+    for flag in ("enable_secondary_steering", "enable_yaw_added_recovery",
+                 "enable_transverse_velocities"):
+        config["wake"][flag] = gch
+    if atmosphere is not None:
+        config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {
+            "atmosphere": copy.deepcopy(atmosphere)
+        }
+    config["farm"]["layout_x"] = list(layout_x)
+    config["farm"]["layout_y"] = list(layout_y)
+    config["flow_field"]["wind_speeds"] = list(wind_speeds)
+    config["flow_field"]["wind_directions"] = list(wind_directions)
+    config["flow_field"]["turbulence_intensities"] = [0.06] * len(wind_speeds)
+    config["flow_field"]["reference_wind_height"] = reference_wind_height
+    return config
+
+
+@pytest.fixture
+def inflow_hook():
+    """The Ekman inflow hook, installed (idempotent; stays installed: it is a no-op for FLORIS
+    inputs without an atmosphere block)."""
+    inflow.install_inflow_hook()
+    return inflow
