@@ -1,7 +1,16 @@
 """floris-ekman-veer: the veer-corrected curled-wake model of Narasimhan, Gayme & Meneveau
-(JRSE 2025) and its coupled Ekman-surface-layer inflow, for FLORIS v4."""
+(JRSE 2025) and its coupled Ekman-surface-layer inflow, for FLORIS v4.
+
+Importing the package registers, in FLORIS's model tables, the velocity and deflection models
+``ekman_veer`` (the paper's M-1; M-2 with veer off), the velocity model ``bastankhah2014`` (M-3),
+the turbine operation model ``actuator-disk``, and installs the Ekman inflow hook, a no-op for
+FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
+"""
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.coupling.registry import register
 
-__all__ = ["EkmanABL"]
+__all__ = ["EkmanABL", "register"]
 __version__ = "0.1.0"
+
+register()

@@ -278,17 +278,10 @@ def register_operation_model() -> type[ActuatorDiskTurbine]:
     Idempotent. Raises ValueError if that name already maps to another class (a reloaded copy of
     this very class, same module and qualified name, is replaced by the current one).
     """
-    registry = _floris_turbine.TURBINE_MODEL_MAP["operation_model"]
-    existing = registry.get(OPERATION_MODEL_NAME)
-    if existing is not None and existing is not ActuatorDiskTurbine:
-        same_origin = (
-            getattr(existing, "__module__", None) == ActuatorDiskTurbine.__module__
-            and getattr(existing, "__qualname__", None) == ActuatorDiskTurbine.__qualname__
-        )
-        if not same_origin:
-            raise ValueError(
-                f"FLORIS operation model '{OPERATION_MODEL_NAME}' is already registered as "
-                f"{existing!r}; refusing to overwrite it with {ActuatorDiskTurbine!r}"
-            )
-    registry[OPERATION_MODEL_NAME] = ActuatorDiskTurbine
+    from floris_ekman_veer.coupling.registry import register_in
+
+    register_in(
+        _floris_turbine.TURBINE_MODEL_MAP["operation_model"], OPERATION_MODEL_NAME,
+        ActuatorDiskTurbine, "operation model",
+    )
     return ActuatorDiskTurbine

@@ -1,0 +1,347 @@
+"""FLORIS wake models: thin wrappers of the pure functions in :mod:`floris_ekman_veer.wake`.
+
+* ``EkmanVeerVelocityDeficit`` (registered as ``ekman_veer``): the paper's Eq. (du_model) with
+  the curled, polar-angle dependent width (M-1; M-2 when the deflection model's veer is off).
+* ``EkmanVeerVelocityDeflection`` (``ekman_veer``): y_c(x, z) of Eq. (yc_xz), yaw (CVP with
+  ground image) plus veer, at every grid point: it varies with height, which is how veer shears
+  the wake.
+* ``Gaussian2014VelocityDeficit`` (``bastankhah2014``): the paper's M-3 (MODEL_NOTES B.12).
+
+Conventions (MODEL_NOTES B and C), each pinned by tests:
+
+* FLORIS's positive yaw sends the wake to -y, as the paper's positive beta: the yaw angle is
+  passed unchanged (in radians) as beta.
+* FLORIS hands the wake model ``ct_i``, for its cosine-loss (and this package's actuator-disk)
+  operation model C_T cos(yaw); the paper's formulas take the un-yawed C_T and apply cos^2 and
+  cos^3 themselves, so C_T = ct_i / cos(yaw) (otherwise yaw would be counted twice).
+* Momentum theory, on which Eqs. (A_star), (ind_factor) and (Cx) rest, fails for heavily loaded
+  rotors (C_T cos^2 beta -> 1 and beyond, e.g. the NREL 5 MW below 4 m/s). The wake is then
+  evaluated at ``max_thrust_coefficient`` (default 0.96, i.e. a = 0.4, where the Glauert
+  correction takes over from momentum theory) and a ``RuntimeWarning`` says so: a documented,
+  deliberate limit rather than NaN. |yaw| >= 90 degrees raises ValueError.
+* U_h is the ambient hub-height speed of the turbine's own hub height; U(z), V(z) are the ambient
+  profile in the turbine's hub-aligned frame (V(z_h) = 0), MODEL_NOTES A.6 and B.7. FLORIS's frame
+  is aligned with the wind at its reference height; for a hub at another height the profile is
+  rotated by the direction difference (a few tenths of a degree across typical hub heights).
+* The deficit is returned relative to the local inflow: FLORIS multiplies it by
+  ``u_initial`` = U(z), so (Delta u / U_h) U_h / U(z) is returned. Where the inflow vanishes
+  (heights at or below the roughness length) there is no flow and no wake: 0 is returned.
+* Inputs are never mutated.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from attrs import define, field, validators
+from floris.core import BaseModel, FlowField, Grid
+from floris.utilities import rotate_coordinates_rel_west
+
+from floris_ekman_veer.atmosphere.turbulence import (
+    ALPHA_PRIME,
+    MERGE_EXPONENT,
+    MIXING_LAYER_FLOOR,
+    TOWNSEND_PERRY_A1,
+    TOWNSEND_PERRY_B1,
+    wake_expansion_rate,
+)
+from floris_ekman_veer.coupling.inflow import solved_atmosphere
+from floris_ekman_veer.wake.deficit import normalised_deficit
+from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
+from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
+
+#: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
+GLAUERT_THRUST_COEFFICIENT = 0.96
+
+
+# --------------------------------------------------------------------------------- shared pieces
+def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
+    """C_T = ct_i / cos(yaw) (MODEL_NOTES B.10), limited to the momentum-theory range.
+
+    ``yaw`` in radians. Returns the C_T the wake formulas use; warns when the limit acts.
+    """
+    if np.any(np.abs(yaw) >= np.pi / 2):
+        raise ValueError(
+            "yaw angles must satisfy |yaw| < 90 degrees for the ekman_veer wake models; got "
+            f"{np.rad2deg(np.max(np.abs(yaw))):.6g} degrees"
+        )
+    ct = np.asarray(ct_i, dtype=float) / np.cos(yaw)
+    limit = max_thrust_coefficient / np.cos(yaw) ** 2
+    heavy = ct > limit
+    if np.any(heavy):
+        warnings.warn(
+            f"{int(np.count_nonzero(heavy))} wake(s) with C_T cos^2(yaw) > "
+            f"{max_thrust_coefficient:g}, beyond momentum theory: evaluated at C_T cos^2(yaw) = "
+            f"{max_thrust_coefficient:g} (max_thrust_coefficient)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    return np.where(heavy, limit, ct)
+
+
+def turbine_frame_profile(abl, z, hub_height, reference_height):
+    """Ambient (U, V)(z) in the frame where V(hub_height) = 0 (MODEL_NOTES A.6).
+
+    FLORIS's x axis follows the wind at ``reference_height``; the profile there is rotated by the
+    turbine's hub-height direction. Heights below the roughness length give U = V = 0.
+    """
+    u, v = abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
+    u_hub, v_hub = abl.hub_aligned_velocity(hub_height, reference_height)
+    speed = np.hypot(u_hub, v_hub)
+    cos_a, sin_a = u_hub / speed, v_hub / speed
+    return u * cos_a + v * sin_a, v * cos_a - u * sin_a
+
+
+def hub_heights_of(grid: Grid, flow_field: FlowField):
+    """Rotated turbine positions and hub heights of the farm behind any FLORIS grid.
+
+    FLORIS's deflection call carries no hub height (MODEL_NOTES C.2). Every grid holds the farm's
+    ``turbine_coordinates`` (x, y, hub height) and rotates points about the centre of the farm's
+    bounding box, as done here, so the turbine whose wake is computed is the one at (x_i, y_i).
+    Returns (x, y) of shape (n_findex, n_turbines) and the hub heights (n_turbines,).
+    """
+    coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
+    x, y, _, _, _ = rotate_coordinates_rel_west(flow_field.wind_directions, coordinates)
+    return x, y, coordinates[:, 2]
+
+
+def hub_height_at(x_i, y_i, turbines):
+    """Hub height of the turbine at (x_i, y_i) (shape (n_findex, 1, 1, 1)) per condition."""
+    x, y, hub_heights = turbines
+    distance = (x - x_i[:, 0, 0]) ** 2 + (y - y_i[:, 0, 0]) ** 2
+    return hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
+
+
+@define
+class _EkmanWakeModel(BaseModel):
+    """Parameters shared by the velocity models that draw on the Ekman atmosphere."""
+
+    #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
+    #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.coupling.inflow.
+    atmosphere: dict | None = field(default=None)
+    A1: float = field(converter=float, default=TOWNSEND_PERRY_A1)
+    B1: float = field(converter=float, default=TOWNSEND_PERRY_B1)
+    alpha_prime: float = field(converter=float, default=ALPHA_PRIME)
+    k_w_floor: float = field(converter=float, default=MIXING_LAYER_FLOOR)
+    k_w_exponent: float = field(converter=float, default=MERGE_EXPONENT)
+    #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
+    #: "local_turbulence": alpha' times FLORIS's turbulence intensity at the turbine (ambient
+    #: plus wake-added, from FLORIS's turbulence model) in the same smooth maximum, for farms.
+    wake_expansion: str = field(
+        default="ambient", validator=validators.in_(("ambient", "local_turbulence"))
+    )
+    max_thrust_coefficient: float = field(
+        converter=float, default=GLAUERT_THRUST_COEFFICIENT,
+        validator=[validators.gt(0.0), validators.lt(1.0)],
+    )
+
+    def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity):
+        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant."""
+        if self.wake_expansion == "ambient":
+            return wake_expansion_rate(
+                abl.friction_velocity, abl.boundary_layer_height, hub_height, hub_speed,
+                A1=self.A1, B1=self.B1, alpha_prime=self.alpha_prime, floor=self.k_w_floor,
+                n=self.k_w_exponent,
+            )
+        turbulent = self.alpha_prime * np.asarray(turbulence_intensity, dtype=float)
+        return (self.k_w_floor**self.k_w_exponent + turbulent**self.k_w_exponent) ** (
+            1.0 / self.k_w_exponent
+        )
+
+    def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
+        return {
+            "x": grid.x_sorted,
+            "y": grid.y_sorted,
+            "z": grid.z_sorted,
+            "u_initial": flow_field.u_initial_sorted,
+            "abl": solved_atmosphere(flow_field),
+            "reference_height": flow_field.reference_wind_height,
+        }
+
+    def _turbine_state(self, abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height):
+        """Quantities of turbine i shared by the velocity models."""
+        if np.any(hub_height_i <= abl.roughness_length):
+            raise ValueError("hub_height must be above the atmosphere's roughness_length")
+        yaw = np.deg2rad(yaw_angle_i)
+        ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
+        hub_speed = abl.speed(hub_height_i)
+        local_u, local_v = turbine_frame_profile(abl, z, hub_height_i, reference_height)
+        return yaw, ct, hub_speed, local_u, local_v, x - x_i
+
+    @staticmethod
+    def _relative_to_inflow(deficit_over_hub_speed, hub_speed, u_initial, local_u):
+        """FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial."""
+        flowing = (u_initial > 0) & (local_u > 0)
+        safe_u = np.where(flowing, u_initial, 1.0)
+        return np.where(flowing, deficit_over_hub_speed * hub_speed / safe_u, 0.0)
+
+
+# --------------------------------------------------------------------------------- M-1 / M-2
+@define
+class EkmanVeerVelocityDeficit(_EkmanWakeModel):
+    """Veer-corrected curled-wake deficit, Eq. (du_model) of Narasimhan, Gayme & Meneveau (2025).
+
+    Delta u / U_h = C(x) exp(-((y - y_c)^2 + (z - z_h)^2) / (2 sigma(theta, x)^2)), with C(x) of
+    Eq. (Cx), sigma(theta, x) = k_w x + 0.4 xi0(theta) xi_hat(theta, t_hat) (Eqs. sigma_width,
+    xi0_theta, xi_emp, that) and k_w of Eq. (kw_CNBL_SBL_model). The centre y_c is FLORIS's
+    deflection field (this package's ``ekman_veer`` deflection: yaw + veer, varying with z).
+
+    Parameters (``wake_velocity_parameters.ekman_veer``):
+        atmosphere: the Ekman atmosphere (see floris_ekman_veer.coupling.inflow).
+        curl: polar-angle dependent (curled) width; False keeps the initial ellipse xi_hat = 1.
+        polar_angle_centre: "wake_centre" (paper: theta about the full yaw + veer centre) or
+            "yaw_centre" (the authors' published code: theta about the yaw-only centre while the
+            Gaussian sits on the full centre, MODEL_NOTES B.2; needs the ekman_veer deflection).
+        A1, B1, alpha_prime, k_w_floor, k_w_exponent, wake_expansion: Eq. (kw_CNBL_SBL_model).
+        max_thrust_coefficient: momentum-theory limit of C_T cos^2(yaw) (see module docstring).
+    """
+
+    curl: bool = field(converter=bool, default=True)
+    polar_angle_centre: str = field(
+        default="wake_centre", validator=validators.in_(("wake_centre", "yaw_centre"))
+    )
+
+    def function(
+        self,
+        x_i: np.ndarray,
+        y_i: np.ndarray,
+        z_i: np.ndarray,
+        axial_induction_i: np.ndarray,
+        deflection_field_i: np.ndarray,
+        yaw_angle_i: np.ndarray,
+        turbulence_intensity_i: np.ndarray,
+        ct_i: np.ndarray,
+        hub_height_i: np.ndarray,
+        rotor_diameter_i: np.ndarray,
+        *,
+        x: np.ndarray,
+        y: np.ndarray,
+        z: np.ndarray,
+        u_initial: np.ndarray,
+        abl,
+        reference_height: float,
+    ) -> np.ndarray:
+        yaw, ct, hub_speed, local_u, local_v, dx = self._turbine_state(
+            abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height
+        )
+        flowing = local_u > 0
+        safe_u = np.where(flowing, local_u, 1.0)
+        dy = y - y_i - deflection_field_i
+        polar_dy = None
+        if self.polar_angle_centre == "yaw_centre":
+            polar_dy = dy + veer_deflection(dx, safe_u, np.where(flowing, local_v, 0.0))
+        deficit = normalised_deficit(
+            dx, dy, z - hub_height_i,
+            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
+            radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
+            friction_velocity=abl.friction_velocity, hub_speed=hub_speed, local_speed=safe_u,
+            curl=self.curl, polar_dy=polar_dy,
+        )
+        return self._relative_to_inflow(deficit, hub_speed, u_initial, local_u)
+
+
+@define
+class EkmanVeerVelocityDeflection(BaseModel):
+    """Wake-centre offset y_c(x, z), Eq. (yc_xz): counter-rotating-vortex deflection with its
+    ground image, Eq. (yhatc) with t_hat of Eq. (that), plus the veer shear x V(z)/U(z),
+    Eq. (yc_veer). Returned at every grid point, so it varies with height.
+
+    Parameters (``wake_deflection_parameters.ekman_veer``):
+        veer: include y_c,veer (False gives the paper's M-2).
+        ground_image: include the image-vortex term of Eq. (yhatc).
+        max_thrust_coefficient: as for the velocity model.
+    The atmosphere comes from the velocity block (``wake_velocity_parameters.ekman_veer``).
+    """
+
+    veer: bool = field(converter=bool, default=True)
+    ground_image: bool = field(converter=bool, default=True)
+    max_thrust_coefficient: float = field(
+        converter=float, default=GLAUERT_THRUST_COEFFICIENT,
+        validator=[validators.gt(0.0), validators.lt(1.0)],
+    )
+
+    def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
+        return {
+            "x": grid.x_sorted,
+            "z": grid.z_sorted,
+            "abl": solved_atmosphere(flow_field),
+            "reference_height": flow_field.reference_wind_height,
+            "turbines": hub_heights_of(grid, flow_field),
+        }
+
+    def function(
+        self,
+        x_i: np.ndarray,
+        y_i: np.ndarray,
+        yaw_i: np.ndarray,
+        turbulence_intensity_i: np.ndarray,
+        ct_i: np.ndarray,
+        rotor_diameter_i: np.ndarray,
+        *,
+        x: np.ndarray,
+        z: np.ndarray,
+        abl,
+        reference_height: float,
+        turbines,
+    ) -> np.ndarray:
+        hub_height = hub_height_at(x_i, y_i, turbines)
+        yaw = np.deg2rad(yaw_i)
+        ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
+        local_u, local_v = turbine_frame_profile(abl, z, hub_height, reference_height)
+        flowing = local_u > 0
+        offset = wake_centre_offset(
+            x - x_i, z, hub_height=hub_height, radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
+            friction_velocity=abl.friction_velocity, hub_speed=abl.speed(hub_height),
+            local_speed=np.where(flowing, local_u, 1.0),
+            lateral_speed=np.where(flowing, local_v, 0.0), veer=self.veer,
+            ground_image=self.ground_image,
+        )
+        return np.where(flowing, offset, 0.0)
+
+
+# --------------------------------------------------------------------------------- M-3
+@define
+class Gaussian2014VelocityDeficit(_EkmanWakeModel):
+    """The paper's M-3: Bastankhah & Porte-Agel (2014) Gaussian, no yaw or veer physics
+    (MODEL_NOTES B.12), on the Ekman inflow; centred on FLORIS's deflection field.
+
+    k* = ``k_star`` if given, else the paper's k_w (Eq. kw_CNBL_SBL_model, or the local
+    turbulence variant), so that M-1 and M-3 differ only by their physics, not their mixing.
+    The deficit is relative to U_h, the ambient hub-height speed.
+    """
+
+    k_star: float | None = field(default=None)
+
+    def function(
+        self,
+        x_i: np.ndarray,
+        y_i: np.ndarray,
+        z_i: np.ndarray,
+        axial_induction_i: np.ndarray,
+        deflection_field_i: np.ndarray,
+        yaw_angle_i: np.ndarray,
+        turbulence_intensity_i: np.ndarray,
+        ct_i: np.ndarray,
+        hub_height_i: np.ndarray,
+        rotor_diameter_i: np.ndarray,
+        *,
+        x: np.ndarray,
+        y: np.ndarray,
+        z: np.ndarray,
+        u_initial: np.ndarray,
+        abl,
+        reference_height: float,
+    ) -> np.ndarray:
+        _, ct, hub_speed, local_u, _, dx = self._turbine_state(
+            abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height
+        )
+        k_star = self.k_star
+        if k_star is None:
+            k_star = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i)
+        deficit = bastankhah2014_deficit(
+            dx, y - y_i - deflection_field_i, z - hub_height_i,
+            ct=ct, diameter=rotor_diameter_i, k_star=k_star,
+        )
+        return self._relative_to_inflow(deficit, hub_speed, u_initial, local_u)

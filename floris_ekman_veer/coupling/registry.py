@@ -1,0 +1,58 @@
+"""Registration of the package's models in FLORIS's model tables (idempotent, never overwriting).
+
+``register()`` makes the wake models selectable by name in a FLORIS input
+(``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
+bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
+inflow hook. Importing ``floris_ekman_veer`` calls it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import MutableMapping
+
+#: Names under which the wake models appear in ``floris.core.wake.MODEL_MAP``. Not cc, turbopark
+#: or empirical_gauss: those names select their own solvers (MODEL_NOTES C.1).
+VELOCITY_MODEL_NAME = "ekman_veer"
+DEFLECTION_MODEL_NAME = "ekman_veer"
+GAUSSIAN_2014_NAME = "bastankhah2014"
+
+
+def register_in(table: MutableMapping, name: str, cls: type, kind: str) -> type:
+    """Put ``cls`` in ``table[name]`` unless another class holds the name (ValueError).
+
+    A class of the same module and qualified name (this very class after a module reload) is
+    replaced, so that reloading the package does not lock itself out.
+    """
+    existing = table.get(name)
+    if existing is not None and existing is not cls:
+        same_origin = (getattr(existing, "__module__", None), getattr(existing, "__qualname__", None)) \
+            == (cls.__module__, cls.__qualname__)
+        if not same_origin:
+            raise ValueError(
+                f"FLORIS {kind} '{name}' is already registered as {existing!r}; refusing to "
+                f"overwrite it with {cls!r}"
+            )
+    table[name] = cls
+    return cls
+
+
+def register() -> None:
+    """Register the wake models and the actuator-disk turbine, install the inflow hook."""
+    from floris.core.wake import MODEL_MAP
+
+    from floris_ekman_veer.coupling.inflow import install_inflow_hook
+    from floris_ekman_veer.coupling.models import (
+        EkmanVeerVelocityDeficit,
+        EkmanVeerVelocityDeflection,
+        Gaussian2014VelocityDeficit,
+    )
+    from floris_ekman_veer.coupling.turbine import register_operation_model
+
+    register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
+                "velocity_model")
+    register_in(MODEL_MAP["velocity_model"], GAUSSIAN_2014_NAME, Gaussian2014VelocityDeficit,
+                "velocity_model")
+    register_in(MODEL_MAP["deflection_model"], DEFLECTION_MODEL_NAME, EkmanVeerVelocityDeflection,
+                "deflection_model")
+    register_operation_model()
+    install_inflow_hook()
