@@ -463,3 +463,13 @@ def test_ambient_v_would_change_gch(monkeypatch):
     unwaked = powers(300.0) / reference[300.0] - 1
     assert np.max(np.abs(waked)) > 0.02
     np.testing.assert_allclose(unwaked, 0.0, atol=1e-12)
+
+
+def test_velocity_deficit_profiles_use_the_inflow():
+    fmodel = ekman_model("gauss", wind_speeds=(8.0,))
+    profiles = fmodel.sample_velocity_deficit_profiles(
+        direction="vertical", downstream_dists=[-500.0], profile_range=[-60.0, 60.0],
+        resolution=5, homogeneous_wind_speed=8.0)
+    z = profiles[0].z.to_numpy()
+    upstream = 8.0 * (1.0 - profiles[0].velocity_deficit.to_numpy())
+    np.testing.assert_allclose(upstream, expected_profile(fmodel, z)[0, 0, 0], rtol=1e-12)

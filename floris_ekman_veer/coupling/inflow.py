@@ -39,21 +39,25 @@ What the hook sets
 * ``u_initial_sorted`` (and ``u_sorted``) = the hub-aligned streamwise component U(z) of the
   analytic profile at every grid height, in the frame rotated so that V(reference_wind_height) = 0:
   FLORIS's wind direction is read as the direction at its reference height, and
-  U(reference_wind_height) equals FLORIS's wind speed. Points below the roughness length get 0.
+  U(reference_wind_height) equals FLORIS's wind speed. Points below the roughness length get 0
+  (FLORIS's gauss models divide by u_initial and warn there, as they do at z = 0 with the power
+  law).
   ``wind_shear`` is ignored (the atmosphere defines the shear); 2-D/3-D heterogeneous speed
   multipliers, if also given, multiply the profile.
-* ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U (analytic; 0 below z0). GCH's
-  secondary steering uses it.
+* ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U, by a centred difference of the
+  analytic profile (relative step 1e-4: relative error about 1e-8; EkmanABL exposes no analytic
+  gradient), 0 below z0. GCH's secondary steering uses it.
 * ``v_initial_sorted`` stays zero. FLORIS's solvers read ``v`` as *wake-induced* transverse
-  velocity: GCH derives an effective yaw from the rotor-averaged ``v`` (secondary steering) and
-  feeds ``v``/``w`` into the yaw-added-recovery term. Ambient veer in ``v_initial`` would therefore
-  be mistaken for wake-induced sidewash of every turbine, even a lone unyawed one. Measured on a
-  3 x 1 row (NREL 5 MW, 7 D spacing, 8 m/s at 90 m, stable atmosphere of the module example with
-  about 9 deg of veer across the rotor, GCH, zero yaw): putting the hub-aligned V(z) into
-  ``v_initial_sorted`` changes the turbine powers by up to about 1.2 % (it yaws the
-  wakes of unyawed turbines through secondary steering) and it changes them for any wind
-  direction, also without wakes; see ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The
-  veer reaches this package's own deflection model through :func:`solved_atmosphere` instead.
+  velocity: GCH derives an effective yaw from the rotor-averaged ``v`` of each turbine (secondary
+  steering) and feeds ``v``/``w`` into yaw-added recovery, so ambient veer in ``v_initial`` would
+  be mistaken for the sidewash of a yawed rotor. Measured (GCH, NREL 5 MW row at 7 D, 8 m/s at
+  90 m, f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s; powers with V(z) in ``v_initial`` vs without):
+  cooling rate -1 K/h (h = 71 m, 36 deg of veer across the rotor): downstream turbines +97 % and
+  +64 % at zero yaw; -0.25 K/h (h = 197 m, 25 deg): +2.7 %, and +7.6 % with the first turbine
+  yawed 20 deg; neutral (0 K/h, 0.5 deg of backing): +0.03 to +1.1 %. Unwaked turbines do not
+  change (wind direction 300 deg: 0 %), i.e. the effect is purely a spurious wake steering. See
+  ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The veer reaches this package's own
+  deflection model through :func:`solved_atmosphere` instead.
 * Turbulence intensities remain FLORIS's inputs (see
   :func:`floris_ekman_veer.coupling.comparison.builtin_inflow_settings` for values consistent with
   the atmosphere).
