@@ -2,6 +2,7 @@
 
 import copy
 import multiprocessing
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -368,6 +369,20 @@ def test_par_floris_model_matches_serial(start_method):
     points = (np.array([300.0, 900.0]), np.array([0.0, 10.0]), np.array([90.0, 50.0]))
     np.testing.assert_allclose(par.sample_flow_at_points(*points),
                                serial.sample_flow_at_points(*points), rtol=1e-12)
+
+
+def test_par_floris_model_spawn_workers_know_the_package_models():
+    """MODEL_NOTES C.4: spawn workers start without the parent's registrations."""
+    path = Path(__file__).parents[1] / "inputs" / "farm_sbl6.yaml"
+    serial = FlorisModel(path)
+    assert serial.core.wake.model_strings["velocity_model"] == "ekman_veer"
+    serial.set(wind_speeds=[8.0, 9.0, 10.0], wind_directions=[270.0, 275.0, 280.0],
+               turbulence_intensities=[0.06] * 3)
+    serial.run()
+    par = ParFlorisModel(serial, interface="multiprocessing", max_workers=2)
+    par._PoolExecutor = multiprocessing.get_context("spawn").Pool
+    par.run()
+    np.testing.assert_allclose(par.get_turbine_powers(), serial.get_turbine_powers(), rtol=1e-12)
 
 
 def test_worker_dict_prepares_the_unpickling_process(monkeypatch):
