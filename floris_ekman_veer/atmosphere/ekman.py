@@ -418,6 +418,16 @@ class EkmanABL:
                 "no physical solution with U_g > 0: the cooling is too strong for this wind, "
                 "the stable boundary layer collapses",
             )
+        # The root is unique, but it is a model state only if the surface layer exists:
+        # the matching height (matching_fraction * h, which grows with u*) above z0.
+        u_star, _, h_hat, _, _, _ = self._state(x, flat)
+        collapsed = self.matching_fraction * h_hat * u_star / flat["f"] <= flat["z0"]
+        if np.any(collapsed):
+            raise self._failure(
+                collapsed.reshape(shape),
+                "matching height matching_fraction * h at or below roughness_length z0: "
+                "the stable boundary layer collapses",
+            )
         self._params = {k: v.reshape(shape) for k, v in flat.items()}
         self._set_solution(x.reshape(shape), self._params)
 
@@ -461,7 +471,9 @@ class EkmanABL:
         u_star, h_hat, f = self.friction_velocity, self.h_hat, self._f
         xi = z * f / u_star
         xi0 = self.roughness_length * f / u_star
-        eta = np.clip(xi / h_hat, 0.0, 1.0)  # z/h; the profile formulas live on [0, h]
+        # z/h; the profile formulas live on [0, h]. Taken as z/h (not xi/h_hat) so that
+        # z = h gives eta = 1 exactly: sqrt(1 - eta) would turn round-off into ~1e-8 of U.
+        eta = np.clip(z / self.boundary_layer_height, 0.0, 1.0)
         g, dg = stress_shape(eta, h_hat, self.c_g, self.stress_decay)
         stress = (1.0 - eta) ** 1.5
         u_g = self.geostrophic_components[0]
