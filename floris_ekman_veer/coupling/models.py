@@ -55,6 +55,13 @@ from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
 GLAUERT_THRUST_COEFFICIENT = 0.96
 
+#: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
+#: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
+#: rotor points can lie a round-off (~1e-13 m) downstream of x_i, where the wake is already 2a
+#: deep: without the margin a turbine sits in its own wake (tests/test_models.py). FLORIS's gauss
+#: model uses the same 0.1 m.
+ROTOR_PLANE_MARGIN = 0.1
+
 
 # --------------------------------------------------------------------------------- shared pieces
 def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
@@ -168,7 +175,9 @@ class _EkmanWakeModel(BaseModel):
         ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
         hub_speed = abl.speed(hub_height_i)
         local_u, local_v = turbine_frame_profile(abl, z, hub_height_i, reference_height)
-        return yaw, ct, hub_speed, local_u, local_v, x - x_i
+        dx = x - x_i
+        # dx = 0 means "no wake" to the deficit functions (ROTOR_PLANE_MARGIN).
+        return yaw, ct, hub_speed, local_u, local_v, np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0)
 
     @staticmethod
     def _relative_to_inflow(deficit_over_hub_speed, hub_speed, u_initial, local_u):
