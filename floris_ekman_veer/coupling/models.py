@@ -88,13 +88,22 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
     return np.where(heavy, limit, ct)
 
 
-def turbine_frame_profile(abl, z, hub_height, reference_height):
-    """Ambient (U, V)(z) in the frame where V(hub_height) = 0 (MODEL_NOTES A.6).
+def reference_frame_profile(abl, z, reference_height):
+    """Ambient (U, V)(z) in FLORIS's frame, aligned with the wind at ``reference_height``.
 
-    FLORIS's x axis follows the wind at ``reference_height``; the profile there is rotated by the
-    turbine's hub-height direction. Heights below the roughness length give U = V = 0.
+    Evaluated once per model preparation (not per turbine); heights below the roughness length
+    give U = V = 0.
     """
-    u, v = abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
+    return abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
+
+
+def turbine_frame_profile(abl, profile, hub_height, reference_height):
+    """Ambient (U, V) in the frame where V(hub_height) = 0 (MODEL_NOTES A.6).
+
+    ``profile`` is :func:`reference_frame_profile` at the grid; it is rotated by the turbine's
+    hub-height direction (identity for a hub at the reference height).
+    """
+    u, v = profile
     u_hub, v_hub = abl.hub_aligned_velocity(hub_height, reference_height)
     speed = np.hypot(u_hub, v_hub)
     cos_a, sin_a = u_hub / speed, v_hub / speed
@@ -119,6 +128,22 @@ def hub_height_at(x_i, y_i, turbines):
     x, y, hub_heights = turbines
     distance = (x - x_i[:, 0, 0]) ** 2 + (y - y_i[:, 0, 0]) ** 2
     return hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
+
+
+@define(frozen=True)
+class _TurbineWake:
+    """Turbine i's quantities at the grid, shared by the velocity models (radians, metres)."""
+
+    dx: np.ndarray
+    dy: np.ndarray
+    dz: np.ndarray
+    yaw: np.ndarray
+    ct: np.ndarray
+    radius: np.ndarray
+    hub_speed: np.ndarray
+    k_w: np.ndarray
+    local_u: np.ndarray
+    local_v: np.ndarray
 
 
 @define
@@ -158,33 +183,68 @@ class _EkmanWakeModel(BaseModel):
         )
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
+        abl = solved_atmosphere(flow_field)
+        reference_height = flow_field.reference_wind_height
         return {
             "x": grid.x_sorted,
             "y": grid.y_sorted,
             "z": grid.z_sorted,
             "u_initial": flow_field.u_initial_sorted,
-            "abl": solved_atmosphere(flow_field),
-            "reference_height": flow_field.reference_wind_height,
+            "abl": abl,
+            "reference_height": reference_height,
+            "profile": reference_frame_profile(abl, grid.z_sorted, reference_height),
         }
 
-    def _turbine_state(self, abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height):
-        """Quantities of turbine i shared by the velocity models."""
+    def function(
+        self,
+        x_i: np.ndarray,
+        y_i: np.ndarray,
+        z_i: np.ndarray,
+        axial_induction_i: np.ndarray,
+        deflection_field_i: np.ndarray,
+        yaw_angle_i: np.ndarray,
+        turbulence_intensity_i: np.ndarray,
+        ct_i: np.ndarray,
+        hub_height_i: np.ndarray,
+        rotor_diameter_i: np.ndarray,
+        *,
+        x: np.ndarray,
+        y: np.ndarray,
+        z: np.ndarray,
+        u_initial: np.ndarray,
+        abl,
+        reference_height: float,
+        profile,
+    ) -> np.ndarray:
+        """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid."""
         if np.any(hub_height_i <= abl.roughness_length):
             raise ValueError("hub_height must be above the atmosphere's roughness_length")
         yaw = np.deg2rad(yaw_angle_i)
-        ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
         hub_speed = abl.speed(hub_height_i)
-        local_u, local_v = turbine_frame_profile(abl, z, hub_height_i, reference_height)
+        local_u, local_v = turbine_frame_profile(abl, profile, hub_height_i, reference_height)
         dx = x - x_i
-        # dx = 0 means "no wake" to the deficit functions (ROTOR_PLANE_MARGIN).
-        return yaw, ct, hub_speed, local_u, local_v, np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0)
-
-    @staticmethod
-    def _relative_to_inflow(deficit_over_hub_speed, hub_speed, u_initial, local_u):
-        """FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial."""
+        wake = _TurbineWake(
+            dx=np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0),  # dx = 0 means "no wake"
+            dy=y - y_i - deflection_field_i,
+            dz=z - hub_height_i,
+            yaw=yaw,
+            ct=unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient),
+            radius=0.5 * rotor_diameter_i,
+            hub_speed=hub_speed,
+            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
+            local_u=local_u,
+            local_v=local_v,
+        )
+        deficit = self.normalised_deficit(wake, abl)
+        # FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial. Where
+        # there is no inflow (at and below z0) there is no wake.
         flowing = (u_initial > 0) & (local_u > 0)
         safe_u = np.where(flowing, u_initial, 1.0)
-        return np.where(flowing, deficit_over_hub_speed * hub_speed / safe_u, 0.0)
+        return np.where(flowing, deficit * hub_speed / safe_u, 0.0)
+
+    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+        """Delta u / U_h of one wake; each model defines it."""
+        raise NotImplementedError("BaseModel.normalised_deficit")
 
 
 # --------------------------------------------------------------------------------- M-1 / M-2
@@ -212,43 +272,19 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
         default="wake_centre", validator=validators.in_(("wake_centre", "yaw_centre"))
     )
 
-    def function(
-        self,
-        x_i: np.ndarray,
-        y_i: np.ndarray,
-        z_i: np.ndarray,
-        axial_induction_i: np.ndarray,
-        deflection_field_i: np.ndarray,
-        yaw_angle_i: np.ndarray,
-        turbulence_intensity_i: np.ndarray,
-        ct_i: np.ndarray,
-        hub_height_i: np.ndarray,
-        rotor_diameter_i: np.ndarray,
-        *,
-        x: np.ndarray,
-        y: np.ndarray,
-        z: np.ndarray,
-        u_initial: np.ndarray,
-        abl,
-        reference_height: float,
-    ) -> np.ndarray:
-        yaw, ct, hub_speed, local_u, local_v, dx = self._turbine_state(
-            abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height
-        )
-        flowing = local_u > 0
-        safe_u = np.where(flowing, local_u, 1.0)
-        dy = y - y_i - deflection_field_i
+    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+        flowing = wake.local_u > 0
+        safe_u = np.where(flowing, wake.local_u, 1.0)
         polar_dy = None
         if self.polar_angle_centre == "yaw_centre":
-            polar_dy = dy + veer_deflection(dx, safe_u, np.where(flowing, local_v, 0.0))
-        deficit = normalised_deficit(
-            dx, dy, z - hub_height_i,
-            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
-            radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
-            friction_velocity=abl.friction_velocity, hub_speed=hub_speed, local_speed=safe_u,
-            curl=self.curl, polar_dy=polar_dy,
+            polar_dy = wake.dy + veer_deflection(
+                wake.dx, safe_u, np.where(flowing, wake.local_v, 0.0)
+            )
+        return normalised_deficit(
+            wake.dx, wake.dy, wake.dz, k_w=wake.k_w, radius=wake.radius, ct=wake.ct,
+            yaw=wake.yaw, friction_velocity=abl.friction_velocity, hub_speed=wake.hub_speed,
+            local_speed=safe_u, curl=self.curl, polar_dy=polar_dy,
         )
-        return self._relative_to_inflow(deficit, hub_speed, u_initial, local_u)
 
 
 @define
@@ -272,11 +308,14 @@ class EkmanVeerVelocityDeflection(BaseModel):
     )
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
+        abl = solved_atmosphere(flow_field)
+        reference_height = flow_field.reference_wind_height
         return {
             "x": grid.x_sorted,
             "z": grid.z_sorted,
-            "abl": solved_atmosphere(flow_field),
-            "reference_height": flow_field.reference_wind_height,
+            "abl": abl,
+            "reference_height": reference_height,
+            "profile": reference_frame_profile(abl, grid.z_sorted, reference_height),
             "turbines": hub_heights_of(grid, flow_field),
         }
 
@@ -293,12 +332,13 @@ class EkmanVeerVelocityDeflection(BaseModel):
         z: np.ndarray,
         abl,
         reference_height: float,
+        profile,
         turbines,
     ) -> np.ndarray:
         hub_height = hub_height_at(x_i, y_i, turbines)
         yaw = np.deg2rad(yaw_i)
         ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
-        local_u, local_v = turbine_frame_profile(abl, z, hub_height, reference_height)
+        local_u, local_v = turbine_frame_profile(abl, profile, hub_height, reference_height)
         flowing = local_u > 0
         offset = wake_centre_offset(
             x - x_i, z, hub_height=hub_height, radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
@@ -323,34 +363,9 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
 
     k_star: float | None = field(default=None)
 
-    def function(
-        self,
-        x_i: np.ndarray,
-        y_i: np.ndarray,
-        z_i: np.ndarray,
-        axial_induction_i: np.ndarray,
-        deflection_field_i: np.ndarray,
-        yaw_angle_i: np.ndarray,
-        turbulence_intensity_i: np.ndarray,
-        ct_i: np.ndarray,
-        hub_height_i: np.ndarray,
-        rotor_diameter_i: np.ndarray,
-        *,
-        x: np.ndarray,
-        y: np.ndarray,
-        z: np.ndarray,
-        u_initial: np.ndarray,
-        abl,
-        reference_height: float,
-    ) -> np.ndarray:
-        _, ct, hub_speed, local_u, _, dx = self._turbine_state(
-            abl, x, z, x_i, yaw_angle_i, ct_i, hub_height_i, reference_height
+    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+        k_star = wake.k_w if self.k_star is None else self.k_star
+        diameter = 2.0 * wake.radius
+        return bastankhah2014_deficit(
+            wake.dx, wake.dy, wake.dz, ct=wake.ct, diameter=diameter, k_star=k_star
         )
-        k_star = self.k_star
-        if k_star is None:
-            k_star = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i)
-        deficit = bastankhah2014_deficit(
-            dx, y - y_i - deflection_field_i, z - hub_height_i,
-            ct=ct, diameter=rotor_diameter_i, k_star=k_star,
-        )
-        return self._relative_to_inflow(deficit, hub_speed, u_initial, local_u)
