@@ -138,7 +138,7 @@ class Case:
             elif name == "M-3":
                 wake["model_strings"]["velocity_model"] = "bastankhah2014"
                 wake["model_strings"]["deflection_model"] = "undeflected"
-                wake["wake_velocity_parameters"]["bastankhah2014"] = {}
+                wake["wake_velocity_parameters"].setdefault("bastankhah2014", {})
                 wake["wake_deflection_parameters"]["undeflected"] = {}
             self._models[name] = FlorisModel(config)
         fmodel = self._models[name]
