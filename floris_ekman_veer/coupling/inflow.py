@@ -579,7 +579,10 @@ def install_inflow_hook() -> None:
 
     from floris_ekman_veer.coupling import parallel
 
-    _patch(FlowField, "initialize_velocity_field", lambda _: _initialize_velocity_field)
+    _patch(
+        FlowField, "initialize_velocity_field",
+        lambda original: functools.wraps(original)(_initialize_velocity_field),
+    )
     _patch(Core, "__attrs_post_init__", _validating_post_init)
     for name in (
         "initialize_domain",
