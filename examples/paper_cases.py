@@ -50,16 +50,12 @@ except ImportError:  # run from a checkout without installing
     sys.path.insert(0, str(REPOSITORY))
     import floris_ekman_veer  # noqa: F401
 
-from attrs import define  # noqa: E402
 from floris import FlorisModel  # noqa: E402
-from floris.core import BaseModel  # noqa: E402
-from floris.core.wake import MODEL_MAP  # noqa: E402
 from floris.cut_plane import rescale_axis  # noqa: E402
 from floris.flow_visualization import visualize_cut_plane  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
-from floris_ekman_veer.coupling.registry import register_in  # noqa: E402
 from floris_ekman_veer.wake.deficit import max_deficit, potential_core_length  # noqa: E402
 
 INPUTS = REPOSITORY / "inputs"
@@ -83,21 +79,6 @@ DISK_RADIAL, DISK_ANGULAR = 16, 48
 
 
 # ----------------------------------------------------------------------------------- set-up
-@define
-class Undeflected(BaseModel):
-    """A deflection model that never deflects, for M-3 behind a YAWED rotor: the paper's M-3
-    has no yaw deflection, but FLORIS's ``none`` deflection raises for non-zero yaw angles."""
-
-    def prepare_function(self, grid, flow_field) -> dict:
-        return {"x": grid.x_sorted}
-
-    def function(self, x_i, y_i, yaw_i, turbulence_intensity_i, ct_i, rotor_diameter_i, *, x):
-        return np.zeros_like(x)
-
-
-register_in(MODEL_MAP["deflection_model"], "undeflected", Undeflected, "deflection_model")
-
-
 class Case:
     """One paper case: its FLORIS input (per model) and its ABL."""
 
@@ -137,9 +118,11 @@ class Case:
                 wake["wake_deflection_parameters"]["ekman_veer"]["veer"] = False
             elif name == "M-3":
                 wake["model_strings"]["velocity_model"] = "bastankhah2014"
-                wake["model_strings"]["deflection_model"] = "undeflected"
+                # M-3 has neither yaw nor veer deflection, also behind a yawed rotor.
+                wake["wake_deflection_parameters"]["ekman_veer"].update(
+                    veer=False, yaw_deflection=False
+                )
                 wake["wake_velocity_parameters"].setdefault("bastankhah2014", {})
-                wake["wake_deflection_parameters"]["undeflected"] = {}
             self._models[name] = FlorisModel(config)
         fmodel = self._models[name]
         if self._yaw.get(name) != beta:

@@ -438,6 +438,29 @@ def test_yaw_mirror_symmetry_without_veer():
             np.testing.assert_allclose(fields[25.0], mirrored, rtol=0.0, atol=1e-12)
 
 
+def test_m3_behind_a_yawed_rotor_is_undeflected():
+    """M-3 (bastankhah2014 with the ekman_veer deflection's yaw and veer terms off) has no
+    deflection: behind a yawed rotor its wake is symmetric in y, centred on y = 0, and the same
+    for +beta and -beta (the paper: M-3 always places the power minimum at y_T = 0)."""
+    x = np.array([4.0, 10.0])[:, None, None] * D
+    y = np.linspace(-2.0, 2.0, 17)[None, :, None] * D
+    z = np.array([60.0, 100.0, 140.0])[None, None, :]
+    fields = {}
+    for yaw in (20.0, -20.0):
+        cfg = config("sbl6")
+        cfg["wake"]["model_strings"]["velocity_model"] = "bastankhah2014"
+        cfg["wake"]["wake_deflection_parameters"]["ekman_veer"].update(
+            veer=False, yaw_deflection=False
+        )
+        fmodel = FlorisModel(cfg)
+        fmodel.set(yaw_angles=[[yaw]])
+        fields[yaw] = sample(fmodel, x, y, z)
+    np.testing.assert_allclose(fields[20.0], fields[20.0][:, ::-1, :], rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(fields[20.0], fields[-20.0], rtol=0.0, atol=1e-12)
+    # the wake is there: the centre line is slower than 2 D to the side
+    assert np.all(fields[20.0][:, 8, 1] < fields[20.0][:, 0, 1] - 0.5)
+
+
 def test_southern_hemisphere_is_the_mirror_image():
     """f_c -> -f_c with veer on: the field at (x, y, z) with yaw beta in the south equals the
     northern one at (x, -y, z) with yaw -beta; so do the powers of a mirrored farm."""

@@ -295,12 +295,16 @@ class EkmanVeerVelocityDeflection(BaseModel):
 
     Parameters (``wake_deflection_parameters.ekman_veer``):
         veer: include y_c,veer (False gives the paper's M-2).
+        yaw_deflection: include the yaw (vortex-pair) term; with ``veer`` also False the wake
+            is not deflected at all, as in the paper's M-3 behind a yawed rotor (FLORIS's
+            ``none`` deflection refuses non-zero yaw).
         ground_image: include the image-vortex term of Eq. (yhatc).
         max_thrust_coefficient: as for the velocity model.
     The atmosphere comes from the velocity block (``wake_velocity_parameters.ekman_veer``).
     """
 
     veer: bool = field(converter=bool, default=True)
+    yaw_deflection: bool = field(converter=bool, default=True)
     ground_image: bool = field(converter=bool, default=True)
     max_thrust_coefficient: float = field(
         converter=float, default=GLAUERT_THRUST_COEFFICIENT,
@@ -336,7 +340,8 @@ class EkmanVeerVelocityDeflection(BaseModel):
         turbines,
     ) -> np.ndarray:
         hub_height = hub_height_at(x_i, y_i, turbines)
-        yaw = np.deg2rad(yaw_i)
+        # Without the vortex pair the yaw term vanishes: the offset is that of an unyawed rotor.
+        yaw = np.deg2rad(yaw_i) if self.yaw_deflection else np.zeros_like(yaw_i, dtype=float)
         ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
         local_u, local_v = turbine_frame_profile(abl, profile, hub_height, reference_height)
         flowing = local_u > 0
