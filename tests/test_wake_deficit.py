@@ -291,7 +291,8 @@ def test_curl_shape_positive_everywhere():
     theta = np.linspace(-np.pi, np.pi, 721)[None, :]
     xi = wd.curl_shape(t, np.cos(2 * theta), np.cos(3 * theta), np.cos(4 * theta))
     assert xi.min() > 1.2e-4
-    assert np.all(wd.curl_shape(0.0, np.cos(2 * theta), np.cos(3 * theta), np.cos(4 * theta)) == 1)
+    unyawed = wd.curl_shape(np.zeros((3, 1)), np.cos(2 * theta), np.cos(3 * theta), np.cos(4 * theta))
+    assert unyawed.shape == (3, theta.size) and np.all(unyawed == 1)
 
 
 # ------------------------------------------------------------------------- t_hat, sigma

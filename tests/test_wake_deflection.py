@@ -73,6 +73,8 @@ def test_yaw_deflection_numbers():
 def test_yaw_deflection_zero_at_zero_time():
     z = np.array([-500.0, -ZH, 0.0, 12.3, ZH, 400.0])
     np.testing.assert_array_equal(wf.yaw_deflection(0.0, z, ZH, R, CT, BETA), 0.0)
+    # the unyawed fast path keeps the broadcast shape of t_hat and z
+    assert wf.yaw_deflection(np.zeros((2, 1)), z, ZH, R, CT, BETA).shape == (2, z.size)
 
 
 @pytest.mark.parametrize("t", [1e-4, 1e-6, -1e-5])

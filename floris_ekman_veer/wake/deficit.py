@@ -226,6 +226,9 @@ def curl_shape(t_hat, cos2, cos3, cos4, alpha=CURL_ALPHA):
     t_hat = np.asarray(t_hat, dtype=float)
     alpha = np.asarray(alpha, dtype=float)
     _require((alpha > 0.0) & (alpha < CURL_ALPHA_MAX), "alpha", "in (0, 48/38)", alpha)
+    if not np.any(t_hat):
+        # Unyawed rotors (t_hat = 0 everywhere): xi_hat = 1 exactly; skip the work.
+        return np.ones(np.broadcast_shapes(t_hat.shape, *map(np.shape, (cos2, cos3, cos4, alpha))))
     tanh2 = np.tanh(t_hat**2 / (4.0 * alpha))
     tanh3 = np.tanh(t_hat**3 / (8.0 * alpha))
     tanh4 = np.tanh(t_hat**4 / (16.0 * alpha))

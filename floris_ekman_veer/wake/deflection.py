@@ -47,6 +47,10 @@ def yaw_deflection(t_hat, z, hub_height, radius, ct, yaw, ground_image=True):
     ``hub_height`` > 0 (m), ``radius`` > 0 (m), ``ct`` in [0, 1), ``yaw`` in (-pi/2, pi/2).
     """
     t_hat = np.asarray(t_hat, dtype=float)
+    if not np.any(t_hat):
+        # Unyawed rotors (t_hat = 0 everywhere): both terms vanish exactly; skip the work.
+        _positive(hub_height, "hub_height")
+        return np.zeros(np.broadcast_shapes(t_hat.shape, np.shape(z)))
     abs_t = np.abs(t_hat)
     pm1 = np.pi - 1.0
     numerator = pm1 * abs_t**3 + 2.0 * np.sqrt(3.0) * np.pi**2 * abs_t**2 + 48.0 * pm1**2 * abs_t
