@@ -884,6 +884,27 @@ def test_thrust_coefficient_beyond_momentum_theory():
     assert np.all(np.isfinite(fmodel.get_turbine_powers()))
 
 
+def test_heavily_loaded_yawed_rotor_limits_the_normal_loading():
+    """Yawed by 20 deg, the NREL 5 MW at 3 m/s (C_T = 0.9999) loads its rotor normal with
+    C_T cos^2 = 0.883 < 0.96: M-1 evaluates it as it is (no warning). M-3 has no yaw in its
+    momentum theory, so there C_T itself is limited to 0.96 (warning). Both stay finite."""
+    for velocity_model, warns in (("ekman_veer", False), ("bastankhah2014", True)):
+        cfg = config("farm_sbl6", wind_speeds=[3.0], reference_wind_height=HUB_5MW)
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
+            config("cnbl")["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"])
+        cfg["wake"]["model_strings"]["velocity_model"] = velocity_model
+        cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 630.0], [0.0, 0.0]
+        fmodel = FlorisModel(cfg)
+        fmodel.set(yaw_angles=[[20.0, 0.0]])
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fmodel.run()
+        limited = [w for w in caught if "max_thrust_coefficient" in str(w.message)]
+        assert bool(limited) is warns
+        velocities = fmodel.turbine_average_velocities
+        assert np.all(np.isfinite(velocities)) and velocities[0, 1] < velocities[0, 0]
+
+
 @pytest.mark.parametrize("yaw", [90.0, -90.0, 120.0])
 def test_yaw_of_90_degrees_or_more_is_refused(yaw):
     fmodel = FlorisModel(config("cnbl"))

@@ -485,6 +485,7 @@ def test_deficit_bounded_by_potential_core_value(x, dy, dz, ct, beta, kw, ustar,
 # ------------------------------------------------------------------------- invalid input
 INVALID = [
     (wd.stream_tube_area_ratio, dict(ct=1.0, yaw=0.0), "ct"),
+    (wd.stream_tube_area_ratio, dict(ct=1.25, yaw=np.deg2rad(20.0)), "ct"),  # 1.25 cos^2 = 1.104
     (wd.stream_tube_area_ratio, dict(ct=-0.1, yaw=0.0), "ct"),
     (wd.stream_tube_area_ratio, dict(ct=np.array([0.5, np.nan]), yaw=0.0), "ct"),
     (wd.axial_induction, dict(ct=0.5, yaw=math.pi / 2), "yaw"),
@@ -515,7 +516,7 @@ def test_invalid_input_raises_value_error_naming_parameter(function, kwargs, nam
 
 
 def test_invalid_input_message_states_range():
-    with pytest.raises(ValueError, match=r"ct must be in \[0, 1\)"):
+    with pytest.raises(ValueError, match=r"ct must be >= 0 with ct cos\^2\(yaw\) < 1"):
         wd.axial_induction(1.13, 0.0)
     with pytest.raises(ValueError, match=r"yaw must be in \(-pi/2, pi/2\) radians"):
         wd.axial_induction(0.5, 1.6)
@@ -527,3 +528,15 @@ def test_deficit_requires_speeds_for_curl_only():
                               friction_velocity=USTAR, hub_speed=UH)
     out = wd.normalised_deficit(100.0, 0.0, 0.0, k_w=KW, radius=R, ct=CT, yaw=0.2, curl=False)
     assert out == pytest.approx(2 * hand_a(CT, 0.2), rel=RTOL)
+
+
+def test_yawed_rotor_with_unyawed_ct_above_one_is_valid():
+    """Only the normal loading C_T cos^2(beta) must stay below 1: C_T = 1.05 at 20 degrees
+    (loading 0.927) is a valid yawed rotor, with A* and a from Eqs. (A_star), (ind_factor)."""
+    beta = math.radians(20.0)
+    loading = 1.05 * math.cos(beta) ** 2
+    root = math.sqrt(1.0 - loading)
+    assert wd.axial_induction(1.05, beta) == pytest.approx(0.5 * (1.0 - root), rel=1e-12)
+    assert wd.stream_tube_area_ratio(1.05, beta) == pytest.approx(
+        (1.0 + root) / (2.0 * root), rel=1e-12
+    )

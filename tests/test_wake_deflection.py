@@ -229,7 +229,8 @@ INVALID = [
      "hub_height"),
     (wf.yaw_deflection, dict(t_hat=1.0, z=0.0, hub_height=ZH, radius=-1.0, ct=CT, yaw=0.1),
      "radius"),
-    (wf.yaw_deflection, dict(t_hat=1.0, z=0.0, hub_height=ZH, radius=R, ct=1.0, yaw=0.1), "ct"),
+    # C_T cos^2(yaw) = 1.02 cos^2(0.1) = 1.0098 >= 1: beyond momentum theory of the yawed rotor
+    (wf.yaw_deflection, dict(t_hat=1.0, z=0.0, hub_height=ZH, radius=R, ct=1.02, yaw=0.1), "ct"),
     (wf.yaw_deflection, dict(t_hat=1.0, z=0.0, hub_height=ZH, radius=R, ct=CT, yaw=3.0), "yaw"),
     (wf.veer_deflection, dict(x=1.0, local_speed=-1.0, lateral_speed=0.0), "local_speed"),
     (wf.wake_centre_offset, dict(x=1.0, z=0.0, hub_height=ZH, radius=R, ct=CT, yaw=0.1,

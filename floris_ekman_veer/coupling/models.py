@@ -64,10 +64,12 @@ ROTOR_PLANE_MARGIN = 0.1
 
 
 # --------------------------------------------------------------------------------- shared pieces
-def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
+def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=None):
     """C_T = ct_i / cos(yaw) (MODEL_NOTES B.10), limited to the momentum-theory range.
 
-    ``yaw`` in radians. Returns the C_T the wake formulas use; warns when the limit acts.
+    The limit acts on the rotor-normal loading C_T cos^2(loading_yaw) (default: the yaw itself,
+    as in Eqs. A_star and ind_factor; 0 for a formula without yaw, M-3). ``yaw`` in radians.
+    Returns the C_T the wake formulas use; warns when the limit acts.
     """
     if np.any(np.abs(yaw) >= np.pi / 2):
         raise ValueError(
@@ -75,7 +77,7 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
             f"{np.rad2deg(np.max(np.abs(yaw))):.6g} degrees"
         )
     ct = np.asarray(ct_i, dtype=float) / np.cos(yaw)
-    limit = max_thrust_coefficient / np.cos(yaw) ** 2
+    limit = max_thrust_coefficient / np.cos(yaw if loading_yaw is None else loading_yaw) ** 2
     heavy = ct > limit
     if np.any(heavy):
         warnings.warn(
@@ -228,7 +230,10 @@ class _EkmanWakeModel(BaseModel):
             dy=y - y_i - deflection_field_i,
             dz=z - hub_height_i,
             yaw=yaw,
-            ct=unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient),
+            ct=unyawed_thrust_coefficient(
+                ct_i, yaw, self.max_thrust_coefficient,
+                loading_yaw=yaw if self.yawed_momentum_theory else 0.0,
+            ),
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
             k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
@@ -241,6 +246,10 @@ class _EkmanWakeModel(BaseModel):
         flowing = (u_initial > 0) & (local_u > 0)
         safe_u = np.where(flowing, u_initial, 1.0)
         return np.where(flowing, deficit * hub_speed / safe_u, 0.0)
+
+    #: Whether the model's momentum theory is that of the yawed rotor (C_T cos^2 beta); M-3's
+    #: is the unyawed one (C_T).
+    yawed_momentum_theory = True
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         """Delta u / U_h of one wake; each model defines it."""
@@ -367,6 +376,7 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
     """
 
     k_star: float | None = field(default=None)
+    yawed_momentum_theory = False
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star

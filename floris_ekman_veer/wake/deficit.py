@@ -49,7 +49,7 @@ def _positive(value, name: str) -> np.ndarray:
 
 
 def _thrust_coefficient(ct) -> np.ndarray:
-    """Un-yawed C_T as a float array, required in [0, 1) (momentum theory; also M-3's range)."""
+    """C_T of an unyawed formula (M-3) as a float array, required in [0, 1) (momentum theory)."""
     ct = np.asarray(ct, dtype=float)
     _require((ct >= 0.0) & (ct < 1.0), "ct", "in [0, 1) (un-yawed thrust coefficient)", ct)
     return ct
@@ -63,10 +63,18 @@ def _yaw(yaw) -> np.ndarray:
 
 
 def _momentum_root(ct, yaw) -> np.ndarray:
-    """sqrt(1 - C_T cos^2 beta) = 1 - 2a: the root shared by Eqs. (A_star) and (ind_factor)."""
-    ct = _thrust_coefficient(ct)
-    cos_b = np.cos(_yaw(yaw))
-    return np.sqrt(1.0 - ct * cos_b**2)
+    """sqrt(1 - C_T cos^2 beta) = 1 - 2a: the root shared by Eqs. (A_star) and (ind_factor).
+
+    The yawed rotor's momentum theory needs the normal loading C_T cos^2 beta below 1; the
+    un-yawed C_T itself may exceed 1 (a yawed, heavily loaded rotor).
+    """
+    ct = np.asarray(ct, dtype=float)
+    loading = ct * np.cos(_yaw(yaw)) ** 2
+    _require(
+        np.isfinite(ct) & (ct >= 0.0) & (loading < 1.0), "ct",
+        ">= 0 with ct cos^2(yaw) < 1 (un-yawed thrust coefficient; momentum theory)", ct,
+    )
+    return np.sqrt(1.0 - loading)
 
 
 def _initial_radius(radius, ct, yaw) -> np.ndarray:
