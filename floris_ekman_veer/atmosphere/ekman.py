@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import elementwise
 
+from floris_ekman_veer._validation import finite, require
 from floris_ekman_veer.atmosphere.turbulence import (
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
@@ -48,29 +49,10 @@ _SOLVER_TOLERANCE = 1e-14
 _SOLVER_MAX_ITERATIONS = 200
 
 
-def _as_float_array(name, value):
-    array = np.asarray(value, dtype=float)
-    _require(np.isfinite(array), name, "finite", array)
-    return array
-
-
-def _require(condition, name, requirement, value):
-    """Raise ValueError naming the parameter, its valid range and the offending values.
-
-    The message is built only on failure: formatting large arrays is costly.
-    """
-    condition = np.asarray(condition)
-    if not np.all(condition):
-        offending = np.broadcast_to(np.asarray(value, dtype=float), condition.shape)[~condition]
-        shown = ", ".join(f"{v:.6g}" for v in offending.ravel()[:5])
-        more = f" (and {offending.size - 5} more)" if offending.size > 5 else ""
-        raise ValueError(f"{name} must be {requirement}; got {shown}{more}")
-
-
 def coriolis_parameter_from_latitude(latitude):
     """f_c = 2 Omega sin(phi) [1/s]; latitude in degrees, negative in the south."""
-    latitude = _as_float_array("latitude", latitude)
-    _require(
+    latitude = finite("latitude", latitude)
+    require(
         (np.abs(latitude) >= MIN_ABS_LATITUDE) & (np.abs(latitude) <= 90.0),
         "latitude", "1 <= |latitude| <= 90 degrees (the Ekman model has no solution at the "
         "equator, where f_c = 0)", latitude,
@@ -250,17 +232,17 @@ class EkmanABL:
         }
         self._set_constants(von_karman, c_g, stress_decay, c_tn, c_cn, c_ns, matching_fraction)
 
-        g_wind = _as_float_array("geostrophic_wind", geostrophic_wind)
-        _require(g_wind > 0, "geostrophic_wind", "> 0 m/s", g_wind)
+        g_wind = finite("geostrophic_wind", geostrophic_wind)
+        require(g_wind > 0, "geostrophic_wind", "> 0 m/s", g_wind)
         self.geostrophic_wind = g_wind
         self._set_coriolis(coriolis_parameter, latitude)
 
-        z0 = _as_float_array("roughness_length", roughness_length)
-        _require(z0 > 0, "roughness_length", "> 0 m", z0)
+        z0 = finite("roughness_length", roughness_length)
+        require(z0 > 0, "roughness_length", "> 0 m", z0)
         self.roughness_length = z0
 
-        theta0 = _as_float_array("reference_potential_temperature", reference_potential_temperature)
-        _require(theta0 > 0, "reference_potential_temperature", "> 0 K", theta0)
+        theta0 = finite("reference_potential_temperature", reference_potential_temperature)
+        require(theta0 > 0, "reference_potential_temperature", "> 0 K", theta0)
         self.reference_potential_temperature = theta0
         self._set_free_atmosphere(brunt_vaisala_frequency, lapse_rate)
         self._set_stability_closure(
@@ -290,9 +272,9 @@ class EkmanABL:
         if latitude is not None:
             f_c = coriolis_parameter_from_latitude(latitude)
         else:
-            f_c = _as_float_array("coriolis_parameter", coriolis_parameter)
+            f_c = finite("coriolis_parameter", coriolis_parameter)
             f_min = 2.0 * EARTH_ROTATION_RATE * np.sin(np.deg2rad(MIN_ABS_LATITUDE))
-            _require(
+            require(
                 np.abs(f_c) >= f_min,
                 "coriolis_parameter", f"|f_c| >= {f_min:.4g} 1/s (|latitude| >= 1 deg; the Ekman "
                 "balance has no solution at the equator, f_c = 0)", f_c,
@@ -307,8 +289,8 @@ class EkmanABL:
                 "give at most one of brunt_vaisala_frequency [1/s] or lapse_rate [K/m]"
             )
         if lapse_rate is not None:
-            gamma = _as_float_array("lapse_rate", lapse_rate)
-            _require(
+            gamma = finite("lapse_rate", lapse_rate)
+            require(
                 gamma >= 0, "lapse_rate",
                 ">= 0 K/m (a neutral or stably stratified free atmosphere)", gamma,
             )
@@ -316,8 +298,8 @@ class EkmanABL:
         else:
             if brunt_vaisala_frequency is None:
                 brunt_vaisala_frequency = PAPER_BRUNT_VAISALA_FREQUENCY
-            n_inf = _as_float_array("brunt_vaisala_frequency", brunt_vaisala_frequency)
-            _require(n_inf >= 0, "brunt_vaisala_frequency", ">= 0 1/s", n_inf)
+            n_inf = finite("brunt_vaisala_frequency", brunt_vaisala_frequency)
+            require(n_inf >= 0, "brunt_vaisala_frequency", ">= 0 1/s", n_inf)
         self.brunt_vaisala_frequency = n_inf
         self.zilitinkevich_number = n_inf / self._f
 
@@ -338,14 +320,14 @@ class EkmanABL:
         unstable = "unstable (convective) conditions are not covered by this model"
         # L = +inf is the neutral limit of the Obukhov length; everything else must be finite.
         neutral_obukhov = (value == np.inf) & (self.stability_input == "obukhov_length")
-        _require(np.isfinite(value) | neutral_obukhov, self.stability_input, "finite", value)
+        require(np.isfinite(value) | neutral_obukhov, self.stability_input, "finite", value)
         valid, valid_range = {
             "stability_parameter": (value >= 0, ">= 0"),
             "cooling_rate": (value <= 0, "<= 0 K/h (surface cooling)"),
             "surface_heat_flux": (value <= 0, "<= 0 K m/s (downward heat flux)"),
             "obukhov_length": (value > 0, "> 0 m (stable; np.inf for neutral)"),
         }[self.stability_input]
-        _require(valid, self.stability_input, f"{valid_range}: {unstable}", value)
+        require(valid, self.stability_input, f"{valid_range}: {unstable}", value)
         self._stability_value = value
 
     # ----------------------------------------------------------------------------- solver
@@ -555,12 +537,12 @@ class EkmanABL:
         """
         if "geostrophic_wind" in inputs:
             raise ValueError("from_reference_wind takes speed and height instead of geostrophic_wind")
-        speed = _as_float_array("speed", speed)
-        _require(speed > 0, "speed", "> 0 m/s", speed)
-        height = _as_float_array("height", height)
+        speed = finite("speed", speed)
+        require(speed > 0, "speed", "> 0 m/s", speed)
+        height = finite("height", height)
         if "roughness_length" in inputs:
-            z0 = _as_float_array("roughness_length", inputs["roughness_length"])
-            _require(height > z0, "height", "above roughness_length", height)
+            z0 = finite("roughness_length", inputs["roughness_length"])
+            require(height > z0, "height", "above roughness_length", height)
 
         # Conditions repeat (a wind rose has few distinct speeds): solve each distinct
         # (speed, height, atmosphere) once.

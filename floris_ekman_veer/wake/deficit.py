@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from floris_ekman_veer._validation import positive, require
+
 #: Empirical constant of the vortex-sheet shape, Eq. (xi_emp).
 CURL_ALPHA = 1.263
 
@@ -32,33 +34,17 @@ WIDTH_FACTOR = 0.4
 # --------------------------------------------------------------------------------------------
 
 
-def _require(ok, name: str, valid: str, value) -> None:
-    """Raise ValueError naming ``name`` and its valid range unless ``ok`` holds everywhere."""
-    ok = np.asarray(ok)
-    if not np.all(ok):
-        offending = np.asarray(value)[~ok] if np.ndim(value) else value
-        example = np.ravel(offending)[0] if np.ndim(offending) else offending
-        raise ValueError(f"{name} must be {valid} (got {example!r})")
-
-
-def _positive(value, name: str) -> np.ndarray:
-    """``value`` as a float array, required finite and > 0."""
-    value = np.asarray(value, dtype=float)
-    _require(np.isfinite(value) & (value > 0.0), name, "finite and > 0", value)
-    return value
-
-
 def _thrust_coefficient(ct) -> np.ndarray:
     """C_T of an unyawed formula (M-3) as a float array, required in [0, 1) (momentum theory)."""
     ct = np.asarray(ct, dtype=float)
-    _require((ct >= 0.0) & (ct < 1.0), "ct", "in [0, 1) (un-yawed thrust coefficient)", ct)
+    require((ct >= 0.0) & (ct < 1.0), "ct", "in [0, 1) (un-yawed thrust coefficient)", ct)
     return ct
 
 
 def _yaw(yaw) -> np.ndarray:
     """Yaw in radians as a float array, required in (-pi/2, pi/2)."""
     yaw = np.asarray(yaw, dtype=float)
-    _require(np.abs(yaw) < 0.5 * np.pi, "yaw", "in (-pi/2, pi/2) radians", yaw)
+    require(np.abs(yaw) < 0.5 * np.pi, "yaw", "in (-pi/2, pi/2) radians", yaw)
     return yaw
 
 
@@ -70,7 +56,7 @@ def _momentum_root(ct, yaw) -> np.ndarray:
     """
     ct = np.asarray(ct, dtype=float)
     loading = ct * np.cos(_yaw(yaw)) ** 2
-    _require(
+    require(
         np.isfinite(ct) & (ct >= 0.0) & (loading < 1.0), "ct",
         ">= 0 with ct cos^2(yaw) < 1 (un-yawed thrust coefficient; momentum theory)", ct,
     )
@@ -80,7 +66,7 @@ def _momentum_root(ct, yaw) -> np.ndarray:
 def _initial_radius(radius, ct, yaw) -> np.ndarray:
     """R sqrt(A*), the radius of the expanded stream tube: the length unit of Eqs. (xi0_theta),
     (that) and (yhatc)."""
-    return _positive(radius, "radius") * np.sqrt(stream_tube_area_ratio(ct, yaw))
+    return positive(radius, "radius") * np.sqrt(stream_tube_area_ratio(ct, yaw))
 
 
 # --------------------------------------------------------------------------------------------
@@ -123,7 +109,7 @@ def sigma_tilde_squared(x, k_w, radius, ct, yaw):
     Both factors grow from x = 0 (no virtual origin, MODEL_NOTES B.3). ``k_w`` > 0, ``radius`` > 0.
     """
     x = np.asarray(x, dtype=float)
-    k_w = _positive(k_w, "k_w")
+    k_w = positive(k_w, "k_w")
     width0 = WIDTH_FACTOR * _initial_radius(radius, ct, yaw)
     return (k_w * x + width0) * (k_w * x + width0 * np.cos(yaw))
 
@@ -143,8 +129,8 @@ def potential_core_length(k_w, radius, ct, yaw):
     the width where C = 2a): there is no potential core and C(x) decays from the rotor on. The value
     is returned as is.
     """
-    k_w = _positive(k_w, "k_w")
-    radius = _positive(radius, "radius")
+    k_w = positive(k_w, "k_w")
+    radius = positive(radius, "radius")
     r_tube = _initial_radius(radius, ct, yaw)
     cos_b = np.cos(yaw)
     root = np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * radius**2 * cos_b)
@@ -162,7 +148,7 @@ def max_deficit(x, k_w, radius, ct, yaw):
     1 - sqrt(1 - q) but free of cancellation when C is small far downstream.
     """
     x = np.asarray(x, dtype=float)
-    radius = _positive(radius, "radius")
+    radius = positive(radius, "radius")
     x0 = potential_core_length(k_w, radius, ct, yaw)
     # The decaying branch is real only for x >= x0; evaluate it there and nowhere else.
     x_decay = np.maximum(x, x0)
@@ -210,7 +196,7 @@ def initial_wake_shape(sin_t, radius, ct, yaw):
     projection, narrow in y (theta = 0) and R sqrt(A*) tall in z. ``sin_t`` in [-1, 1].
     """
     sin_t = np.asarray(sin_t, dtype=float)
-    _require(np.abs(sin_t) <= 1.0, "sin_t", "in [-1, 1]", sin_t)
+    require(np.abs(sin_t) <= 1.0, "sin_t", "in [-1, 1]", sin_t)
     sin_b = np.sin(yaw)
     return (
         _initial_radius(radius, ct, yaw)
@@ -233,7 +219,7 @@ def curl_shape(t_hat, cos2, cos3, cos4, alpha=CURL_ALPHA):
     """
     t_hat = np.asarray(t_hat, dtype=float)
     alpha = np.asarray(alpha, dtype=float)
-    _require((alpha > 0.0) & (alpha < CURL_ALPHA_MAX), "alpha", "in (0, 48/38)", alpha)
+    require((alpha > 0.0) & (alpha < CURL_ALPHA_MAX), "alpha", "in (0, 48/38)", alpha)
     if not np.any(t_hat):
         # Unyawed rotors (t_hat = 0 everywhere): xi_hat = 1 exactly; skip the work.
         return np.ones(np.broadcast_shapes(t_hat.shape, *map(np.shape, (cos2, cos3, cos4, alpha))))
@@ -262,10 +248,10 @@ def time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct,
     1 - exp(-y) is evaluated as -expm1(-y) to keep precision close to the rotor.
     """
     x = np.asarray(x, dtype=float)
-    u_star = _positive(friction_velocity, "friction_velocity")
-    u_hub = _positive(hub_speed, "hub_speed")
-    u_local = _positive(local_speed, "local_speed")
-    radius = _positive(radius, "radius")
+    u_star = positive(friction_velocity, "friction_velocity")
+    u_hub = positive(hub_speed, "hub_speed")
+    u_local = positive(local_speed, "local_speed")
+    radius = positive(radius, "radius")
     sqrt_area = np.sqrt(stream_tube_area_ratio(ct, yaw))
     yaw_thrust = np.asarray(ct) * np.cos(yaw) ** 2 * np.sin(yaw)
     strength = -1.44 * (u_hub / u_star) / sqrt_area * yaw_thrust
@@ -277,7 +263,7 @@ def wake_width(x, k_w, xi):
     """Polar-angle dependent wake width sigma(theta, x) = k_w x + 0.4 xi(theta, x), Eq.
     (sigma_width), in metres (xi = xi0 xi_hat, Eq. wake_shape_function, carries the length)."""
     x = np.asarray(x, dtype=float)
-    return _positive(k_w, "k_w") * x + WIDTH_FACTOR * np.asarray(xi, dtype=float)
+    return positive(k_w, "k_w") * x + WIDTH_FACTOR * np.asarray(xi, dtype=float)
 
 
 # --------------------------------------------------------------------------------------------

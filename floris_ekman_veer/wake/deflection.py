@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from floris_ekman_veer._validation import positive
+
 from .deficit import (
     WIDTH_FACTOR,
     _initial_radius,
-    _positive,
     time_like_variable,
 )
 
@@ -49,7 +50,7 @@ def yaw_deflection(t_hat, z, hub_height, radius, ct, yaw, ground_image=True):
     t_hat = np.asarray(t_hat, dtype=float)
     if not np.any(t_hat):
         # Unyawed rotors (t_hat = 0 everywhere): both terms vanish exactly; skip the work.
-        _positive(hub_height, "hub_height")
+        positive(hub_height, "hub_height")
         return np.zeros(np.broadcast_shapes(t_hat.shape, np.shape(z)))
     abs_t = np.abs(t_hat)
     pm1 = np.pi - 1.0
@@ -60,7 +61,7 @@ def yaw_deflection(t_hat, z, hub_height, radius, ct, yaw, ground_image=True):
     vortex_pair = np.sign(t_hat) * numerator / denominator
     if not ground_image:
         return vortex_pair * np.ones_like(np.asarray(z, dtype=float))
-    hub_height = _positive(hub_height, "hub_height")
+    hub_height = positive(hub_height, "hub_height")
     r_tube = _initial_radius(radius, ct, yaw)
     eta = np.maximum((np.asarray(z, dtype=float) + hub_height) / r_tube, 1.0 + IMAGE_CORE)
     return vortex_pair - (2.0 / np.pi) * t_hat / (eta**2 - 1.0)
@@ -77,7 +78,7 @@ def veer_deflection(x, local_speed, lateral_speed):
     limit as U -> 0+, so no value would be honest. The caller decides how the roughness sublayer is
     treated (e.g. evaluate the inflow no lower than a small height above z0).
     """
-    u_local = _positive(local_speed, "local_speed")
+    u_local = positive(local_speed, "local_speed")
     lateral = np.asarray(lateral_speed, dtype=float)
     return np.maximum(np.asarray(x, dtype=float), 0.0) * lateral / u_local
 

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .deficit import _positive, _thrust_coefficient
+from floris_ekman_veer._validation import positive
+
+from .deficit import _thrust_coefficient
 
 def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     """Normalised deficit Delta u / U_inf of the Bastankhah & Porte-Agel (2014) Gaussian wake.
@@ -36,8 +38,8 @@ def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     dy = np.asarray(dy, dtype=float)
     dz = np.asarray(dz, dtype=float)
     ct = _thrust_coefficient(ct)
-    diameter = _positive(diameter, "diameter")
-    k_star = _positive(k_star, "k_star")
+    diameter = positive(diameter, "diameter")
+    k_star = positive(k_star, "k_star")
     root = np.sqrt(1.0 - ct)
     beta_bp = 0.5 * (1.0 + root) / root
     # Upstream points carry no wake; evaluating them at the rotor plane keeps every term finite.
