@@ -90,46 +90,66 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=No
     return np.where(heavy, limit, ct)
 
 
-def reference_frame_profile(abl, z, reference_height):
-    """Ambient (U, V)(z) in FLORIS's frame, aligned with the wind at ``reference_height``.
+@define(frozen=True)
+class Ambient:
+    """The ambient atmosphere of one FLORIS grid, evaluated once per model preparation.
 
-    Evaluated once per model preparation (not per turbine); heights below the roughness length
-    give U = V = 0.
-    """
-    return abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
-
-
-def turbine_frame_profile(abl, profile, hub_height, reference_height):
-    """Ambient (U, V) in the frame where V(hub_height) = 0 (MODEL_NOTES A.6).
-
-    ``profile`` is :func:`reference_frame_profile` at the grid; it is rotated by the turbine's
-    hub-height direction (identity for a hub at the reference height).
-    """
-    u, v = profile
-    u_hub, v_hub = abl.hub_aligned_velocity(hub_height, reference_height)
-    speed = np.hypot(u_hub, v_hub)
-    cos_a, sin_a = u_hub / speed, v_hub / speed
-    return u * cos_a + v * sin_a, v * cos_a - u * sin_a
-
-
-def hub_heights_of(grid: Grid, flow_field: FlowField):
-    """Rotated turbine positions and hub heights of the farm behind any FLORIS grid.
+    Holds the ABL, the ambient (U, V) at the grid in FLORIS's frame (aligned with the wind at the
+    reference height; 0 below the roughness length), and the hub-height speed and direction at
+    each distinct hub height of the farm, so that no wake evaluates the profile again.
 
     FLORIS's deflection call carries no hub height (MODEL_NOTES C.2). Every grid holds the farm's
     ``turbine_coordinates`` (x, y, hub height) and rotates points about the centre of the farm's
     bounding box, as done here, so the turbine whose wake is computed is the one at (x_i, y_i).
-    Returns (x, y) of shape (n_findex, n_turbines) and the hub heights (n_turbines,).
     """
-    coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
-    x, y, _, _, _ = rotate_coordinates_rel_west(flow_field.wind_directions, coordinates)
-    return x, y, coordinates[:, 2]
 
+    abl: Any
+    u: np.ndarray
+    v: np.ndarray
+    hub_heights: np.ndarray  # distinct hub heights of the farm, sorted
+    hub_speed: np.ndarray  # (n_findex, n_hub_heights)
+    hub_cos: np.ndarray  # direction of the hub-height wind in FLORIS's frame
+    hub_sin: np.ndarray
+    turbine_x: np.ndarray  # rotated turbine positions, (n_findex, n_turbines)
+    turbine_y: np.ndarray
+    turbine_hub_heights: np.ndarray  # (n_turbines,)
 
-def hub_height_at(x_i, y_i, turbines):
-    """Hub height of the turbine at (x_i, y_i) (shape (n_findex, 1, 1, 1)) per condition."""
-    x, y, hub_heights = turbines
-    distance = (x - x_i[:, 0, 0]) ** 2 + (y - y_i[:, 0, 0]) ** 2
-    return hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
+    @classmethod
+    def of(cls, grid: Grid, flow_field: FlowField) -> Ambient:
+        abl = solved_atmosphere(flow_field)
+        reference_height = flow_field.reference_wind_height
+        u, v = abl.hub_aligned_velocity(grid.z_sorted, reference_height, below_roughness="zero")
+        coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
+        hub_heights = np.unique(coordinates[:, 2])
+        u_hub, v_hub = abl.hub_aligned_velocity(hub_heights.reshape(1, 1, 1, -1), reference_height)
+        speed = np.hypot(u_hub, v_hub)
+        x, y, _, _, _ = rotate_coordinates_rel_west(flow_field.wind_directions, coordinates)
+        n_findex = len(flow_field.wind_directions)
+        shape = (n_findex, hub_heights.size)
+        return cls(
+            abl, u, v, hub_heights,
+            *(np.broadcast_to(a, (n_findex, 1, 1, hub_heights.size)).reshape(shape)
+              for a in (speed, u_hub / speed, v_hub / speed)),
+            x, y, coordinates[:, 2],
+        )
+
+    def hub_height_at(self, x_i, y_i):
+        """Hub height of the turbine at (x_i, y_i) (shapes (n_findex, 1, 1, 1))."""
+        distance = (self.turbine_x - x_i[:, 0, 0]) ** 2 + (self.turbine_y - y_i[:, 0, 0]) ** 2
+        return self.turbine_hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
+
+    def at_hub(self, hub_height):
+        """U_h and the ambient (U, V) at the grid in the frame where V(hub_height) = 0
+        (MODEL_NOTES A.6): FLORIS's frame rotated by the hub-height direction."""
+        if np.any(hub_height <= self.abl.roughness_length):
+            raise ValueError("hub_height must be above the atmosphere's roughness_length")
+        rows = np.arange(hub_height.shape[0])
+        column = np.searchsorted(self.hub_heights, hub_height[:, 0, 0, 0])
+        pick = lambda table: table[rows, column][:, None, None, None]  # noqa: E731
+        cos_a, sin_a = pick(self.hub_cos), pick(self.hub_sin)
+        u = self.u * cos_a + self.v * sin_a
+        v = self.v * cos_a - self.u * sin_a
+        return pick(self.hub_speed), u, v
 
 
 @define(frozen=True)
@@ -185,16 +205,12 @@ class _EkmanWakeModel(BaseModel):
         )
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
-        abl = solved_atmosphere(flow_field)
-        reference_height = flow_field.reference_wind_height
         return {
             "x": grid.x_sorted,
             "y": grid.y_sorted,
             "z": grid.z_sorted,
             "u_initial": flow_field.u_initial_sorted,
-            "abl": abl,
-            "reference_height": reference_height,
-            "profile": reference_frame_profile(abl, grid.z_sorted, reference_height),
+            "ambient": Ambient.of(grid, flow_field),
         }
 
     def function(
@@ -214,16 +230,12 @@ class _EkmanWakeModel(BaseModel):
         y: np.ndarray,
         z: np.ndarray,
         u_initial: np.ndarray,
-        abl,
-        reference_height: float,
-        profile,
+        ambient: Ambient,
     ) -> np.ndarray:
         """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid."""
-        if np.any(hub_height_i <= abl.roughness_length):
-            raise ValueError("hub_height must be above the atmosphere's roughness_length")
+        abl = ambient.abl
         yaw = np.deg2rad(yaw_angle_i)
-        hub_speed = abl.speed(hub_height_i)
-        local_u, local_v = turbine_frame_profile(abl, profile, hub_height_i, reference_height)
+        hub_speed, local_u, local_v = ambient.at_hub(hub_height_i)
         dx = x - x_i
         wake = _TurbineWake(
             dx=np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0),  # dx = 0 means "no wake"
@@ -321,16 +333,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
     )
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
-        abl = solved_atmosphere(flow_field)
-        reference_height = flow_field.reference_wind_height
-        return {
-            "x": grid.x_sorted,
-            "z": grid.z_sorted,
-            "abl": abl,
-            "reference_height": reference_height,
-            "profile": reference_frame_profile(abl, grid.z_sorted, reference_height),
-            "turbines": hub_heights_of(grid, flow_field),
-        }
+        return {"x": grid.x_sorted, "z": grid.z_sorted, "ambient": Ambient.of(grid, flow_field)}
 
     def function(
         self,
@@ -343,20 +346,17 @@ class EkmanVeerVelocityDeflection(BaseModel):
         *,
         x: np.ndarray,
         z: np.ndarray,
-        abl,
-        reference_height: float,
-        profile,
-        turbines,
+        ambient: Ambient,
     ) -> np.ndarray:
-        hub_height = hub_height_at(x_i, y_i, turbines)
+        hub_height = ambient.hub_height_at(x_i, y_i)
         # Without the vortex pair the yaw term vanishes: the offset is that of an unyawed rotor.
         yaw = np.deg2rad(yaw_i) if self.yaw_deflection else np.zeros_like(yaw_i, dtype=float)
         ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
-        local_u, local_v = turbine_frame_profile(abl, profile, hub_height, reference_height)
+        hub_speed, local_u, local_v = ambient.at_hub(hub_height)
         flowing = local_u > 0
         offset = wake_centre_offset(
             x - x_i, z, hub_height=hub_height, radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
-            friction_velocity=abl.friction_velocity, hub_speed=abl.speed(hub_height),
+            friction_velocity=ambient.abl.friction_velocity, hub_speed=hub_speed,
             local_speed=np.where(flowing, local_u, 1.0),
             lateral_speed=np.where(flowing, local_v, 0.0), veer=self.veer,
             ground_image=self.ground_image,
