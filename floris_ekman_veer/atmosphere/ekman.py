@@ -182,7 +182,8 @@ class EkmanABL:
     Solved attributes: ``friction_velocity`` [m/s], ``boundary_layer_height`` [m],
     ``cross_isobaric_angle`` [deg, signed, surface-stress frame], ``stability_parameter``
     (mu, also when derived from C_r, Q0 or L), ``zilitinkevich_number`` mu_N,
-    ``geostrophic_components`` (U_g, V_g), ``coriolis_parameter`` (signed).
+    ``geostrophic_components`` (U_g, V_g), ``coriolis_parameter`` (signed), and the
+    dimensionless ``h_hat`` = h f_c/u* with the GDL coefficients ``gdl_a``, ``gdl_b`` (A, B).
     """
 
     def __init__(
@@ -207,29 +208,6 @@ class EkmanABL:
         c_ns=0.78,
         matching_fraction=0.2,
     ):
-        self.inputs = {
-            key: value
-            for key, value in dict(
-                coriolis_parameter=coriolis_parameter,
-                latitude=latitude,
-                roughness_length=roughness_length,
-                stability_parameter=stability_parameter,
-                cooling_rate=cooling_rate,
-                surface_heat_flux=surface_heat_flux,
-                obukhov_length=obukhov_length,
-                brunt_vaisala_frequency=brunt_vaisala_frequency,
-                lapse_rate=lapse_rate,
-                reference_potential_temperature=reference_potential_temperature,
-                von_karman=von_karman,
-                c_g=c_g,
-                stress_decay=stress_decay,
-                c_tn=c_tn,
-                c_cn=c_cn,
-                c_ns=c_ns,
-                matching_fraction=matching_fraction,
-            ).items()
-            if value is not None
-        }
         self._set_constants(von_karman, c_g, stress_decay, c_tn, c_cn, c_ns, matching_fraction)
 
         g_wind = finite("geostrophic_wind", geostrophic_wind)

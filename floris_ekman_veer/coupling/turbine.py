@@ -253,9 +253,8 @@ class ActuatorDiskTurbine(BaseOperationModel):
         Independent of the wind speed: the disk's C_T' is constant.
         """
         ct_prime, _diameter = _disk_parameters(power_thrust_table)
-        shape = _disk_average(velocities, average_method, cubature_weights)
         ct = disk_thrust_coefficient(ct_prime, yaw_angles) * _cos_yaw(yaw_angles)
-        return ct * np.ones_like(shape)
+        return ct * np.ones(np.shape(velocities)[:2])  # (n_findex, n_turbines)
 
     @staticmethod
     def axial_induction(
@@ -268,8 +267,7 @@ class ActuatorDiskTurbine(BaseOperationModel):
     ) -> NDArrayFloat:
         """a(beta) = C_T' cos^2 beta / (4 + C_T' cos^2 beta), the paper's Eq. (ind_factor)."""
         ct_prime, _diameter = _disk_parameters(power_thrust_table)
-        shape = _disk_average(velocities, average_method, cubature_weights)
-        return induction_factor(ct_prime, yaw_angles) * np.ones_like(shape)
+        return induction_factor(ct_prime, yaw_angles) * np.ones(np.shape(velocities)[:2])
 
 
 def register_operation_model() -> type[ActuatorDiskTurbine]:
