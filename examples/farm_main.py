@@ -239,7 +239,7 @@ def yaw_demo(farm: Farm) -> None:
     print("  gain: farm power at the optimum vs zero yaw; mirror: the optimal angles with the "
           "opposite sign.\n  Without veer (M-2) the mirrored set gains as much at 270 deg (the "
           "optimiser's choice of sign is arbitrary);\n  with veer (M-1) the sheared wake favours "
-          "one sign (MODEL_NOTES C.5), so search negative yaw too.")
+          "one sign (docs/coupling.md#yaw-optimisation), so search negative yaw too.")
 
 
 # ----------------------------------------------------------------------------------- figures

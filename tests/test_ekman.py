@@ -1,4 +1,4 @@
-"""Tests of floris_ekman_veer.atmosphere.ekman (paper Section 2.5, MODEL_NOTES part A).
+"""Tests of floris_ekman_veer.atmosphere.ekman (paper Section 2.5, docs/atmosphere.md).
 
 Expected values are hand arithmetic (plain ``math`` on scalars, the paper's equations written
 out here) or the LES numbers of the paper's Table 1; no solver output is used as a reference.
@@ -179,7 +179,7 @@ def test_geostrophic_at_and_above_h(abl):
 
 
 def test_no_nan_where_g_exceeds_one(abl):
-    """0.9973 h < z < h: the sqrt(1 - g^2) terms take their limit 0 (MODEL_NOTES A.4)."""
+    """0.9973 h < z < h: the sqrt(1 - g^2) terms take their limit 0 (docs/atmosphere.md#lateral-velocity-near-the-abl-top)."""
     h = float(abl.boundary_layer_height)
     z = h * np.linspace(ETA_G1, 1.0, 50)[1:-1]
     with np.errstate(all="raise"):
@@ -386,7 +386,7 @@ def test_table1_trends(closure):
 
 
 def test_table1_cooling_closure_sbl6_mu():
-    """MODEL_NOTES A.5: Q0 = C_r h with C_r = -1 K/h gives mu ~ 169 (the table lists 148.5)."""
+    """docs/validation.md#table-1: Q0 = C_r h with C_r = -1 K/h gives mu ~ 169 (the table lists 148.5)."""
     a = table_abl("SBL-6", "cooling_rate")
     assert float(a.stability_parameter) == pytest.approx(169.0, rel=0.01)
 

@@ -372,7 +372,7 @@ def test_par_floris_model_matches_serial(start_method):
 
 
 def test_par_floris_model_spawn_workers_know_the_package_models():
-    """MODEL_NOTES C.4: spawn workers start without the parent's registrations."""
+    """docs/coupling.md#parallel-workers: spawn workers start without the parent's registrations."""
     path = Path(__file__).parents[1] / "inputs" / "farm_sbl6.yaml"
     serial = FlorisModel(path)
     assert serial.core.wake.model_strings["velocity_model"] == "ekman_veer"

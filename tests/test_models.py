@@ -3,7 +3,7 @@
 Everything here goes through FLORIS itself (FlorisModel built from the package's YAML inputs, its
 turbine, cubature, planar and points grids, its solvers), and checks the result against the
 paper's formulas written out independently in this file (Narasimhan, Gayme & Meneveau, JRSE 2025,
-Section 2; MODEL_NOTES B and C):
+Section 2; docs/conventions.md, docs/coupling.md):
 
 1. the YAML switch on every FLORIS grid, finite fields down to the ground, turbine grid = points;
 2. limits: zero yaw without veer is Bastankhah & Porte-Agel (2014) with k* = k_w for x >= x0,

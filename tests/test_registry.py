@@ -69,7 +69,7 @@ def test_floris_finds_the_models_by_name_case_insensitively():
 
 
 def test_names_do_not_select_floris_special_solvers():
-    """cc, turbopark(gauss) and empirical_gauss have their own solvers (MODEL_NOTES C.1)."""
+    """cc, turbopark(gauss) and empirical_gauss have their own solvers (docs/coupling.md#registry)."""
     special = {"cc", "turbopark", "turboparkgauss", "empirical_gauss"}
     assert not {registry.VELOCITY_MODEL_NAME, registry.GAUSSIAN_2014_NAME} & special
 

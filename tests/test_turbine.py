@@ -28,7 +28,7 @@ A0 = 1.33 / 5.33  # a = C_T'/(4 + C_T')
 CT0 = 4 * A0 * (1 - A0)  # 0.7491
 COS20 = math.cos(math.radians(20.0))
 A20 = 1.33 * COS20**2 / (4 + 1.33 * COS20**2)
-CT20 = 16 * 1.33 / (4 + 1.33 * COS20**2) ** 2  # 0.7948, MODEL_NOTES B.10
+CT20 = 16 * 1.33 / (4 + 1.33 * COS20**2) ** 2  # 0.7948, docs/conventions.md#thrust-coefficient-and-yaw
 
 
 def hand_power(u, a=A0, cos_yaw=1.0, rho=RHO):

@@ -1,5 +1,5 @@
 """Tests of floris_ekman_veer.wake.deficit: every equation against arithmetic done here by hand
-(plain ``math`` on scalars), plus the limits and properties of MODEL_NOTES part B."""
+(plain ``math`` on scalars), plus the limits and properties of docs/wake_model.md."""
 
 import math
 

@@ -1,5 +1,5 @@
 """Tests of floris_ekman_veer.wake.deflection against arithmetic done here by hand, and the limits
-of MODEL_NOTES B.9 (y_hat_c -> t/2, -> sgn(t)|t|/(2 pi); mirror symmetry; beta > 0 -> y_c < 0)."""
+of docs/wake_model.md#limits (y_hat_c -> t/2, -> sgn(t)|t|/(2 pi); mirror symmetry; beta > 0 -> y_c < 0)."""
 
 import math
 

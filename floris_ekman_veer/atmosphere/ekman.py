@@ -6,7 +6,7 @@ Eq. (h_hat_model) and the geostrophic drag law (GDL), Eqs. (GDL), (A_model_GDL),
 Eq. (U_vel) (Monin-Obukhov surface layer below the matching height 0.2 h, Ekman layer
 above) and Eq. (V_vel).
 
-Frames and signs (MODEL_NOTES A.2): x along the surface stress; in the northern
+Frames and signs (docs/conventions.md#frames-and-signs): x along the surface stress; in the northern
 hemisphere kappa V_g/u* = -B < 0, so the signed cross-isobaric angle
 alpha_0 = atan2(V_g, U_g) is negative; in the southern hemisphere V and V_g change sign.
 
@@ -91,7 +91,7 @@ def gdl_coefficients(
 
 
 def stability_from_cooling_rate(cooling_rate_per_second, friction_velocity, coriolis, theta0, a0, c_ns):
-    """mu for the closure Q0 = C_r h (MODEL_NOTES A.1).
+    """mu for the closure Q0 = C_r h (docs/atmosphere.md#stability-closures).
 
     mu = -(g/Theta0) C_r h_hat(mu) / (f_c^2 u*) with h_hat(mu) = (a0 + mu/C_NS^2)^(-1/2), i.e.
     mu^3/C_NS^2 + a0 mu^2 - c^2 = 0, c = -(g/Theta0) C_r/(f_c^2 u*) >= 0. The cubic is convex
@@ -310,7 +310,7 @@ class EkmanABL:
 
     # ----------------------------------------------------------------------------- solver
     def _closure_mu(self, u_star, p):
-        """mu as a function of u* for the chosen stability input (MODEL_NOTES A.1)."""
+        """mu as a function of u* for the chosen stability input (docs/atmosphere.md#stability-closures)."""
         value, f, theta0 = p["value"], p["f"], p["theta0"]
         if self.stability_input == "stability_parameter":
             return value + 0.0 * u_star
@@ -423,7 +423,7 @@ class EkmanABL:
         U: Monin-Obukhov law up to the matching height 0.2 h, Ekman layer up to h, U_g above;
         continuous at 0.2 h by construction of A (dU/dz jumps there). V: one expression on
         0 <= z <= h with V(0) = 0 exactly; where g(xi) >= 1 (z > 0.9973 h, since c_g > 1)
-        the sqrt(1 - g^2) terms take their physical limit 0 (MODEL_NOTES A.4). The slight
+        the sqrt(1 - g^2) terms take their physical limit 0 (docs/atmosphere.md#lateral-velocity-near-the-abl-top). The slight
         backing of V near the ground is a property of the published formula and is kept.
         At z = z0, U = 0; for z < z0 raise (default) or return 0 with below_roughness='zero'.
         """
@@ -461,7 +461,7 @@ class EkmanABL:
     def hub_aligned_velocity(self, z, reference_height, below_roughness="raise"):
         """(U, V)(z) rotated so that V(reference_height) = 0 and U(reference_height) > 0.
 
-        This is the frame of the wake model (MODEL_NOTES A.6): x along the wind at hub height.
+        This is the frame of the wake model (docs/conventions.md#hub-aligned-frame): x along the wind at hub height.
         """
         u_ref, v_ref = self.velocity(reference_height)
         speed = np.hypot(u_ref, v_ref)
@@ -566,7 +566,7 @@ class EkmanABL:
 
 def friction_velocity_fixed_point(abl, iterations=200):
     """Re-solve u* of a solved `EkmanABL` by the fixed-point form of the GDL,
-    u* <- kappa G / sqrt((ln(u*/(f_c z0)) - A)^2 + B^2) (MODEL_NOTES A.1), from u* = 0.05 G.
+    u* <- kappa G / sqrt((ln(u*/(f_c z0)) - A)^2 + B^2) (docs/atmosphere.md#stability-closures), from u* = 0.05 G.
 
     An independent route to the same root, used to check the bracketed solver.
     """

@@ -11,7 +11,7 @@ reference wind, :func:`builtin_inflow_settings` gives each of them the best info
 ``wind_veer``
     The direction change across the rotor layer, ``EkmanABL.wind_direction_change(z_h - R,
     z_h + R)`` [deg], positive = veering (clockwise with height, the northern-hemisphere sense).
-    What the built-ins do with it (FLORIS 4.7, MODEL_NOTES C.3): gauss (hence GCH) and
+    What the built-ins do with it (FLORIS 4.7, docs/coupling.md#floris-inflow): gauss (hence GCH) and
     empirical_gauss rotate their elliptical Gaussian cross-section by this single angle (positive
     tilts the wake's top towards -y, the shape northern-hemisphere veer gives; the gauss deflection
     also narrows sigma_y0 by cos(wind_veer)). No built-in shifts a wake with height, which is

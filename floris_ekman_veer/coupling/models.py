@@ -5,9 +5,9 @@
 * ``EkmanVeerVelocityDeflection`` (``ekman_veer``): y_c(x, z) of Eq. (yc_xz), yaw (CVP with
   ground image) plus veer, at every grid point: it varies with height, which is how veer shears
   the wake.
-* ``Gaussian2014VelocityDeficit`` (``bastankhah2014``): the paper's M-3 (MODEL_NOTES B.12).
+* ``Gaussian2014VelocityDeficit`` (``bastankhah2014``): the paper's M-3 (docs/wake_model.md#m-3).
 
-Conventions (MODEL_NOTES B and C), each pinned by tests:
+Conventions (docs/conventions.md, docs/coupling.md), each pinned by tests:
 
 * FLORIS's positive yaw sends the wake to -y, as the paper's positive beta: the yaw angle is
   passed unchanged (in radians) as beta.
@@ -20,7 +20,7 @@ Conventions (MODEL_NOTES B and C), each pinned by tests:
   correction takes over from momentum theory) and a ``RuntimeWarning`` says so: a documented,
   deliberate limit rather than NaN. |yaw| >= 90 degrees raises ValueError.
 * U_h is the ambient hub-height speed of the turbine's own hub height; U(z), V(z) are the ambient
-  profile in the turbine's hub-aligned frame (V(z_h) = 0), MODEL_NOTES A.6 and B.7. FLORIS's frame
+  profile in the turbine's hub-aligned frame (V(z_h) = 0), docs/conventions.md#hub-aligned-frame and docs/wake_model.md#which-velocity-goes-where. FLORIS's frame
   is aligned with the wind at its reference height; for a hub at another height the profile is
   rotated by the direction difference (a few tenths of a degree across typical hub heights).
 * The deficit is returned relative to the local inflow: FLORIS multiplies it by
@@ -65,7 +65,7 @@ ROTOR_PLANE_MARGIN = 0.1
 
 # --------------------------------------------------------------------------------- shared pieces
 def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=None):
-    """C_T = ct_i / cos(yaw) (MODEL_NOTES B.10), limited to the momentum-theory range.
+    """C_T = ct_i / cos(yaw) (docs/conventions.md#thrust-coefficient-and-yaw), limited to the momentum-theory range.
 
     The limit acts on the rotor-normal loading C_T cos^2(loading_yaw) (default: the yaw itself,
     as in Eqs. A_star and ind_factor; 0 for a formula without yaw, M-3). ``yaw`` in radians.
@@ -98,7 +98,7 @@ class Ambient:
     reference height; 0 below the roughness length), and the hub-height speed and direction at
     each distinct hub height of the farm, so that no wake evaluates the profile again.
 
-    FLORIS's deflection call carries no hub height (MODEL_NOTES C.2). Every grid holds the farm's
+    FLORIS's deflection call carries no hub height (docs/coupling.md#call-signatures). Every grid holds the farm's
     ``turbine_coordinates`` (x, y, hub height) and rotates points about the centre of the farm's
     bounding box, as done here, so the turbine whose wake is computed is the one at (x_i, y_i).
     """
@@ -140,7 +140,7 @@ class Ambient:
 
     def at_hub(self, hub_height):
         """U_h and the ambient (U, V) at the grid in the frame where V(hub_height) = 0
-        (MODEL_NOTES A.6): FLORIS's frame rotated by the hub-height direction."""
+        (docs/conventions.md#hub-aligned-frame): FLORIS's frame rotated by the hub-height direction."""
         if np.any(hub_height <= self.abl.roughness_length):
             raise ValueError("hub_height must be above the atmosphere's roughness_length")
         rows = np.arange(hub_height.shape[0])
@@ -283,7 +283,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
         curl: polar-angle dependent (curled) width; False keeps the initial ellipse xi_hat = 1.
         polar_angle_centre: "wake_centre" (paper: theta about the full yaw + veer centre) or
             "yaw_centre" (the authors' published code: theta about the yaw-only centre while the
-            Gaussian sits on the full centre, MODEL_NOTES B.2; needs the ekman_veer deflection).
+            Gaussian sits on the full centre, docs/wake_model.md#polar-angle; needs the ekman_veer deflection).
         A1, B1, alpha_prime, k_w_floor, k_w_exponent, wake_expansion: Eq. (kw_CNBL_SBL_model).
         max_thrust_coefficient: momentum-theory limit of C_T cos^2(yaw) (see module docstring).
     """
@@ -368,7 +368,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
 @define
 class Gaussian2014VelocityDeficit(_EkmanWakeModel):
     """The paper's M-3: Bastankhah & Porte-Agel (2014) Gaussian, no yaw or veer physics
-    (MODEL_NOTES B.12), on the Ekman inflow; centred on FLORIS's deflection field.
+    (docs/wake_model.md#m-3), on the Ekman inflow; centred on FLORIS's deflection field.
 
     k* = ``k_star`` if given, else the paper's k_w (Eq. kw_CNBL_SBL_model, or the local
     turbulence variant), so that M-1 and M-3 differ only by their physics, not their mixing.

@@ -6,7 +6,7 @@ plain ``FlorisModel(fmodel_dict)``. Two things must hold there:
 * The package's models and the inflow hook must be installed in the worker. With the ``fork``
   start method they are inherited; with ``spawn`` or ``forkserver`` (the default on macOS and
   Windows, and from Python 3.14 on Linux) the worker starts from a fresh interpreter that imports
-  only FLORIS, and a model registered in the parent is missing (MODEL_NOTES C.4). ParFlorisModel
+  only FLORIS, and a model registered in the parent is missing (docs/coupling.md#parallel-workers). ParFlorisModel
   offers no pool initializer, so the dictionary sent to each worker is a :class:`WorkerDict`,
   whose unpickling calls :func:`prepare_worker` before FLORIS sees it.
 * Per-condition atmosphere lists (length n_findex of the parent) are cut to the worker's share of

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import MutableMapping
 
 #: Names under which the wake models appear in ``floris.core.wake.MODEL_MAP``. Not cc, turbopark
-#: or empirical_gauss: those names select their own solvers (MODEL_NOTES C.1).
+#: or empirical_gauss: those names select their own solvers (docs/coupling.md#registry).
 VELOCITY_MODEL_NAME = "ekman_veer"
 DEFLECTION_MODEL_NAME = "ekman_veer"
 GAUSSIAN_2014_NAME = "bastankhah2014"

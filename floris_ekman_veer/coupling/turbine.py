@@ -9,7 +9,7 @@ two-turbine power cases can be run through FLORIS, and registers it in FLORIS's
 Momentum theory of the disk
 ---------------------------
 A disk of fixed C_T' in a wind U, yawed by beta (FLORIS's yaw angle, which is the paper's beta,
-MODEL_NOTES B.1), feels the disk-normal force F = 1/2 rho A C_T' u_n^2 with the disk-normal
+docs/conventions.md#frames-and-signs), feels the disk-normal force F = 1/2 rho A C_T' u_n^2 with the disk-normal
 velocity u_n = (1 - a) U cos(beta). One-dimensional momentum balance F = 1/2 rho A U^2 4a(1 - a)
 then gives (Shapiro, Gayme & Meneveau 2018; Bastankhah et al. 2022)
 
@@ -20,7 +20,7 @@ where C_T(beta) is the thrust coefficient *on the un-yawed basis* that the paper
 they apply cos^2(beta) and cos^3(beta) themselves, and the paper's Eq. (ind_factor),
 a = (1 - sqrt(1 - C_T cos^2 beta))/2, evaluated with C_T(beta), returns exactly a(beta) above.
 Un-yawed: a = C_T'/(4 + C_T') = 0.24953 and C_T = 4a(1 - a) = 0.74906 for C_T' = 1.33; at
-beta = 20 deg, C_T(beta) = 0.79478 (MODEL_NOTES B.10).
+beta = 20 deg, C_T(beta) = 0.79478 (docs/conventions.md#thrust-coefficient-and-yaw).
 
 The power is the disk-normal force times the disk-normal velocity,
 

@@ -3,10 +3,10 @@
     Delta u / U_h = C(x) exp[-((y - y_c)^2 + (z - z_h)^2) / (2 sigma(theta, x)^2)]   Eq. (du_model)
 
 Every function is pure numpy and broadcasts its arguments by numpy rules, so the caller may pass
-FLORIS's 4-D arrays or plain scalars. Conventions (MODEL_NOTES B.1): right-handed frame, x
+FLORIS's 4-D arrays or plain scalars. Conventions (docs/conventions.md#frames-and-signs): right-handed frame, x
 downstream, y to the left looking downstream, z up; yaw ``beta`` in radians, positive yaw sends the
 wake to -y. ``ct`` is always the UN-YAWED thrust coefficient C_T: the equations apply cos^2(beta)
-and cos^3(beta) themselves (MODEL_NOTES B.10). Lengths are in metres, speeds in m/s.
+and cos^3(beta) themselves (docs/conventions.md#thrust-coefficient-and-yaw). Lengths are in metres, speeds in m/s.
 
 Invalid parameters raise ``ValueError`` naming the parameter and its valid range; nothing is
 clipped silently and no function returns NaN for valid input.
@@ -106,7 +106,7 @@ def sigma_tilde_squared(x, k_w, radius, ct, yaw):
 
     sigma_tilde^2 = (k_w x + 0.4 R sqrt(A*)) (k_w x + 0.4 R sqrt(A*) cos beta).
 
-    Both factors grow from x = 0 (no virtual origin, MODEL_NOTES B.3). ``k_w`` > 0, ``radius`` > 0.
+    Both factors grow from x = 0 (no virtual origin, docs/wake_model.md#wake-width). ``k_w`` > 0, ``radius`` > 0.
     """
     x = np.asarray(x, dtype=float)
     k_w = positive(k_w, "k_w")
@@ -167,7 +167,7 @@ def max_deficit(x, k_w, radius, ct, yaw):
 
 def polar_harmonics(dy, dz):
     """cos(theta), sin(theta), cos(2 theta), cos(3 theta), cos(4 theta) of the polar angle
-    theta = arctan2(dz, dy), Eq. (polar_angle) read four-quadrant (MODEL_NOTES B.2).
+    theta = arctan2(dz, dy), Eq. (polar_angle) read four-quadrant (docs/wake_model.md#polar-angle).
 
     No trigonometric call: cos = dy/r, sin = dz/r with r = hypot(dy, dz), and the multiples follow
     from the Chebyshev recurrence T_{n+1} = 2 cos(theta) T_n - T_{n-1}, which keeps the quadrant
@@ -212,7 +212,7 @@ def curl_shape(t_hat, cos2, cos3, cos4, alpha=CURL_ALPHA):
                          - 5/48 tanh(t^4/(16 alpha)) cos 2theta
                          + 7/48 tanh(t^4/(16 alpha)) cos 4theta ].
 
-    The two cos(2 theta) terms are kept separate as printed (MODEL_NOTES B.5). xi_hat = 1 at
+    The two cos(2 theta) terms are kept separate as printed (docs/wake_model.md#curled-shape). xi_hat = 1 at
     t_hat = 0. For t_hat < 0 (beta > 0) the notch of the kidney is at theta = 0 (+y side) and the
     lobes stretch vertically. ``alpha`` in (0, 48/38): beyond 48/38 xi_hat turns negative at the
     notch for large |t_hat|, and the wake width with it.
@@ -242,7 +242,7 @@ def time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct,
             [1 - exp(-0.35 (u*/U(z)) x/R)].
 
     U_h (``hub_speed``) sets the circulation of the vortex pair (prefactor); the local U(z)
-    (``local_speed``) sets the advection time to x (exponential), MODEL_NOTES B.7. beta > 0 gives
+    (``local_speed``) sets the advection time to x (exponential), docs/wake_model.md#which-velocity-goes-where. beta > 0 gives
     t_hat < 0. Time counts from the rotor plane, so t_hat = 0 for x <= 0. All speeds must be
     finite and > 0: U(z) <= 0 (at or below the roughness height) carries nothing downstream.
     1 - exp(-y) is evaluated as -expm1(-y) to keep precision close to the rotor.
@@ -301,7 +301,7 @@ def normalised_deficit(
     polar_dy : if given, the lateral distance used ONLY for the polar angle theta. The paper
         measures theta from the full centre (default, ``polar_dy=None``); the authors' published
         code measures it from the yaw-only centre while centring the Gaussian on the full one
-        (MODEL_NOTES B.2): pass y - y_c,yaw to reproduce that.
+        (docs/wake_model.md#polar-angle): pass y - y_c,yaw to reproduce that.
 
     sigma(theta, x) > 0 for x >= 0 (xi0 > 0 and xi_hat > 0 for alpha < 48/38), so the Gaussian is
     always defined.

@@ -5,7 +5,7 @@
 y_hat_c (Eq. yhatc) is the sidewash of the yaw-induced counter-rotating vortex pair plus that of its
 ground image; y_c,veer (Eq. yc_veer) is the shear of the wake by the veering inflow. Pure numpy,
 broadcasting by numpy rules; yaw in radians; ``ct`` the un-yawed C_T. Frame: x downstream, y to the
-left looking downstream, z up; beta > 0 gives t_hat < 0 and y_c < 0 (MODEL_NOTES B.1).
+left looking downstream, z up; beta > 0 gives t_hat < 0 and y_c < 0 (docs/conventions.md#frames-and-signs).
 """
 
 from __future__ import annotations
@@ -71,7 +71,7 @@ def veer_deflection(x, local_speed, lateral_speed):
     """Lateral wake displacement by wind veer y_c,veer = x V(z) / U(z), Eq. (yc_veer), in metres.
 
     ``local_speed`` U(z) and ``lateral_speed`` V(z) are the inflow components in the frame where
-    the hub-height wind is along +x (MODEL_NOTES A.6). Zero for x <= 0 (no wake upstream).
+    the hub-height wind is along +x (docs/conventions.md#hub-aligned-frame). Zero for x <= 0 (no wake upstream).
 
     U(z) must be finite and > 0 everywhere, else ValueError: a parcel with U <= 0 (at or below the
     roughness height, where the log law changes sign) never reaches x > 0, and x V/U has no finite
@@ -103,7 +103,7 @@ def wake_centre_offset(
     y_c = y_hat_c(t_hat) R sqrt(A*) + y_c,veer, with t_hat from Eq. (that) (``friction_velocity``
     u*, ``hub_speed`` U_h, ``local_speed`` U(z)) and y_c,veer from Eq. (yc_veer)
     (``lateral_speed`` V(z), required when ``veer`` is True). ``veer=False`` gives the yaw-only
-    centre (model M-2, and the centre of the polar angle in the authors' code, MODEL_NOTES B.2).
+    centre (model M-2, and the centre of the polar angle in the authors' code, docs/wake_model.md#polar-angle).
     x is the streamwise distance behind the rotor; y_c = 0 for x <= 0.
     """
     t_hat = time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct, yaw)

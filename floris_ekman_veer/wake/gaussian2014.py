@@ -2,7 +2,7 @@
 
     Delta u / U_inf = C(x) exp[-(dy^2 + dz^2) / (2 sigma^2)],
     sigma/D = k* x/D + 0.2 sqrt(beta_BP),   beta_BP = (1 + sqrt(1 - C_T)) / (2 sqrt(1 - C_T)),
-    C(x) = 1 - sqrt(1 - C_T / (8 (sigma/D)^2))                                   (MODEL_NOTES B.12)
+    C(x) = 1 - sqrt(1 - C_T / (8 (sigma/D)^2))                                   (docs/wake_model.md#m-3)
 
 Near the rotor the far-wake C(x) is undefined (negative root argument for sigma/D < sqrt(C_T/8))
 and, where it is defined but sigma/D < 1/sqrt(8), it exceeds the momentum-theory deficit
