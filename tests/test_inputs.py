@@ -19,7 +19,15 @@ PAPER_ATMOSPHERE = dict(
 PAPER_G = 15.0
 
 
-@pytest.mark.parametrize("case, cooling_rate", [("cnbl", 0.0), ("sbl6", -1.0)])
+#: The paper's cases (Table 1) and their LES cooling rates C_r [K/h]; every file uses the
+#: cooling-rate closure (Q0 = C_r h).
+PAPER_COOLING_RATES = {
+    "cnbl": 0.0, "sbl1": -0.03, "sbl2": -0.125, "sbl3": -0.25, "sbl4": -0.375, "sbl5": -0.5,
+    "sbl6": -1.0,
+}
+
+
+@pytest.mark.parametrize("case, cooling_rate", PAPER_COOLING_RATES.items())
 def test_paper_case_inputs(case, cooling_rate):
     """The wind speed of each paper-case file is the 100 m speed of the paper's atmosphere with
     G = 15 m/s: solving the ABL back from it gives G = 15 m/s; one actuator disk (C_T' = 1.33,
