@@ -5,12 +5,16 @@ Importing the package registers, in FLORIS's model tables, the velocity and defl
 ``ekman_veer`` (the paper's M-1; M-2 with veer off), the velocity model ``bastankhah2014`` (M-3),
 the turbine operation model ``actuator-disk``, and installs the Ekman inflow hook, a no-op for
 FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
+
+``floris_ekman_veer.ParFlorisModel`` is FLORIS's ParFlorisModel plus ``interface="dask"``
+(conditions chunked over a dask.distributed cluster; optional extra ``dask``).
 """
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.coupling.distributed import ParFlorisModel
 from floris_ekman_veer.coupling.registry import register
 
-__all__ = ["EkmanABL", "register"]
+__all__ = ["EkmanABL", "ParFlorisModel", "register"]
 __version__ = "0.1.0"
 
 register()

@@ -1,0 +1,190 @@
+"""ParFlorisModel(interface="dask") on a LocalCluster of two worker processes.
+
+The cluster test runs a script in a fresh interpreter that imports floris_ekman_veer only inside
+``main()``: Dask's worker processes are spawned from a fresh interpreter too, so they know the
+package's models only if ParFlorisModel registers them there (docs/coupling.md#parallel-workers).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from floris_ekman_veer import ParFlorisModel  # noqa: E402
+from floris_ekman_veer.coupling import distributed as cluster_module  # noqa: E402
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+
+SCRIPT = textwrap.dedent(
+    """
+    import json
+    import sys
+    import time
+
+    import numpy as np
+
+
+    def main():
+        started = time.perf_counter()
+        from distributed import Client, LocalCluster
+        from floris import FlorisModel
+        from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+        import floris_ekman_veer
+        from floris_ekman_veer import ParFlorisModel
+        from floris_ekman_veer.coupling import inflow
+
+        farm = sys.argv[1]
+        wind_speeds = np.array([7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 9.0])
+        wind_directions = np.array([262.0, 266.0, 270.0, 274.0, 278.0, 270.0, 95.0])
+        conditions = dict(wind_speeds=wind_speeds, wind_directions=wind_directions,
+                          turbulence_intensities=np.full(7, 0.06))
+        out = {}
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                          dashboard_address=None) as cluster, Client(cluster) as client:
+            serial = FlorisModel(farm)
+            serial.set(yaw_angles=np.tile([10.0, -5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                                          (7, 1)), **conditions)
+            serial.run()
+            par = ParFlorisModel(serial, interface="dask", client=client)
+            par.run()
+            out["max_workers"] = par.max_workers
+            out["interface"] = par.interface
+            out["run"] = np.max(np.abs(par.get_turbine_powers()
+                                       - serial.get_turbine_powers())).item()
+            points = (np.array([300.0, 900.0, 1500.0]), np.array([0.0, 20.0, -30.0]),
+                      np.array([90.0, 60.0, 120.0]))
+            out["points"] = np.max(np.abs(par.sample_flow_at_points(*points)
+                                          - serial.sample_flow_at_points(*points))).item()
+            # The package's models ran on the workers (a worker without them would have raised).
+            out["worker_models"] = sorted(set(client.run(_velocity_models).values()))
+
+            by_address = ParFlorisModel(serial, interface="dask",
+                                        client=cluster.scheduler_address,
+                                        return_turbine_powers_only=True)
+            by_address.run()
+            out["powers_only"] = np.max(np.abs(by_address.get_turbine_powers()
+                                               - serial.get_turbine_powers())).item()
+            by_address.client.close()
+
+            # Per-condition atmosphere lists are cut with the conditions.
+            day_night = FlorisModel(farm)
+            atmosphere = inflow.atmosphere_of(day_night.core).sliced(slice(None))
+            atmosphere["stability_parameter"] = [0.0, 148.49] * 3 + [60.0]
+            inflow.set_atmosphere(day_night, atmosphere, **conditions)
+            day_night.run()
+            par_day_night = ParFlorisModel(day_night, interface="dask", client=client)
+            par_day_night.run()
+            out["per_condition"] = np.max(np.abs(par_day_night.get_turbine_powers()
+                                                 - day_night.get_turbine_powers())).item()
+
+            # FLORIS's optimiser takes the Dask model as it takes any ParFlorisModel.
+            serial.set(yaw_angles=np.zeros((7, 9)))
+            kwargs = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
+            reference = YawOptimizationSR(serial, **kwargs).optimize(print_progress=False)
+            par.set(yaw_angles=np.zeros((7, 9)))
+            on_cluster = YawOptimizationSR(par, **kwargs).optimize(print_progress=False)
+            out["yaw_angles"] = np.max(np.abs(np.vstack(on_cluster.yaw_angles_opt)
+                                              - np.vstack(reference.yaw_angles_opt))).item()
+            out["yaw_power"] = np.max(np.abs(on_cluster.farm_power_opt.to_numpy()
+                                             - reference.farm_power_opt.to_numpy())).item()
+            out["yaw_steered"] = np.max(np.abs(np.vstack(reference.yaw_angles_opt))).item()
+        out["seconds"] = time.perf_counter() - started
+        print("RESULT " + json.dumps(out))
+
+
+    def _velocity_models():
+        from floris.core.wake import MODEL_MAP
+
+        return "ekman_veer" in MODEL_MAP["velocity_model"]
+
+
+    if __name__ == "__main__":
+        main()
+    """
+)
+
+
+@pytest.fixture(scope="module")
+def cluster_results(tmp_path_factory):
+    script = tmp_path_factory.mktemp("dask") / "run_on_cluster.py"
+    script.write_text(SCRIPT)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(REPOSITORY)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    done = subprocess.run(
+        [sys.executable, str(script), str(REPOSITORY / "inputs" / "farm_sbl6.yaml")],
+        capture_output=True, text=True, env=env, timeout=300, cwd=script.parent,
+    )
+    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
+    assert done.returncode == 0 and lines, done.stderr[-3000:]
+    return json.loads(lines[-1][len("RESULT "):])
+
+
+def test_dask_model_is_the_serial_model(cluster_results):
+    assert cluster_results["interface"] == "dask"
+    assert cluster_results["max_workers"] == 2  # two single-threaded workers
+    assert cluster_results["worker_models"] == [True]
+    # Each condition is computed on its own, so the chunks give the serial numbers exactly.
+    for key in ("run", "points", "powers_only", "per_condition"):
+        assert cluster_results[key] == 0.0, key
+
+
+def test_dask_model_in_floris_optimiser(cluster_results):
+    assert cluster_results["yaw_steered"] > 0.0  # the case does steer
+    assert cluster_results["yaw_angles"] == 0.0
+    assert cluster_results["yaw_power"] == 0.0
+
+
+# ------------------------------------------------------------------------- bad input
+
+
+def test_client_requires_dask_interface():
+    with pytest.raises(ValueError, match='only used with interface="dask"'):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="multiprocessing",
+                       client="tcp://127.0.0.1:8786")
+
+
+def test_dask_interface_without_a_client():
+    with pytest.raises(ValueError, match="needs client="):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask")
+
+
+def test_dask_interface_rejects_other_client_objects():
+    with pytest.raises(ValueError, match="got int"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=8786)
+
+
+class _FakeClient:
+    """What _check_workers reads of a Client: run() on every worker, the scheduler address."""
+
+    class scheduler:
+        address = "tcp://fake:8786"
+
+    def __init__(self, versions):
+        self.versions = versions
+
+    def run(self, function):
+        return {"tcp://worker:1": self.versions}
+
+
+def test_worker_with_other_versions_is_rejected():
+    local = cluster_module._versions()
+    cluster_module._check_workers(_FakeClient(local))
+    with pytest.raises(ValueError, match=r"tcp://worker:1 has floris_ekman_veer 0\.0\.0"):
+        cluster_module._check_workers(_FakeClient(("0.0.0", local[1])))
+
+
+def test_other_interfaces_are_floris_parflorismodel():
+    par = ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface=None)
+    par.run()
+    assert par.client is None and par.interface is None
+    assert np.all(np.isfinite(par.get_turbine_powers()))
