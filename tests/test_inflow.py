@@ -209,6 +209,7 @@ def test_unconfigured_floris_is_bitwise_unchanged(wake):
         plain = _unconfigured_outputs(config)
     finally:
         inflow.install_inflow_hook()
+        parallel.install_parallel_hook()
     for a, b, c in zip(hooked, hooked_empty_block, plain, strict=True):
         np.testing.assert_array_equal(a, c)
         np.testing.assert_array_equal(b, c)

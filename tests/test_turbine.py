@@ -16,6 +16,7 @@ from floris.utilities import load_yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from floris_ekman_veer.coupling import registry
 from floris_ekman_veer.coupling import turbine as adt
 
 REPO = Path(__file__).resolve().parents[1]
@@ -38,7 +39,7 @@ def hand_power(u, a=A0, cos_yaw=1.0, rho=RHO):
 
 @pytest.fixture(autouse=True, scope="module")
 def _registered():
-    adt.register_operation_model()
+    registry.register_operation_model()
 
 
 def table():
@@ -255,33 +256,33 @@ def test_nonzero_ref_tilt_raises():
 
 
 def test_registration_is_idempotent():
-    registry = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
-    assert adt.register_operation_model() is adt.ActuatorDiskTurbine
-    assert adt.register_operation_model() is adt.ActuatorDiskTurbine
-    assert registry["actuator-disk"] is adt.ActuatorDiskTurbine
-    assert registry["cosine-loss"].__name__ == "CosineLossTurbine"
+    operation_models = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
+    assert registry.register_operation_model() is adt.ActuatorDiskTurbine
+    assert registry.register_operation_model() is adt.ActuatorDiskTurbine
+    assert operation_models["actuator-disk"] is adt.ActuatorDiskTurbine
+    assert operation_models["cosine-loss"].__name__ == "CosineLossTurbine"
 
 
 def test_registration_refuses_to_overwrite_other_class(monkeypatch):
-    registry = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
-    other = registry["cosine-loss"]
-    monkeypatch.setitem(registry, "actuator-disk", other)
+    operation_models = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
+    other = operation_models["cosine-loss"]
+    monkeypatch.setitem(operation_models, "actuator-disk", other)
     with pytest.raises(ValueError, match="actuator-disk"):
-        adt.register_operation_model()
-    assert registry["actuator-disk"] is other
+        registry.register_operation_model()
+    assert operation_models["actuator-disk"] is other
 
 
 def test_registration_replaces_a_reloaded_copy_of_itself(monkeypatch):
     # importlib.reload of the module creates a new class object of the same origin.
-    registry = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
+    operation_models = floris_turbine.TURBINE_MODEL_MAP["operation_model"]
     stale = type(
         "ActuatorDiskTurbine",
         (),
         {"__module__": adt.__name__, "__qualname__": adt.ActuatorDiskTurbine.__qualname__},
     )
-    monkeypatch.setitem(registry, "actuator-disk", stale)
-    assert adt.register_operation_model() is adt.ActuatorDiskTurbine
-    assert registry["actuator-disk"] is adt.ActuatorDiskTurbine
+    monkeypatch.setitem(operation_models, "actuator-disk", stale)
+    assert registry.register_operation_model() is adt.ActuatorDiskTurbine
+    assert operation_models["actuator-disk"] is adt.ActuatorDiskTurbine
 
 
 # --- inside FLORIS -------------------------------------------------------------------------------

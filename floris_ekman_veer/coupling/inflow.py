@@ -557,6 +557,8 @@ def _rejecting_per_condition(method, tool: str, fmodel_of):
 
 
 def _patch(owner, name: str, make_wrapper) -> None:
+    """Replace ``owner.name`` by ``make_wrapper(original)`` once (idempotent); the original is
+    kept for :func:`uninstall_inflow_hook`."""
     if (owner, name) in _ORIGINALS:
         return
     original = owner.__dict__[name]
@@ -571,13 +573,13 @@ def install_inflow_hook() -> None:
     ``Core.initialize_domain``, ``steady_state_atmospheric_condition``, ``solve_for_viz``,
     ``solve_for_points``, ``solve_for_velocity_deficit_profiles`` (atmosphere context);
     ``FlorisModel.set_for_viz`` (slices per-condition lists); ``UncertainFlorisModel._set_uncertain``
-    and ``YawOptimization.__init__`` (reject per-condition lists); ParFlorisModel's condition
-    splitting (see :mod:`floris_ekman_veer.coupling.parallel`).
+    and ``YawOptimization.__init__`` (reject per-condition lists). ParFlorisModel's condition
+    splitting is installed, by
+    :func:`floris_ekman_veer.coupling.parallel.install_parallel_hook` (this module does not import
+    that one: imports point one way, docs/coupling.md#parallel-workers).
     """
     from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
     from floris.uncertain_floris_model import UncertainFlorisModel
-
-    from floris_ekman_veer.coupling import parallel
 
     _patch(
         FlowField, "initialize_velocity_field",
@@ -601,7 +603,6 @@ def install_inflow_hook() -> None:
         YawOptimization, "__init__",
         lambda m: _rejecting_per_condition(m, "a yaw optimiser", lambda s, fmodel, *a, **k: fmodel),
     )
-    parallel.install_parallel_hook(_patch)
 
 
 def uninstall_inflow_hook() -> None:

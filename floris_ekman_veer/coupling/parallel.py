@@ -25,19 +25,22 @@ import numpy as np
 from floris_ekman_veer.coupling.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
+    _patch,
     atmosphere_of,
     install_inflow_hook,
 )
 
 
 def prepare_worker() -> None:
-    """Register the package's FLORIS models and install the inflow hook (idempotent)."""
-    import floris_ekman_veer
+    """Make this process ready to build the package's FLORIS models (idempotent).
 
-    register = getattr(floris_ekman_veer, "register", None)
-    if callable(register):
-        register()
+    Reaching this function imports ``floris_ekman_veer`` (Python imports a package before its
+    modules; unpickling looks the function up by module name), and that import registers the models;
+    this call then re-installs the inflow hook and the ParFlorisModel support, should they have
+    been uninstalled. It imports nothing above it (docs/coupling.md#parallel-workers).
+    """
     install_inflow_hook()
+    install_parallel_hook()
 
 
 def _unpickle_worker_dict(data: dict) -> dict:
@@ -79,8 +82,9 @@ def _splitting_preprocessing(method):
     return wrapper
 
 
-def install_parallel_hook(patch) -> None:
-    """Wrap ParFlorisModel's condition splitting (called by ``install_inflow_hook``)."""
+def install_parallel_hook() -> None:
+    """Wrap ParFlorisModel's condition splitting (idempotent; ``register()`` calls it;
+    ``uninstall_inflow_hook`` restores it with the other patches)."""
     from floris.par_floris_model import ParFlorisModel
 
-    patch(ParFlorisModel, "_preprocessing", _splitting_preprocessing)
+    _patch(ParFlorisModel, "_preprocessing", _splitting_preprocessing)

@@ -3,7 +3,10 @@
 ``register()`` makes the wake models selectable by name in a FLORIS input
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
 bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
-inflow hook. Importing ``floris_ekman_veer`` calls it.
+inflow hook and ParFlorisModel support. Importing ``floris_ekman_veer`` calls it.
+
+This is the top of the coupling layer: it imports the model, turbine, inflow and parallel modules,
+and none of them imports it (docs/coupling.md#registry).
 """
 
 from __future__ import annotations
@@ -36,8 +39,25 @@ def register_in(table: MutableMapping, name: str, cls: type, kind: str) -> type:
     return cls
 
 
+def register_operation_model() -> type:
+    """Register the actuator disk as FLORIS operation model ``"actuator-disk"``; return its class.
+
+    Idempotent. Raises ValueError if that name already maps to another class (a reloaded copy of
+    that very class, same module and qualified name, is replaced by the current one).
+    """
+    from floris.core.turbine import turbine as floris_turbine
+
+    from floris_ekman_veer.coupling.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
+
+    return register_in(
+        floris_turbine.TURBINE_MODEL_MAP["operation_model"], OPERATION_MODEL_NAME,
+        ActuatorDiskTurbine, "operation model",
+    )
+
+
 def register() -> None:
-    """Register the wake models and the actuator-disk turbine, install the inflow hook."""
+    """Register the wake models and the actuator-disk turbine, install the inflow hook and the
+    ParFlorisModel support."""
     from floris.core.wake import MODEL_MAP
 
     from floris_ekman_veer.coupling.inflow import install_inflow_hook
@@ -46,7 +66,7 @@ def register() -> None:
         EkmanVeerVelocityDeflection,
         Gaussian2014VelocityDeficit,
     )
-    from floris_ekman_veer.coupling.turbine import register_operation_model
+    from floris_ekman_veer.coupling.parallel import install_parallel_hook
 
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
                 "velocity_model")
@@ -56,3 +76,4 @@ def register() -> None:
                 "deflection_model")
     register_operation_model()
     install_inflow_hook()
+    install_parallel_hook()

@@ -61,8 +61,9 @@ power is FLORIS's flow ``air_density`` (power is linear in it), as FLORIS's own 
 their tables from ``ref_air_density``. Not modelled: tilt, cut-in/out, rated power, derating
 setpoints, AWC (the LES disk has none of these); |yaw| must stay below 90 deg.
 
-Registration: call :func:`register_operation_model` before FLORIS builds a farm using the model
-(in every process, including ParFlorisModel workers).
+Registration: importing ``floris_ekman_veer`` registers the model (in every process, including
+ParFlorisModel workers); :func:`floris_ekman_veer.coupling.registry.register_operation_model`
+does it alone.
 """
 
 from __future__ import annotations
@@ -70,7 +71,6 @@ from __future__ import annotations
 import numpy as np
 from attrs import define
 from floris.core.rotor_velocity import average_velocity
-from floris.core.turbine import turbine as _floris_turbine
 from floris.core.turbine.operation_models import BaseOperationModel
 from floris.type_dec import NDArrayFloat
 
@@ -269,17 +269,3 @@ class ActuatorDiskTurbine(BaseOperationModel):
         ct_prime, _diameter = _disk_parameters(power_thrust_table)
         return induction_factor(ct_prime, yaw_angles) * np.ones(np.shape(velocities)[:2])
 
-
-def register_operation_model() -> type[ActuatorDiskTurbine]:
-    """Register :class:`ActuatorDiskTurbine` as FLORIS operation model ``"actuator-disk"``.
-
-    Idempotent. Raises ValueError if that name already maps to another class (a reloaded copy of
-    this very class, same module and qualified name, is replaced by the current one).
-    """
-    from floris_ekman_veer.coupling.registry import register_in
-
-    register_in(
-        _floris_turbine.TURBINE_MODEL_MAP["operation_model"], OPERATION_MODEL_NAME,
-        ActuatorDiskTurbine, "operation model",
-    )
-    return ActuatorDiskTurbine
