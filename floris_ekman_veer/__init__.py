@@ -10,11 +10,11 @@ FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
 (conditions chunked over a dask.distributed cluster; optional extra ``dask``).
 """
 
+from floris_ekman_veer._version import __version__
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.coupling.distributed import ParFlorisModel
 from floris_ekman_veer.coupling.registry import register
 
-__all__ = ["EkmanABL", "ParFlorisModel", "register"]
-__version__ = "0.1.0"
+__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "register"]
 
 register()

@@ -28,6 +28,7 @@ import copy
 
 from floris.par_floris_model import ParFlorisModel as _FlorisParFlorisModel
 
+from floris_ekman_veer._version import __version__
 from floris_ekman_veer.coupling.parallel import prepare_worker
 
 DASK = "dask"
@@ -49,9 +50,7 @@ def _versions() -> tuple[str, str]:
     prepare_worker()
     import floris
 
-    import floris_ekman_veer
-
-    return floris_ekman_veer.__version__, floris.__version__
+    return __version__, floris.__version__
 
 
 def _check_workers(client) -> None:
