@@ -8,13 +8,16 @@ FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
 
 ``floris_ekman_veer.ParFlorisModel`` is FLORIS's ParFlorisModel plus ``interface="dask"``
 (conditions chunked over a dask.distributed cluster; optional extra ``dask``).
+``floris_ekman_veer.optimize_yaw(fmodel, optimizer_class, **options)`` runs FLORIS's yaw
+optimisers on scalar and per-condition atmospheres alike and returns FLORIS's ``df_opt``.
 """
 
 from floris_ekman_veer._version import __version__
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.coupling.distributed import ParFlorisModel
+from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
 
-__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "register"]
+__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "optimize_yaw", "register"]
 
 register()

@@ -1,0 +1,246 @@
+"""Yaw optimisation with FLORIS's optimisers on models whose atmosphere varies per condition.
+
+FLORIS's yaw optimisers tile, mask and re-order their model's conditions internally (the Serial
+Refine evaluates ``Ny`` copies of every condition at once and skips those already in memory;
+the SciPy optimiser sets one condition at a time), so a per-condition atmosphere list
+(docs/coupling.md#yaw-optimisation), which binds to conditions by position, cannot follow them.
+Every condition's optimum depends on that condition alone, so :func:`optimize_yaw` runs the
+optimiser once per distinct atmosphere (and per chunk of conditions, for the progress bar) on
+a model holding just those conditions with that atmosphere as scalars, and puts the rows of
+FLORIS's ``df_opt`` frames back in the caller's order. The result is, by construction, the
+result of running each distinct atmosphere on its own (tests/test_optimization.py measures it).
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
+
+from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+
+#: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
+PER_CONDITION_OPTIONS = (
+    "minimum_yaw_angle", "maximum_yaw_angle", "yaw_angles_baseline", "x0", "turbine_weights",
+)
+
+#: Methods of scipy.optimize.minimize (YawOptimizationScipy's ``opt_method``).
+SCIPY_METHODS = (
+    "nelder-mead", "powell", "cg", "bfgs", "newton-cg", "l-bfgs-b", "tnc", "cobyla", "cobyqa",
+    "slsqp", "trust-constr", "dogleg", "trust-ncg", "trust-exact", "trust-krylov",
+)
+
+#: Conditions per optimiser run: large enough to keep FLORIS's vectorisation efficient, small
+#: enough for the progress bar to move on long studies.
+DEFAULT_CHUNK_SIZE = 256
+
+
+def optimize_yaw(
+    fmodel,
+    optimizer_class,
+    *,
+    progress: bool | None = None,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    **optimizer_kwargs,
+) -> pd.DataFrame:
+    """Optimal yaw angles for every condition of ``fmodel`` with a FLORIS yaw optimiser.
+
+    Args:
+        fmodel: FlorisModel, ParFlorisModel or UncertainFlorisModel, with a scalar or a
+            per-condition atmosphere (or none: plain FLORIS).
+        optimizer_class: A FLORIS yaw optimiser class (``YawOptimizationSR``,
+            ``YawOptimizationScipy``, ``YawOptimizationGeometric``...).
+        progress: Show a tqdm progress bar over conditions; None (default) shows it when the
+            study takes more than one optimiser run.
+        chunk_size: Conditions per optimiser run (results do not depend on it).
+        **optimizer_kwargs: The optimiser's own options (``minimum_yaw_angle``,
+            ``maximum_yaw_angle``, ``Ny_passes``, ``opt_options``...). The options in
+            :data:`PER_CONDITION_OPTIONS` may be (n_findex, n_turbines) arrays.
+
+    Returns:
+        FLORIS's ``df_opt`` frame: one row per condition of ``fmodel``, in its order (index
+        0..n_findex-1), with ``wind_direction``, ``wind_speed``, ``turbulence_intensity``,
+        ``yaw_angles_opt``, ``farm_power_opt`` and ``farm_power_baseline``.
+
+    Raises:
+        ValueError: for options the optimiser does not accept or would reject, before any
+            FLORIS evaluation.
+    """
+    n_findex = fmodel.core.flow_field.n_findex
+    n_turbines = fmodel.core.farm.n_turbines
+    check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
+        raise ValueError(f"optimize_yaw: chunk_size must be an integer >= 1; got {chunk_size!r}")
+
+    runs = [
+        (atmosphere, chunk)
+        for atmosphere, index in atmosphere_groups(fmodel)
+        for chunk in np.array_split(index, -(-index.size // chunk_size))
+    ]
+    if progress is None:
+        progress = len(runs) > 1
+    optimize_takes_progress = "print_progress" in inspect.signature(optimizer_class.optimize).parameters
+
+    from tqdm.auto import tqdm
+
+    frames = []
+    with tqdm(total=n_findex, desc=f"{optimizer_class.__name__}", unit="condition",
+              disable=not progress) as bar:
+        for atmosphere, index in runs:
+            subset = condition_subset(fmodel, index, atmosphere)
+            kwargs = {
+                name: np.asarray(value, dtype=float)[index]
+                if name in PER_CONDITION_OPTIONS and np.ndim(value) == 2 else value
+                for name, value in optimizer_kwargs.items()
+            }
+            optimizer = optimizer_class(subset, **kwargs)
+            # FLORIS's own per-pass prints would interleave with the bar.
+            df = optimizer.optimize(print_progress=False) if optimize_takes_progress else optimizer.optimize()
+            df.index = index
+            frames.append(df)
+            bar.update(index.size)
+    return pd.concat(frames).sort_index()
+
+
+def atmosphere_groups(fmodel) -> list[tuple[Mapping | None, np.ndarray]]:
+    """[(scalar atmosphere mapping or None, condition indices)] of ``fmodel``.
+
+    One group holding every condition when the atmosphere is scalar (its mapping is returned
+    unchanged) or absent (None); otherwise one group per distinct row of the per-condition
+    values, in order of first appearance.
+    """
+    n_findex = fmodel.core.flow_field.n_findex
+    spec = atmosphere_of(fmodel.core)
+    if spec is None or spec.n_conditions is None:
+        return [(None if spec is None else spec.sliced(slice(None)), np.arange(n_findex))]
+    names = sorted(k for k, v in spec.inputs.items() if not isinstance(v, float))
+    rows = np.stack([spec.inputs[k].reshape(-1) for k in names], axis=1)
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    groups = []
+    for label in np.argsort(first):
+        index = np.flatnonzero(inverse == label)
+        groups.append((spec.sliced(index[0]), index))
+    return groups
+
+
+def condition_subset(fmodel, index, atmosphere: Mapping | None):
+    """A copy of ``fmodel`` holding conditions ``index`` (in that order) and ``atmosphere``.
+
+    Carries every per-condition input FLORIS has: wind directions, speeds, turbulence
+    intensities, heterogeneous speed multipliers and the operation set-points (yaw angles,
+    power set-points, active wake control), so that the subset's conditions are those of the
+    parent.
+    """
+    index = np.asarray(index)
+    core = fmodel.core
+    flow_field, farm = core.flow_field, core.farm
+    set_kwargs = dict(
+        wind_directions=flow_field.wind_directions[index],
+        wind_speeds=flow_field.wind_speeds[index],
+        turbulence_intensities=flow_field.turbulence_intensities[index],
+        yaw_angles=farm.yaw_angles[index],
+        power_setpoints=farm.power_setpoints[index],
+        awc_modes=farm.awc_modes[index],
+        awc_amplitudes=farm.awc_amplitudes[index],
+        awc_frequencies=farm.awc_frequencies[index],
+    )
+    heterogeneous = flow_field.heterogeneous_inflow_config
+    if heterogeneous is not None and heterogeneous.get("speed_multipliers") is not None:
+        set_kwargs["heterogeneous_inflow_config"] = {
+            **heterogeneous,
+            "speed_multipliers": np.asarray(heterogeneous["speed_multipliers"])[index],
+        }
+    subset = fmodel.copy()
+    set_atmosphere(subset, atmosphere, **set_kwargs)
+    return subset
+
+
+def check_optimizer_options(optimizer_class, options: Mapping, n_findex: int, n_turbines: int):
+    """Raise ValueError for options ``optimizer_class`` does not take or would reject.
+
+    FLORIS checks some options only after its baseline farm evaluation (``Ny_passes``), passes
+    others on to SciPy at the first optimisation (``opt_method``), or fails with a TypeError
+    (unknown names); here all of them fail before any work, with the option named.
+    """
+    if not (inspect.isclass(optimizer_class) and issubclass(optimizer_class, YawOptimization)):
+        raise ValueError(
+            "optimize_yaw: optimizer_class must be a FLORIS yaw optimiser class (a subclass of "
+            "floris.optimization.yaw_optimization.yaw_optimization_base.YawOptimization); got "
+            f"{optimizer_class!r}"
+        )
+    name = optimizer_class.__name__
+    accepted = [
+        p.name for p in list(inspect.signature(optimizer_class.__init__).parameters.values())[2:]
+        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+    ]
+    unknown = sorted(set(options) - set(accepted))
+    if unknown:
+        raise ValueError(
+            f"optimize_yaw: {name} has no option(s) {unknown}; its options are {accepted} "
+            "(the model is optimize_yaw's first argument)"
+        )
+
+    def angles(option, default):
+        value = options.get(option, default)
+        array = np.asarray(value, dtype=float) if value is not None else None
+        if array is None:
+            return None
+        if array.shape not in ((), (n_turbines,), (n_findex, n_turbines)) or not np.all(
+            np.isfinite(array)
+        ):
+            raise ValueError(
+                f"optimize_yaw: {name} option {option} must be a finite number, a list of "
+                f"n_turbines = {n_turbines} numbers or an (n_findex, n_turbines) = "
+                f"({n_findex}, {n_turbines}) array; got {value!r}"
+            )
+        return array
+
+    defaults = inspect.signature(optimizer_class.__init__).parameters
+    lower = angles("minimum_yaw_angle", defaults["minimum_yaw_angle"].default)
+    upper = angles("maximum_yaw_angle", defaults["maximum_yaw_angle"].default)
+    if np.any(lower > upper):
+        raise ValueError(
+            f"optimize_yaw: {name} minimum_yaw_angle must not exceed maximum_yaw_angle; got "
+            f"{options.get('minimum_yaw_angle')!r} > {options.get('maximum_yaw_angle')!r}"
+        )
+    if np.any(np.abs(lower) >= 90.0) or np.any(np.abs(upper) >= 90.0):
+        raise ValueError(
+            f"optimize_yaw: {name} yaw bounds must lie within (-90, 90) degrees; got "
+            f"minimum_yaw_angle={options.get('minimum_yaw_angle')!r}, "
+            f"maximum_yaw_angle={options.get('maximum_yaw_angle')!r}"
+        )
+    for option in ("yaw_angles_baseline", "turbine_weights"):
+        angles(option, None)
+    x0 = angles("x0", None)
+    if x0 is not None and (np.any(x0 < lower) or np.any(x0 > upper)):
+        raise ValueError(
+            f"optimize_yaw: {name} option x0 must lie within [minimum_yaw_angle, "
+            f"maximum_yaw_angle]; got {options['x0']!r}"
+        )
+    if "Ny_passes" in options:
+        passes = options["Ny_passes"]
+        if (
+            not isinstance(passes, (list, tuple)) or not passes
+            or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 2 for n in passes)
+            or any(n % 2 for n in passes[1:])
+        ):
+            raise ValueError(
+                f"optimize_yaw: {name} option Ny_passes must be a non-empty list of integers "
+                f">= 2, all but the first even; got {passes!r}"
+            )
+    if "opt_method" in options:
+        method = options["opt_method"]
+        if not callable(method) and str(method).lower() not in SCIPY_METHODS:
+            raise ValueError(
+                f"optimize_yaw: {name} option opt_method must be a scipy.optimize.minimize "
+                f"method {list(SCIPY_METHODS)} or a callable; got {method!r}"
+            )
+    if options.get("opt_options") is not None and not isinstance(options["opt_options"], Mapping):
+        raise ValueError(
+            f"optimize_yaw: {name} option opt_options must be a dict of "
+            f"scipy.optimize.minimize options; got {options['opt_options']!r}"
+        )
