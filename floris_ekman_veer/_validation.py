@@ -1,8 +1,18 @@
-"""Input checks shared by the physics modules: a clear ValueError naming the parameter, its
-valid range and the offending values, never NaN and never a silent clip."""
+"""Input checks, the one validation path of the package: a clear ValueError naming the parameter
+(by its path in the input where it has one), its valid range or type and the offending values;
+never NaN, never a silent clip or coercion.
+
+The physics modules check arrays with :func:`require`; the FLORIS models declare their typed
+parameters with :func:`number_field`, :func:`boolean_field` and :func:`choice_field`, checked when
+the model is built (from YAML or Python alike, docs/coupling.md#input-validation).
+"""
 
 from __future__ import annotations
 
+import numbers
+from collections.abc import Mapping
+
+import attrs
 import numpy as np
 
 
@@ -29,3 +39,112 @@ def positive(value, name: str) -> np.ndarray:
     array = np.asarray(value, dtype=float)
     require(np.isfinite(array) & (array > 0.0), name, "finite and > 0", array)
     return array
+
+
+# ------------------------------------------------------------------ typed inputs (model build)
+# YAML and Python inputs alike: a string is never read as a number or a boolean ("false" is a
+# truthy string, so bool("false") is True), and a boolean is never read as a number.
+
+
+def _describe(value) -> str:
+    return f"{value!r} ({type(value).__name__})"
+
+
+def number(value, name: str, valid: str = "finite", ok=np.isfinite) -> float:
+    """``value`` as a float, required a real number (not a string or boolean) with ``ok(value)``.
+
+    ``name`` is the input's full path (e.g. ``wake.wake_velocity_parameters.ekman_veer.A1``);
+    ``valid`` describes the range for the message, ``ok`` tests it.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.number)):
+        raise ValueError(f"{name} must be a number ({valid}); got {_describe(value)}")
+    value = float(value)
+    if not ok(value):
+        raise ValueError(f"{name} must be {valid}; got {value!r}")
+    return value
+
+
+def boolean(value, name: str) -> bool:
+    """``value`` as a bool, required a boolean (YAML true/false, unquoted; Python True/False)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(
+            f"{name} must be a boolean (true or false, unquoted in YAML); got {_describe(value)}"
+        )
+    return bool(value)
+
+
+def choice(value, name: str, options) -> str:
+    """``value`` required one of the strings ``options``."""
+    if not isinstance(value, str) or value not in options:
+        raise ValueError(f"{name} must be one of {list(options)}; got {_describe(value)}")
+    return value
+
+
+def input_block(data, name: str, allowed) -> None:
+    """Require an input block to be a mapping whose keys are all in ``allowed``."""
+    if not isinstance(data, Mapping):
+        raise ValueError(
+            f"{name} must be a mapping of parameters (allowed keys {sorted(allowed)}); "
+            f"got {_describe(data)}"
+        )
+    unknown = sorted(str(k) for k in data if k not in allowed)
+    if unknown:
+        raise ValueError(f"{name}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+
+
+def require_each(ok, name: str, valid: str, value, labels=("condition",)) -> None:
+    """As :func:`require` for a per-entry input, naming the offending entries by their index
+    along each axis (``labels``: one name per axis, e.g. ("condition", "turbine"))."""
+    ok = np.asarray(ok)
+    if not np.all(ok):
+        value = np.broadcast_to(np.asarray(value, dtype=float), ok.shape)
+        labels = (labels,) if isinstance(labels, str) else tuple(labels)
+        bad = np.argwhere(~ok)
+        shown = ", ".join(
+            f"{value[tuple(i)]:.6g} at "
+            + ", ".join(f"{label} {j}" for label, j in zip(labels, i))
+            for i in bad[:5]
+        )
+        more = f" (and {len(bad) - 5} more)" if len(bad) > 5 else ""
+        raise ValueError(f"{name} must be {valid}; got {shown}{more}")
+
+
+def _input_path(instance, attribute) -> str:
+    return f"{getattr(type(instance), 'input_path', type(instance).__name__)}.{attribute.name}"
+
+
+def number_field(default, valid: str, ok=np.isfinite, optional: bool = False):
+    """An attrs field holding a number checked by :func:`number` on init and on assignment; the
+    message carries the input path ``<class input_path>.<field name>``. ``optional``: None
+    allowed (meaning "not given")."""
+
+    def convert(value, instance, attribute):
+        if optional and value is None:
+            return None
+        return number(value, _input_path(instance, attribute), valid, ok)
+
+    return attrs.field(default=default, converter=attrs.Converter(
+        convert, takes_self=True, takes_field=True
+    ))
+
+
+def boolean_field(default: bool):
+    """An attrs field holding a boolean checked by :func:`boolean` (see :func:`number_field`)."""
+
+    def convert(value, instance, attribute):
+        return boolean(value, _input_path(instance, attribute))
+
+    return attrs.field(default=default, converter=attrs.Converter(
+        convert, takes_self=True, takes_field=True
+    ))
+
+
+def choice_field(default: str, options):
+    """An attrs field holding one of the strings ``options`` (see :func:`number_field`)."""
+
+    def convert(value, instance, attribute):
+        return choice(value, _input_path(instance, attribute), options)
+
+    return attrs.field(default=default, converter=attrs.Converter(
+        convert, takes_self=True, takes_field=True
+    ))

@@ -226,12 +226,28 @@ def test_missing_ct_prime_raises():
         call("thrust_coefficient", power_thrust_table=tab)
 
 
-def test_invalid_ct_prime_in_floris_model_raises():
+def test_invalid_ct_prime_in_floris_model_raises_at_build():
     turbine = adt.actuator_disk_turbine()
     turbine["power_thrust_table"]["ct_prime"] = -0.5
-    fmodel = floris_model(turbine=turbine)
-    with pytest.raises(ValueError, match="ct_prime"):
-        fmodel.run()
+    with pytest.raises(ValueError, match=r"farm\.turbine_type\[0\]\.power_thrust_table\.ct_prime"):
+        floris_model(turbine=turbine)
+
+
+@pytest.mark.parametrize("ct_prime", [3.99, 4.0])
+def test_ct_prime_up_to_momentum_theory_limit_is_accepted(ct_prime):
+    """C_T' = 4 is a = 1/2, the end of momentum theory (MAX_CT_PRIME): still one-to-one with C_T."""
+    tab = adt.actuator_disk_power_thrust_table(ct_prime, 100.0)
+    a = adt.induction_factor(ct_prime)
+    assert tab["thrust_coefficient"][0] == pytest.approx(4 * a * (1 - a), rel=1e-12)
+    assert a <= 0.5
+
+
+def test_ct_prime_beyond_momentum_theory_raises():
+    """C_T' = 40 would give a = 0.91 in the power but C_T = 4a(1 - a) = 0.33 to the wake."""
+    assert adt.induction_factor(40.0) == pytest.approx(40 / 44)
+    assert adt.disk_thrust_coefficient(40.0) == pytest.approx(640 / 44**2)
+    with pytest.raises(ValueError, match=r"ct_prime must be in \(0, 4\]"):
+        adt.actuator_disk_power_thrust_table(40.0, 100.0)
 
 
 def test_stale_table_arrays_raise():

@@ -457,11 +457,21 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
 
 
 def _with_core_atmosphere(method):
-    """Run a Core method with the Core's atmosphere (or None) active for flow-field set-ups."""
+    """Run a Core method with the Core's atmosphere (or None) active for flow-field set-ups,
+    after checking the operation (yaw) and, for ``solve_for_points``, the sample coordinates
+    (:mod:`floris_ekman_veer.coupling.input_checks`)."""
+    from floris_ekman_veer.coupling import input_checks
+
+    points = method.__name__ == "solve_for_points"
 
     @functools.wraps(method)
     def wrapper(self: Core, *args, **kwargs):
-        token = _ACTIVE.set(atmosphere_of(self))
+        atmosphere = atmosphere_of(self)
+        if input_checks.uses_package(self, atmosphere):
+            input_checks.check_operation(self)
+            if points:
+                input_checks.check_points(*args, **kwargs)
+        token = _ACTIVE.set(atmosphere)
         try:
             return method(self, *args, **kwargs)
         finally:
@@ -471,12 +481,17 @@ def _with_core_atmosphere(method):
 
 
 def _validating_post_init(method):
-    """Validate the atmosphere when a Core is built (FlorisModel(), set(), copy())."""
+    """Validate the atmosphere, and the layout, conditions and turbines of a Core using the
+    package (:func:`floris_ekman_veer.coupling.input_checks.check_core`, before FLORIS builds
+    its grid), when a Core is built (FlorisModel(), set(), copy())."""
+    from floris_ekman_veer.coupling import input_checks
 
     @functools.wraps(method)
     def wrapper(self: Core) -> None:
-        method(self)
         spec = atmosphere_of(self)
+        if input_checks.uses_package(self, spec):
+            input_checks.check_core(self)
+        method(self)
         # reference_wind_height = -1 is FLORIS's "use the hub height" sentinel; FlorisModel
         # replaces it through set(), which builds (and validates) again.
         # No conditions yet (n_findex = 0): nothing to solve until set() gives them.

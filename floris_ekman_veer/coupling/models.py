@@ -35,10 +35,17 @@ import warnings
 from typing import Any
 
 import numpy as np
-from attrs import define, field, validators
+import attrs
+from attrs import define, field
 from floris.core import BaseModel, FlowField, Grid
 from floris.utilities import rotate_coordinates_rel_west
 
+from floris_ekman_veer._validation import (
+    boolean_field,
+    choice_field,
+    input_block,
+    number_field,
+)
 from floris_ekman_veer.atmosphere.turbulence import (
     ALPHA_PRIME,
     MERGE_EXPONENT,
@@ -48,6 +55,11 @@ from floris_ekman_veer.atmosphere.turbulence import (
     wake_expansion_rate,
 )
 from floris_ekman_veer.coupling.inflow import solved_atmosphere
+from floris_ekman_veer.coupling.registry import (
+    DEFLECTION_MODEL_NAME,
+    GAUSSIAN_2014_NAME,
+    VELOCITY_MODEL_NAME,
+)
 from floris_ekman_veer.wake.deficit import normalised_deficit
 from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
@@ -64,6 +76,24 @@ ROTOR_PLANE_MARGIN = 0.1
 
 
 # --------------------------------------------------------------------------------- shared pieces
+def _from_input_block(cls, data):
+    """FLORIS's ``from_dict`` for a model block, refusing a non-mapping block (e.g. ``"on"``,
+    which FLORIS would iterate as the keys 'o', 'n') or unknown keys with a ValueError naming
+    the block's input path (docs/coupling.md#input-validation)."""
+    input_block(data, cls.input_path, [a.name for a in attrs.fields(cls) if a.init])
+    return BaseModel.from_dict.__func__(cls, data)
+
+
+#: Valid ranges of the model parameters (docs/coupling.md#input-validation): text and test.
+_POSITIVE = ("finite and > 0", lambda v: np.isfinite(v) and v > 0.0)
+_NON_NEGATIVE = ("finite and >= 0", lambda v: np.isfinite(v) and v >= 0.0)
+# k_w_exponent n: the smooth maximum (floor^n + x^n)^(1/n) lies between max(floor, x) (n -> inf)
+# and floor + x (n = 1); n < 1 would exceed the sum, n = 0 divides by zero.
+_MERGE_EXPONENT_RANGE = ("finite and >= 1", lambda v: np.isfinite(v) and v >= 1.0)
+# A thrust-coefficient limit below 1: momentum theory's a < 1/2 (docs/conventions.md).
+_THRUST_LIMIT_RANGE = ("in (0, 1)", lambda v: 0.0 < v < 1.0)
+
+
 def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=None):
     """C_T = ct_i / cos(yaw) (docs/conventions.md#thrust-coefficient-and-yaw), limited to the momentum-theory range.
 
@@ -74,7 +104,7 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=No
     if np.any(np.abs(yaw) >= np.pi / 2):
         raise ValueError(
             "yaw angles must satisfy |yaw| < 90 degrees for the ekman_veer wake models; got "
-            f"{np.rad2deg(np.max(np.abs(yaw))):.6g} degrees"
+            f"{np.rad2deg(yaw.flat[np.argmax(np.abs(yaw))]):.6g} degrees"
         )
     ct = np.asarray(ct_i, dtype=float) / np.cos(yaw)
     limit = max_thrust_coefficient / np.cos(yaw if loading_yaw is None else loading_yaw) ** 2
@@ -175,21 +205,20 @@ class _EkmanWakeModel(BaseModel):
     #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
     #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.coupling.inflow.
     atmosphere: dict | None = field(default=None)
-    A1: float = field(converter=float, default=TOWNSEND_PERRY_A1)
-    B1: float = field(converter=float, default=TOWNSEND_PERRY_B1)
-    alpha_prime: float = field(converter=float, default=ALPHA_PRIME)
-    k_w_floor: float = field(converter=float, default=MIXING_LAYER_FLOOR)
-    k_w_exponent: float = field(converter=float, default=MERGE_EXPONENT)
+    A1: float = number_field(TOWNSEND_PERRY_A1, *_POSITIVE)
+    B1: float = number_field(TOWNSEND_PERRY_B1, *_NON_NEGATIVE)
+    alpha_prime: float = number_field(ALPHA_PRIME, *_POSITIVE)
+    k_w_floor: float = number_field(MIXING_LAYER_FLOOR, *_POSITIVE)
+    k_w_exponent: float = number_field(MERGE_EXPONENT, *_MERGE_EXPONENT_RANGE)
     #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
     #: "local_turbulence": alpha' times FLORIS's turbulence intensity at the turbine (ambient
     #: plus wake-added, from FLORIS's turbulence model) in the same smooth maximum, for farms.
-    wake_expansion: str = field(
-        default="ambient", validator=validators.in_(("ambient", "local_turbulence"))
-    )
-    max_thrust_coefficient: float = field(
-        converter=float, default=GLAUERT_THRUST_COEFFICIENT,
-        validator=[validators.gt(0.0), validators.lt(1.0)],
-    )
+    wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
+    max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
+
+    #: Where the block sits in a FLORIS input (error messages name it).
+    input_path = f"wake.wake_velocity_parameters.{VELOCITY_MODEL_NAME}"
+    from_dict = classmethod(_from_input_block)
 
     def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity):
         """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant."""
@@ -288,10 +317,8 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
         max_thrust_coefficient: momentum-theory limit of C_T cos^2(yaw) (see module docstring).
     """
 
-    curl: bool = field(converter=bool, default=True)
-    polar_angle_centre: str = field(
-        default="wake_centre", validator=validators.in_(("wake_centre", "yaw_centre"))
-    )
+    curl: bool = boolean_field(True)
+    polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         flowing = wake.local_u > 0
@@ -324,13 +351,13 @@ class EkmanVeerVelocityDeflection(BaseModel):
     The atmosphere comes from the velocity block (``wake_velocity_parameters.ekman_veer``).
     """
 
-    veer: bool = field(converter=bool, default=True)
-    yaw_deflection: bool = field(converter=bool, default=True)
-    ground_image: bool = field(converter=bool, default=True)
-    max_thrust_coefficient: float = field(
-        converter=float, default=GLAUERT_THRUST_COEFFICIENT,
-        validator=[validators.gt(0.0), validators.lt(1.0)],
-    )
+    veer: bool = boolean_field(True)
+    yaw_deflection: bool = boolean_field(True)
+    ground_image: bool = boolean_field(True)
+    max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
+
+    input_path = f"wake.wake_deflection_parameters.{DEFLECTION_MODEL_NAME}"
+    from_dict = classmethod(_from_input_block)
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
         return {"x": grid.x_sorted, "z": grid.z_sorted, "ambient": Ambient.of(grid, flow_field)}
@@ -375,8 +402,9 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
     The deficit is relative to U_h, the ambient hub-height speed.
     """
 
-    k_star: float | None = field(default=None)
+    k_star: float | None = number_field(None, *_POSITIVE, optional=True)
     yawed_momentum_theory = False
+    input_path = f"wake.wake_velocity_parameters.{GAUSSIAN_2014_NAME}"
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star

@@ -49,7 +49,7 @@ the induction, e.g. Jensen, take it as the disk's deficit, which is a(beta).)
 
 power_thrust_table keys
 -----------------------
-``ct_prime`` (> 0), ``rotor_diameter`` [m] (the operation model is never told the turbine's
+``ct_prime`` (0 < C_T' <= 4, momentum theory: see ``MAX_CT_PRIME``), ``rotor_diameter`` [m] (the operation model is never told the turbine's
 diameter by FLORIS, so the area enters here, as for FLORIS's controller-dependent model; it must
 equal the turbine's ``rotor_diameter``), ``ref_air_density`` [kg/m^3], ``ref_tilt`` (must be 0:
 the disk has no tilt, and FLORIS then always passes tilt 0 for these turbines), and the arrays
@@ -73,6 +73,8 @@ from attrs import define
 from floris.core.rotor_velocity import average_velocity
 from floris.core.turbine.operation_models import BaseOperationModel
 from floris.type_dec import NDArrayFloat
+
+from floris_ekman_veer._validation import number
 
 OPERATION_MODEL_NAME = "actuator-disk"
 
@@ -104,11 +106,21 @@ def disk_thrust_coefficient(ct_prime, yaw_angles=0.0):
     return 16.0 * ct_prime / (4.0 + ct_prime * c2) ** 2
 
 
-def _check_positive(name, value):
-    value = float(value)
-    if not np.isfinite(value) or value <= 0.0:
-        raise ValueError(f"actuator-disk: {name} must be a finite number > 0, got {value!r}")
-    return value
+#: Valid local thrust coefficients: 0 < C_T' <= 4. One-dimensional momentum theory, on which the
+#: disk's a(beta) and C_T(beta) rest, holds for a <= 1/2 (far-wake speed (1 - 2a) U >= 0);
+#: a = C_T'/(4 + C_T') reaches 1/2 at C_T' = 4. Beyond it C_T = 4a(1 - a) falls again (C_T' = 40:
+#: a = 0.91, C_T = 0.33), so the wake model, which inverts C_T to the lower branch a < 1/2
+#: (Eq. ind_factor), would see a lightly loaded rotor while the power uses a = 0.91.
+MAX_CT_PRIME = 4.0
+
+
+def _ct_prime(value, name):
+    return number(value, name, f"in (0, {MAX_CT_PRIME:g}] (momentum theory: a <= 1/2)",
+                  lambda v: 0.0 < v <= MAX_CT_PRIME)
+
+
+def _positive(value, name):
+    return number(value, name, "finite and > 0", lambda v: np.isfinite(v) and v > 0.0)
 
 
 def actuator_disk_power_thrust_table(
@@ -122,9 +134,9 @@ def actuator_disk_power_thrust_table(
     power [kW] = 1/2 rho_ref (pi D^2/4) C_T' ((1 - a) U)^3 / 1000 and thrust_coefficient = 4a(1 - a)
     at each wind speed U (the un-yawed disk in uniform inflow).
     """
-    ct_prime = _check_positive("ct_prime", ct_prime)
-    rotor_diameter = _check_positive("rotor_diameter", rotor_diameter)
-    ref_air_density = _check_positive("ref_air_density", ref_air_density)
+    ct_prime = _ct_prime(ct_prime, "ct_prime")
+    rotor_diameter = _positive(rotor_diameter, "rotor_diameter")
+    ref_air_density = _positive(ref_air_density, "ref_air_density")
     ws = np.asarray(wind_speed, dtype=float)
     return {
         "ct_prime": ct_prime,
@@ -146,7 +158,7 @@ def actuator_disk_turbine(
     wind_speed=DEFAULT_WIND_SPEEDS,
 ) -> dict:
     """A complete FLORIS turbine definition (dict) for the disk; defaults are the paper's LES."""
-    hub_height = _check_positive("hub_height", hub_height)
+    hub_height = _positive(hub_height, "hub_height")
     return {
         "turbine_type": turbine_type,
         "rotor_diameter": float(rotor_diameter),
@@ -166,19 +178,22 @@ def _tabulated_power_kw(ct_prime, rotor_diameter, air_density, wind_speed):
     return 0.5 * air_density * area * ct_prime * u_d**3 / 1e3
 
 
-def _disk_parameters(power_thrust_table: dict) -> tuple[float, float]:
-    """Validate the table; return (ct_prime, rotor_diameter)."""
+def disk_parameters(
+    power_thrust_table: dict, path: str = "actuator-disk power_thrust_table"
+) -> tuple[float, float]:
+    """Validate the table; return (ct_prime, rotor_diameter). ``path`` names the table in the
+    input (the Core's build check passes ``farm.turbine_type[i].power_thrust_table``)."""
     for key in ("ct_prime", "rotor_diameter", "ref_air_density"):
         if key not in power_thrust_table:
             raise ValueError(
-                f"actuator-disk: power_thrust_table needs '{key}' (build the table with "
+                f"{path} needs '{key}' (build the table with "
                 "floris_ekman_veer.coupling.turbine.actuator_disk_power_thrust_table)"
             )
-    ct_prime = _check_positive("ct_prime", power_thrust_table["ct_prime"])
-    diameter = _check_positive("rotor_diameter", power_thrust_table["rotor_diameter"])
-    rho_ref = _check_positive("ref_air_density", power_thrust_table["ref_air_density"])
-    if float(power_thrust_table.get("ref_tilt", 0.0)) != 0.0:
-        raise ValueError("actuator-disk: the disk has no tilt; ref_tilt must be 0")
+    ct_prime = _ct_prime(power_thrust_table["ct_prime"], f"{path}.ct_prime")
+    diameter = _positive(power_thrust_table["rotor_diameter"], f"{path}.rotor_diameter")
+    rho_ref = _positive(power_thrust_table["ref_air_density"], f"{path}.ref_air_density")
+    tilt = power_thrust_table.get("ref_tilt", 0.0)
+    number(tilt, f"{path}.ref_tilt", "0 (the disk has no tilt)", lambda v: v == 0.0)
 
     ws = np.asarray(power_thrust_table["wind_speed"], dtype=float)
     power = np.asarray(power_thrust_table["power"], dtype=float)
@@ -191,7 +206,7 @@ def _disk_parameters(power_thrust_table: dict) -> tuple[float, float]:
         or not np.allclose(ct, disk_thrust_coefficient(ct_prime), rtol=_TABLE_RTOL, atol=0.0)
     ):
         raise ValueError(
-            "actuator-disk: the power/thrust_coefficient arrays of power_thrust_table do not match "
+            f"{path}: the power/thrust_coefficient arrays do not match "
             f"ct_prime={ct_prime}, rotor_diameter={diameter}, ref_air_density={rho_ref}; "
             "regenerate them with actuator_disk_power_thrust_table()"
         )
@@ -230,7 +245,7 @@ class ActuatorDiskTurbine(BaseOperationModel):
         **_,
     ) -> NDArrayFloat:
         """P = 1/2 rho A C_T' [(1 - a(beta)) U_disk cos beta]^3 in W (Eqs. P0_ref, P_hyp, Ud)."""
-        ct_prime, diameter = _disk_parameters(power_thrust_table)
+        ct_prime, diameter = disk_parameters(power_thrust_table)
         u_disk = _disk_average(velocities, average_method, cubature_weights)
         # A disk-averaged speed below zero only arises from over-subtracted wake deficits; such a
         # disk extracts nothing rather than producing negative power.
@@ -252,7 +267,7 @@ class ActuatorDiskTurbine(BaseOperationModel):
 
         Independent of the wind speed: the disk's C_T' is constant.
         """
-        ct_prime, _diameter = _disk_parameters(power_thrust_table)
+        ct_prime, _diameter = disk_parameters(power_thrust_table)
         ct = disk_thrust_coefficient(ct_prime, yaw_angles) * _cos_yaw(yaw_angles)
         return ct * np.ones(np.shape(velocities)[:2])  # (n_findex, n_turbines)
 
@@ -266,6 +281,6 @@ class ActuatorDiskTurbine(BaseOperationModel):
         **_,
     ) -> NDArrayFloat:
         """a(beta) = C_T' cos^2 beta / (4 + C_T' cos^2 beta), the paper's Eq. (ind_factor)."""
-        ct_prime, _diameter = _disk_parameters(power_thrust_table)
+        ct_prime, _diameter = disk_parameters(power_thrust_table)
         return induction_factor(ct_prime, yaw_angles) * np.ones(np.shape(velocities)[:2])
 

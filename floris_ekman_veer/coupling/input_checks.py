@@ -1,0 +1,137 @@
+"""Checks of a FLORIS Core's layout, conditions, turbines and operation for this package's models.
+
+Called by the inflow hook (:mod:`floris_ekman_veer.coupling.inflow`): :func:`check_core` when a
+Core is built (FlorisModel(), ``set()``, ``copy()``; before FLORIS builds its grid, which is where
+an empty layout would otherwise fail), :func:`check_operation` and :func:`check_points` when a
+Core solves. They act only on a Core that uses the package (an atmosphere block, an ``ekman_veer``
+or ``bastankhah2014`` model, or an ``actuator-disk`` turbine): plain FLORIS inputs are left to
+FLORIS, unchanged. Each error is a ValueError naming the input's path, the offending value (and
+its condition or turbine index) and the valid range (docs/coupling.md#input-validation).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from floris_ekman_veer._validation import number, require_each
+from floris_ekman_veer.coupling.registry import (
+    DEFLECTION_MODEL_NAME,
+    GAUSSIAN_2014_NAME,
+    VELOCITY_MODEL_NAME,
+)
+from floris_ekman_veer.coupling.turbine import OPERATION_MODEL_NAME, disk_parameters
+
+
+def uses_wake_models(core) -> bool:
+    """Whether the Core's velocity or deflection model is one of this package's."""
+    strings = core.wake.model_strings
+    return (
+        str(strings.get("velocity_model", "")).lower() in (VELOCITY_MODEL_NAME, GAUSSIAN_2014_NAME)
+        or str(strings.get("deflection_model", "")).lower() == DEFLECTION_MODEL_NAME
+    )
+
+
+def uses_package(core, atmosphere) -> bool:
+    """Whether the Core uses an atmosphere, a wake model or a turbine of this package."""
+    return (
+        atmosphere is not None
+        or uses_wake_models(core)
+        or any(_is_disk(t) for t in core.farm.turbine_definitions)
+    )
+
+
+def _is_disk(turbine: dict) -> bool:
+    return turbine.get("operation_model") == OPERATION_MODEL_NAME
+
+
+def _is_positive(value) -> bool:
+    return np.isfinite(value) and value > 0.0
+
+
+def _turbine_path(farm, index: int) -> str:
+    # The entry of farm.turbine_type turbine `index` came from (one entry may serve them all).
+    return f"farm.turbine_type[{index if len(farm.turbine_type) > 1 else 0}]"
+
+
+def check_core(core) -> None:
+    """Layout, conditions and turbine definitions of a Core that uses the package."""
+    _check_layout(core.farm)
+    _check_conditions(core.flow_field)
+    _check_turbines(core.farm)
+
+
+def _check_layout(farm) -> None:
+    x = np.asarray(farm.layout_x, dtype=float)
+    y = np.asarray(farm.layout_y, dtype=float)
+    if x.size == 0:
+        raise ValueError("farm.layout_x and farm.layout_y must hold at least one turbine; got none")
+    require_each(np.isfinite(x), "farm.layout_x", "finite [m]", x, "turbine")
+    require_each(np.isfinite(y), "farm.layout_y", "finite [m]", y, "turbine")
+    z = np.empty(x.size)
+    radius = np.empty(x.size)
+    for index, turbine in enumerate(farm.turbine_definitions):
+        path = _turbine_path(farm, index)
+        z[index] = number(turbine["hub_height"], f"{path}.hub_height", "finite and > 0 [m]",
+                          _is_positive)
+        radius[index] = 0.5 * number(turbine["rotor_diameter"], f"{path}.rotor_diameter",
+                                     "finite and > 0 [m]", _is_positive)
+    # Two rotors whose hubs are closer than the sum of their radii intersect for some wind
+    # direction or yaw: no wake model describes that (FLORIS would give coincident turbines
+    # each the power of a lone turbine).
+    distance = np.sqrt(
+        (x[:, None] - x) ** 2 + (y[:, None] - y) ** 2 + (z[:, None] - z) ** 2
+    )
+    clash = np.triu(distance < radius[:, None] + radius, k=1)
+    if np.any(clash):
+        i, j = np.argwhere(clash)[0]
+        raise ValueError(
+            f"farm.layout_x/layout_y: turbines {i} and {j} are {distance[i, j]:.6g} m apart "
+            f"(hub to hub), less than the sum of their rotor radii "
+            f"({radius[i] + radius[j]:.6g} m): their rotors would intersect"
+            + (f" ({int(clash.sum())} such pairs)" if clash.sum() > 1 else "")
+        )
+
+
+def _check_conditions(flow_field) -> None:
+    directions = np.asarray(flow_field.wind_directions, dtype=float)
+    speeds = np.asarray(flow_field.wind_speeds, dtype=float)
+    intensities = np.asarray(flow_field.turbulence_intensities, dtype=float)
+    require_each(np.isfinite(directions), "flow_field.wind_directions", "finite [deg]",
+                 directions)
+    require_each(np.isfinite(speeds) & (speeds >= 0), "flow_field.wind_speeds",
+                 "finite and >= 0 [m/s]", speeds)
+    require_each(np.isfinite(intensities) & (intensities >= 0),
+                 "flow_field.turbulence_intensities", "finite and >= 0", intensities)
+
+
+def _check_turbines(farm) -> None:
+    for index, turbine in enumerate(farm.turbine_definitions):
+        if not _is_disk(turbine):
+            continue
+        path = _turbine_path(farm, index)
+        _, diameter = disk_parameters(turbine["power_thrust_table"], f"{path}.power_thrust_table")
+        if diameter != float(turbine["rotor_diameter"]):
+            raise ValueError(
+                f"{path}.power_thrust_table.rotor_diameter ({diameter:g} m) must equal "
+                f"{path}.rotor_diameter ({turbine['rotor_diameter']!r} m): FLORIS does not pass "
+                "the diameter to operation models"
+            )
+
+
+def check_operation(core) -> None:
+    """Yaw angles of a Core whose wakes are this package's (|yaw| < 90 deg, finite)."""
+    if not uses_wake_models(core):
+        return
+    yaw = np.asarray(core.farm.yaw_angles, dtype=float)
+    if yaw.ndim == 2:
+        require_each(np.isfinite(yaw) & (np.abs(yaw) < 90.0), "yaw_angles",
+                     "finite and in (-90, 90) degrees for the ekman_veer wake models", yaw,
+                     ("condition", "turbine"))
+
+
+def check_points(x, y, z) -> None:
+    """Sample coordinates of ``sample_flow_at_points`` (finite)."""
+    for name, value in (("x", x), ("y", y), ("z", z)):
+        value = np.atleast_1d(np.asarray(value, dtype=float))
+        require_each(np.isfinite(value), f"sample_flow_at_points {name}", "finite [m]", value,
+                     "point")
