@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from floris_ekman_veer._validation import number, require_each
-from floris_ekman_veer.coupling.registry import (
+from floris_ekman_veer.coupling.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,

@@ -55,7 +55,7 @@ from floris_ekman_veer.atmosphere.turbulence import (
     wake_expansion_rate,
 )
 from floris_ekman_veer.coupling.inflow import solved_atmosphere
-from floris_ekman_veer.coupling.registry import (
+from floris_ekman_veer.coupling.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,

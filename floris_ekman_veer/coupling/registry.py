@@ -13,11 +13,11 @@ from __future__ import annotations
 
 from collections.abc import MutableMapping
 
-#: Names under which the wake models appear in ``floris.core.wake.MODEL_MAP``. Not cc, turbopark
-#: or empirical_gauss: those names select their own solvers (docs/coupling.md#registry).
-VELOCITY_MODEL_NAME = "ekman_veer"
-DEFLECTION_MODEL_NAME = "ekman_veer"
-GAUSSIAN_2014_NAME = "bastankhah2014"
+from floris_ekman_veer.coupling.names import (  # noqa: F401  (part of the registry's interface)
+    DEFLECTION_MODEL_NAME,
+    GAUSSIAN_2014_NAME,
+    VELOCITY_MODEL_NAME,
+)
 
 
 def register_in(table: MutableMapping, name: str, cls: type, kind: str) -> type:
