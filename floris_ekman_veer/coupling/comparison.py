@@ -43,7 +43,7 @@ wind speeds, and UncertainFlorisModel, which expands conditions, and the yaw opt
 them, break or misassign them); FLORIS then computes dU/dz = 0 (GCH's secondary steering loses the
 shear); U is linear between the z levels (exact at the levels, which include every rotor-grid
 height); points outside the box get multiplier 1 (uniform flow); and FLORIS's 3-D interpolation
-costs far more than the hook (ARCHITECTURE.md: 0.66 s vs 0.1 s for 1000 conditions x 100 turbines).
+costs far more than the hook (benchmarks/bench_inflow.py times both; the README's Speed section).
 """
 
 from __future__ import annotations

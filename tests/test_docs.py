@@ -1,0 +1,269 @@
+"""The project's documentation holds together: every ``docs/<page>.md#anchor`` that a source,
+test, input or page cites exists; every relative link and every project file path named in the
+text exists in the repository; every test a page cites is defined; no file cites a document the
+project does not contain; and the numbers of docs/validation.md#table-1 are what the code gives.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+DOCS = REPO / "docs"
+#: The text files of the project that may cite documentation.
+SOURCES = sorted(
+    p for pattern in ("*.md", "*.py", "*.yaml", "*.sh", "*.toml")
+    for p in REPO.rglob(pattern)
+    if not any(part.startswith(".") or part in ("output", "build") for part in p.relative_to(REPO).parts)
+    and "egg-info" not in str(p)
+)
+#: Top-level folders whose files the text may name by path.
+PROJECT_FOLDERS = ("docs", "inputs", "examples", "benchmarks", "tests", "scripts", "floris_ekman_veer")
+
+
+def github_anchor(heading: str) -> str:
+    """GitHub's anchor of a Markdown heading: lower case, punctuation dropped, spaces to '-'."""
+    text = re.sub(r"[`*]", "", heading.strip()).lower()
+    text = re.sub(r"[^\w\- ]", "", text)
+    return text.replace(" ", "-")
+
+
+def anchors(page: Path) -> set[str]:
+    found, seen, in_code = set(), {}, False
+    for line in page.read_text().splitlines():
+        if line.startswith("```"):
+            in_code = not in_code
+        if in_code:
+            continue
+        match = re.match(r"#{1,6}\s+(.*)", line)
+        if match:
+            anchor = github_anchor(match[1])
+            count = seen.get(anchor, 0)
+            seen[anchor] = count + 1
+            found.add(anchor if count == 0 else f"{anchor}-{count}")
+    return found
+
+
+def relative(path: Path) -> str:
+    return str(path.relative_to(REPO))
+
+
+def test_github_anchor_rule():
+    assert github_anchor("Lateral velocity near the ABL top") == "lateral-velocity-near-the-abl-top"
+    assert github_anchor("Hub-aligned frame") == "hub-aligned-frame"
+    assert github_anchor("M-3") == "m-3"
+    assert github_anchor("Table 1") == "table-1"
+    assert github_anchor("Which velocity goes where?") == "which-velocity-goes-where"
+    assert github_anchor("`ekman_veer` models") == "ekman_veer-models"
+
+
+def test_docs_have_an_index_linked_from_the_readme():
+    assert (DOCS / "README.md").is_file()
+    index = (DOCS / "README.md").read_text()
+    for page in sorted(DOCS.glob("*.md")):
+        if page.name != "README.md":
+            assert f"]({page.name}" in index, f"docs/README.md does not link {page.name}"
+    assert "](docs/README.md)" in (REPO / "README.md").read_text()
+
+
+# docs/<page>.md#anchor, as cited in code and text (an anchor ends at whitespace or punctuation).
+CITATION = re.compile(r"docs/([\w\-]+\.md)(?:#([\w\-]+))?")
+
+
+def citations():
+    for path in SOURCES:
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            for match in CITATION.finditer(line):
+                yield f"{relative(path)}:{number}", match[1], match[2]
+
+
+def test_cited_doc_pages_and_anchors_exist():
+    cited = list(citations())
+    assert len(cited) > 30  # the code cites the pages throughout; an empty scan would pass vacuously
+    missing = []
+    for where, page, anchor in cited:
+        target = DOCS / page
+        if not target.is_file():
+            missing.append(f"{where}: docs/{page} does not exist")
+        elif anchor and anchor.rstrip("-") not in anchors(target):
+            missing.append(f"{where}: docs/{page}#{anchor} has no such heading")
+    assert not missing, "\n".join(missing)
+
+
+MARKDOWN_LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+def test_relative_links_in_markdown_resolve():
+    broken = []
+    for path in SOURCES:
+        if path.suffix != ".md":
+            continue
+        for target in MARKDOWN_LINK.findall(path.read_text()):
+            if re.match(r"[a-z]+:", target):  # http:, https:, mailto:
+                continue
+            file_part, _, anchor = target.partition("#")
+            resolved = (path.parent / file_part).resolve() if file_part else path
+            if REPO not in resolved.parents and resolved != REPO:
+                broken.append(f"{relative(path)}: {target} leaves the repository")
+            elif not resolved.exists():
+                broken.append(f"{relative(path)}: {target} does not exist")
+            elif anchor and resolved.suffix == ".md" and anchor not in anchors(resolved):
+                broken.append(f"{relative(path)}: {target} has no such heading")
+    assert not broken, "\n".join(broken)
+
+
+PROJECT_PATH = re.compile(
+    r"(?<![\w/.])((?:%s)/[\w./\-]*\.(?:py|md|yaml|yml|sh|png|toml))" % "|".join(PROJECT_FOLDERS)
+)
+
+
+def test_project_paths_named_in_the_text_exist():
+    missing = []
+    for path in SOURCES:
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
+            for name in PROJECT_PATH.findall(line):
+                if not (REPO / name).exists():
+                    missing.append(f"{relative(path)}:{number}: {name}")
+    assert not missing, "\n".join(missing)
+
+
+# Documents of the project's development that are not part of it, and paths of one machine.
+OUTSIDE = re.compile("|".join(["MODEL_NOTES", r"ARCHITECTURE\.md", "/work/", "/home/", "/Users/"]))
+
+
+def test_nothing_cites_a_document_outside_the_project():
+    offending = [
+        f"{relative(path)}:{number}: {line.strip()}"
+        for path in SOURCES
+        if path != Path(__file__).resolve()
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1)
+        if OUTSIDE.search(line)
+    ]
+    assert not offending, "\n".join(offending)
+
+
+def test_tests_cited_by_the_docs_exist():
+    defined = set()
+    for path in (REPO / "tests").glob("test_*.py"):
+        defined.update(re.findall(r"^\s*def (test_\w+)", path.read_text(), flags=re.M))
+    cited = {
+        (page.name, name)
+        for page in DOCS.glob("*.md")
+        for name in re.findall(r"`(test_\w+)`", page.read_text())
+    }
+    assert len(cited) > 20
+    missing = sorted(f"docs/{page}: {name}" for page, name in cited if name not in defined)
+    assert not missing, "\n".join(missing)
+
+
+# ------------------------------------------------------------------------ docs/validation.md#table-1
+def table_rows(heading: str, page: str = "validation.md"):
+    """(header, rows) of the first table under ``heading`` in ``docs/<page>``."""
+    lines = (DOCS / page).read_text().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.strip() == heading)
+    rows, in_table = [], False
+    for line in lines[start + 1:]:
+        if line.startswith("|"):
+            in_table = True
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if not set("".join(cells)) <= set("-: "):
+                rows.append(cells)
+        elif in_table:
+            break
+    return rows[0], rows[1:]
+
+
+PAPER = dict(geostrophic_wind=15.0, roughness_length=0.1, coriolis_parameter=1e-4,
+             brunt_vaisala_frequency=6.1e-3, reference_potential_temperature=265.0)
+#: The paper's Table 1: mu, C_r [K/h].
+TABLE1_INPUTS = {"CNBL": (0.0, 0.0), "SBL-1": (5.62, -0.03), "SBL-2": (20.59, -0.125),
+                 "SBL-3": (39.84, -0.25), "SBL-4": (59.25, -0.375), "SBL-5": (78.35, -0.5),
+                 "SBL-6": (148.49, -1.0)}
+
+
+def test_validation_table1_is_what_the_model_gives():
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+    header, rows = table_rows("## Table 1")
+    assert [r[0] for r in rows] == list(TABLE1_INPUTS)
+    column = {name: i for i, name in enumerate(header)}
+    checked = 0
+    for row in rows:
+        mu, c_r = TABLE1_INPUTS[row[0]]
+        for closure, value in (("mu", dict(stability_parameter=mu)), ("C_r", dict(cooling_rate=c_r))):
+            abl = EkmanABL(**PAPER, **value)
+            got = {
+                f"h [m] ({closure})": abl.boundary_layer_height,
+                f"u* [m/s] ({closure})": abl.friction_velocity,
+                f"alpha_0 [deg] ({closure})": abl.cross_isobaric_angle,
+                f"mu ({closure})": abl.stability_parameter,
+                f"veer 50-150 m [deg] ({closure})": abl.wind_direction_change(50.0, 150.0),
+            }
+            for name, value in got.items():
+                if name in column:
+                    assert_printed(row[column[name]], float(value), (row[0], name))
+                    checked += 1
+    assert checked >= 7 * 8
+
+
+def assert_printed(text: str, value: float, where) -> None:
+    """``text`` is ``value`` rounded to the digits printed (half a unit of the last digit)."""
+    decimals = len(text.partition(".")[2])
+    assert abs(float(text) - value) <= 0.51 * 10.0**-decimals, (where, text, value)
+
+
+@pytest.mark.parametrize("page", ["conventions.md", "atmosphere.md", "wake_model.md",
+                                  "coupling.md", "validation.md"])
+def test_pages_exist_and_cite_the_paper_by_equation(page):
+    text = (DOCS / page).read_text()
+    assert re.search(r"Eqs?\. \(\w+\)", text), f"docs/{page} cites no equation of the paper"
+
+
+def test_validation_single_wakes_are_what_the_model_gives():
+    """The paper's disk (C_T' = 1.33, D = z_h = 100 m) at zero yaw, cooling-rate closure."""
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+    from floris_ekman_veer.wake import deficit
+
+    ct_prime, radius, hub = 1.33, 50.0, 100.0
+    ct = 16.0 * ct_prime / (4.0 + ct_prime) ** 2
+    header, rows = table_rows("## Single wakes")
+    assert [r[0] for r in rows] == ["CNBL", "SBL-4", "SBL-5", "SBL-6"]
+    for row in rows:
+        abl = EkmanABL(**PAPER, cooling_rate=TABLE1_INPUTS[row[0]][1])
+        k_w = float(abl.wake_expansion_rate(hub))
+        got = {
+            "I_u(z_h)": abl.turbulence_intensity(hub),
+            "k_w": k_w,
+            "x0/D": deficit.potential_core_length(k_w, radius, ct, 0.0) / (2 * radius),
+            "C(5 D)": deficit.max_deficit(10 * radius, k_w, radius, ct, 0.0),
+            "C(10 D)": deficit.max_deficit(20 * radius, k_w, radius, ct, 0.0),
+        }
+        assert header[1:] == list(got)
+        for i, value in enumerate(got.values(), 1):
+            assert_printed(row[i], float(value), (row[0], header[i]))
+
+
+def test_atmosphere_backing_layer_table_is_what_the_model_gives():
+    """docs/atmosphere.md#lateral-velocity-near-the-ground: where V > 0 and its maximum."""
+    import numpy as np
+
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+    _, rows = table_rows("## Lateral velocity near the ground", "atmosphere.md")
+    assert [r[0] for r in rows] == ["CNBL", "SBL-4", "SBL-6"]
+    for case, h_text, top_text, peak_text in rows:
+        abl = EkmanABL(**PAPER, cooling_rate=TABLE1_INPUTS[case][1])
+        h = float(abl.boundary_layer_height)
+        z = np.linspace(1.0, h, 200_001)
+        v = abl.velocity(z)[1]
+        top = z[np.argmax(v < 0)]  # first height above 1 m with V < 0
+        peak = np.argmax(v)
+        speed, height = re.match(r"\+([\d.]+) m/s at (\d+) m", peak_text).groups()
+        assert_printed(h_text, h, case)
+        assert_printed(top_text, top, case)
+        assert_printed(speed, v[peak], case)
+        assert_printed(height, z[peak], case)
+        assert 0.26 < top / h < 0.30
