@@ -624,14 +624,14 @@ def test_bad_input_in_arrays_names_offending_values():
         EkmanABL(**{**BASE, "roughness_length": np.array([0.1, -1.0, 0.2, 0.0])})
 
 
-def test_hub_at_or_above_h_raises():
+def test_hub_at_or_above_h_is_continuous_down_to_the_floor():
+    # docs/atmosphere.md#shallow-boundary-layer
     a = EkmanABL(**BASE, cooling_rate=-1.0)
     h = float(a.boundary_layer_height)
-    for hub in (h, 1.5 * h):
-        with pytest.raises(ValueError, match=r"hub_height must lie below the boundary-layer "
-                                             r"height h \(valid range: z0 < hub_height < h\)"):
-            a.wake_expansion_rate(hub)
-    assert float(a.wake_expansion_rate(0.5 * h)) > 0
+    below, at = float(a.wake_expansion_rate(h * (1 - 1e-12))), float(a.wake_expansion_rate(h))
+    assert at == pytest.approx(below, rel=1e-8)  # U(z) ~ sqrt(h - z) just below h
+    assert float(a.wake_expansion_rate(0.5 * h)) >= at >= float(a.wake_expansion_rate(1.5 * h))
+    assert float(a.wake_expansion_rate(1.7 * h)) == pytest.approx(0.021, rel=1e-15)
 
 
 @pytest.mark.parametrize("speed, height, pattern", [

@@ -915,11 +915,18 @@ def test_yaw_of_90_degrees_or_more_is_refused(yaw):
 
 
 @pytest.mark.filterwarnings("ignore:.*max_thrust_coefficient:RuntimeWarning")  # C_T(3 m/s)
-def test_hub_above_the_boundary_layer_is_refused():
-    """SBL-6 stability at 3 m/s: h = 47 m, below the 90 m hub."""
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.coupling.shallow.ShallowBoundaryLayerWarning")
+def test_hub_above_the_boundary_layer_takes_the_floor_expansion():
+    """SBL-6 stability at 3 m/s: h = 47 m, below the 90 m hub and below h exp(B1/A1) = 76 m:
+    no ambient turbulence at the hub, k_w is the floor (docs/atmosphere.md#shallow-boundary-layer)."""
     cfg = config("farm_sbl6", wind_speeds=[3.0])
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 630.0], [0.0, 0.0]
-    assert atmosphere_of(cfg).boundary_layer_height < HUB_5MW
-    with pytest.raises(ValueError, match="hub_height"):
-        FlorisModel(cfg).run()
+    abl = atmosphere_of(cfg)
+    assert abl.boundary_layer_height * np.exp(0.6 / 1.25) < HUB_5MW
+    fmodel = FlorisModel(cfg)
+    fmodel.run()
+    powers = fmodel.get_turbine_powers()
+    assert np.all(np.isfinite(powers)) and powers[0, 1] < powers[0, 0]
+    k_w = fmodel.core.wake.velocity_model.expansion_rate(abl, HUB_5MW, abl.speed(HUB_5MW), 0.06)
+    assert float(k_w) == pytest.approx(0.021, rel=1e-15)
 

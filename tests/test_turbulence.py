@@ -50,12 +50,20 @@ def test_wake_expansion_rate_limits():
     assert tb.wake_expansion_rate(2.0, 300.0, 100.0, 8.0) == pytest.approx(0.33 * i_u, rel=1e-5)
 
 
-def test_zero_at_and_above_abl_top():
-    z = np.array([300.0, 301.0, 1000.0])
+def test_continued_above_abl_top_to_the_zero_of_the_variance():
+    # docs/atmosphere.md#shallow-boundary-layer: sqrt(max(A1 ln(h/z) + B1, 0)) u*/U above h.
+    # just below and at h: B1 alone, sqrt(0.6) u*/U (no jump at h)
+    for z in (300.0 * (1 - 1e-12), 300.0):
+        assert tb.streamwise_turbulence_intensity(z, 0.4, 300.0, 8.0) == (
+            pytest.approx(math.sqrt(0.6) * 0.05, rel=1e-10))
+    # 1.2 h: 1.25 ln(1/1.2) + 0.6 = 0.37209805...; sqrt(.) * 0.05
+    assert tb.streamwise_turbulence_intensity(360.0, 0.4, 300.0, 8.0) == pytest.approx(
+        math.sqrt(1.25 * math.log(1 / 1.2) + 0.6) * 0.05, rel=1e-14)
+    # zero from z_t = h exp(B1/A1) = 1.6160744 h up
+    z_t = 300.0 * math.exp(0.6 / 1.25)
+    assert float(tb.turbulence_top(300.0)) == pytest.approx(z_t, rel=1e-15)
+    z = np.array([z_t, 1.001 * z_t, 1000.0])
     np.testing.assert_array_equal(tb.streamwise_turbulence_intensity(z, 0.4, 300.0, 8.0), 0.0)
-    # just below h: B1 alone, sqrt(0.6) u*/U
-    assert tb.streamwise_turbulence_intensity(300.0 * (1 - 1e-12), 0.4, 300.0, 8.0) == (
-        pytest.approx(math.sqrt(0.6) * 0.05, rel=1e-10))
 
 
 def test_vectorised_over_heights_and_states():
@@ -70,16 +78,13 @@ def test_vectorised_over_heights_and_states():
             assert got[i, j] == pytest.approx(hand, rel=1e-14)
 
 
-@pytest.mark.parametrize("hub", [300.0, 450.0])
-def test_hub_at_or_above_h_raises(hub):
-    with pytest.raises(ValueError, match=r"hub_height must lie below the boundary-layer height"
-                                         r" h \(valid range: z0 < hub_height < h\)"):
-        tb.wake_expansion_rate(0.4, 300.0, hub, 8.0)
-
-
-def test_hub_above_h_in_array_raises():
-    with pytest.raises(ValueError, match=r"got hub_height=350 m and h=300 m"):
-        tb.wake_expansion_rate(0.4, 300.0, np.array([90.0, 350.0]), 8.0)
+@pytest.mark.parametrize("hub", [300.0, 450.0, 480.0, 2000.0])
+def test_hub_at_or_above_h_takes_the_continued_law(hub):
+    i_u = math.sqrt(max(1.25 * math.log(300.0 / hub) + 0.6, 0.0)) * 0.4 / 8.0
+    expected = (0.021**6 + (0.33 * i_u) ** 6) ** (1 / 6)
+    assert tb.wake_expansion_rate(0.4, 300.0, hub, 8.0) == pytest.approx(expected, rel=1e-14)
+    if hub >= 300.0 * math.exp(0.6 / 1.25):  # no ambient turbulence: the floor
+        assert tb.wake_expansion_rate(0.4, 300.0, hub, 8.0) == pytest.approx(0.021, rel=1e-15)
 
 
 # ------------------------------------------------------------------------- through EkmanABL
@@ -100,7 +105,7 @@ def test_ekman_turbulence_intensity_normalisation():
         assert local[k] == pytest.approx(variance / float(a.speed(zk)), rel=1e-13)
         assert hub[k] == pytest.approx(variance / u_h, rel=1e-13)
     assert local[2] == pytest.approx(hub[2], rel=1e-15)
-    assert float(a.turbulence_intensity(1.5 * h)) == 0.0
+    assert float(a.turbulence_intensity(1.7 * h)) == 0.0  # above h exp(B1/A1) = 1.62 h
     with pytest.raises(ValueError, match="heights z must be >= roughness_length z0"):
         a.turbulence_intensity(0.05)
 
@@ -128,8 +133,7 @@ def test_property_nonnegative_and_bounded(u_star, h, frac, speed):
     z = frac * h
     i_u = float(tb.streamwise_turbulence_intensity(z, u_star, h, speed))
     assert math.isfinite(i_u) and i_u >= 0
-    assert (i_u == 0) == (z >= h)
-    if z < h:
-        k_w = float(tb.wake_expansion_rate(u_star, h, z, speed))
-        lower = max(0.021, 0.33 * i_u)
-        assert lower <= k_w <= lower * 2 ** (1 / 6) * (1 + 1e-12)
+    assert (i_u == 0) == (z >= h * math.exp(0.6 / 1.25))
+    k_w = float(tb.wake_expansion_rate(u_star, h, z, speed))
+    lower = max(0.021, 0.33 * i_u)
+    assert lower <= k_w <= lower * 2 ** (1 / 6) * (1 + 1e-12)

@@ -483,8 +483,9 @@ class EkmanABL:
         """Streamwise turbulence intensity I_u(z), Eq. (Iu_model).
 
         Normalised by the speed at ``reference_height`` (the paper's U_h) when given, else by
-        the local speed |(U, V)(z)| (the two agree at the reference height). Zero at and
-        above the ABL top (no boundary-layer turbulence in the geostrophic flow).
+        the local speed |(U, V)(z)| (the two agree at the reference height). Above h the
+        variance law is continued to its zero at h exp(B1/A1) and is zero higher up
+        (docs/atmosphere.md#shallow-boundary-layer).
         """
         z = np.asarray(z, dtype=float)
         reference_speed = self.speed(z if reference_height is None else reference_height)
@@ -496,8 +497,9 @@ class EkmanABL:
     def wake_expansion_rate(self, hub_height, **constants):
         """k_w at a hub height, Eq. (kw_CNBL_SBL_model), with U_h = |(U, V)(z_h)|.
 
-        ``constants`` may override A1, B1, alpha_prime, floor and n. Raises ValueError for
-        a hub at or above the boundary layer.
+        ``constants`` may override A1, B1, alpha_prime, floor and n. A hub at or above h takes
+        the continued law (docs/atmosphere.md#shallow-boundary-layer): the floor from
+        h exp(B1/A1) up.
         """
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,

@@ -26,17 +26,27 @@ MIXING_LAYER_FLOOR = 0.021
 MERGE_EXPONENT = 6.0
 
 
-def _variance_factor(height, boundary_layer_height, A1, B1):
-    """sqrt(A1 ln(h/z) + B1), Eq. (upup_var), zero at and above the ABL top.
+def turbulence_top(boundary_layer_height, A1=TOWNSEND_PERRY_A1, B1=TOWNSEND_PERRY_B1):
+    """z_t = h exp(B1/A1) (1.62 h with the paper's constants), where Eq. (upup_var) gives zero
+    variance (docs/atmosphere.md#shallow-boundary-layer)."""
+    return np.asarray(boundary_layer_height, dtype=float) * np.exp(B1 / A1)
 
-    Above h the flow is the laminar geostrophic wind: no boundary-layer turbulence.
-    The law itself is valid only inside the ABL (for z > h e^{B1/A1} its bracket would
-    turn negative), so heights z >= h return 0 by definition, not by clipping.
+
+def _variance_factor(height, boundary_layer_height, A1, B1):
+    """sqrt(max(A1 ln(h/z) + B1, 0)), Eq. (upup_var) continued to its zero above h.
+
+    Inside the ABL (z < h) this is the paper's law unchanged. At z = h the law still gives
+    <u'u'> = B1 u*^2, while the geostrophic flow above is laminar: stopping the law at h would
+    make I_u, the wake expansion and therefore farm power jump when a weakening wind lowers h
+    through a hub height. The law is instead continued to where its own variance vanishes,
+    z_t = h exp(B1/A1) (`turbulence_top`), and is zero above: continuous in z, h and u*, with
+    no new constant (docs/atmosphere.md#shallow-boundary-layer).
     """
     height = np.asarray(height, dtype=float)
-    inside = height < boundary_layer_height
+    boundary_layer_height = np.asarray(boundary_layer_height, dtype=float)
+    inside = height < turbulence_top(boundary_layer_height, A1, B1)
     ratio = np.where(inside, boundary_layer_height / np.where(inside, height, 1.0), 1.0)
-    return np.where(inside, np.sqrt(A1 * np.log(ratio) + B1), 0.0)
+    return np.where(inside, np.sqrt(np.maximum(A1 * np.log(ratio) + B1, 0.0)), 0.0)
 
 
 def streamwise_turbulence_intensity(
@@ -47,7 +57,8 @@ def streamwise_turbulence_intensity(
     A1: float = TOWNSEND_PERRY_A1,
     B1: float = TOWNSEND_PERRY_B1,
 ):
-    """I_u = [A1 ln(h/z) + B1]^(1/2) u*/U_ref, Eq. (Iu_model); 0 for z >= h.
+    """I_u = [A1 ln(h/z) + B1]^(1/2) u*/U_ref, Eq. (Iu_model); above h the law is continued to
+    its zero at h exp(B1/A1) and is 0 higher up (see `_variance_factor`).
 
     ``reference_speed`` is U_h in the paper (hub-height speed); any positive speed works.
     Heights must be positive (the caller checks them against the roughness length).
@@ -75,18 +86,12 @@ def wake_expansion_rate(
     The smooth maximum keeps k_w from falling below the mixing-layer spreading rate of
     weakly turbulent (stable) inflow, following Vahidi & Porte-Agel (2022).
 
-    Raises:
-        ValueError: if a hub is at or above the boundary-layer top, where the variance
-            law (and the wake model's picture of a turbine inside the ABL) does not hold.
+    A hub at or above h (a boundary layer shallower than the rotor, weak-wind stable nights)
+    is allowed: I_u follows the variance law continued above h (`_variance_factor`), so k_w
+    falls continuously to the floor, reached for hubs at or above h exp(B1/A1), the limit of
+    vanishing ambient turbulence (docs/atmosphere.md#shallow-boundary-layer).
     """
     hub_height = np.asarray(hub_height, dtype=float)
-    if np.any(hub_height >= boundary_layer_height):
-        raise ValueError(
-            "hub_height must lie below the boundary-layer height h (valid range: "
-            f"z0 < hub_height < h); got hub_height={np.max(hub_height):.6g} m and "
-            f"h={np.min(boundary_layer_height):.6g} m. The wake expansion model of "
-            "Eq. (kw_CNBL_SBL_model) describes turbines inside the ABL only."
-        )
     turbulent = alpha_prime * streamwise_turbulence_intensity(
         hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1
     )

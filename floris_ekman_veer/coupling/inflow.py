@@ -484,7 +484,7 @@ def _validating_post_init(method):
     """Validate the atmosphere, and the layout, conditions and turbines of a Core using the
     package (:func:`floris_ekman_veer.coupling.input_checks.check_core`, before FLORIS builds
     its grid), when a Core is built (FlorisModel(), set(), copy())."""
-    from floris_ekman_veer.coupling import input_checks
+    from floris_ekman_veer.coupling import input_checks, shallow
 
     @functools.wraps(method)
     def wrapper(self: Core) -> None:
@@ -500,7 +500,14 @@ def _validating_post_init(method):
             and self.flow_field.n_findex
             and abs(self.flow_field.reference_wind_height + 1.0) > 1e-6
         ):
-            solve(spec, self.flow_field.wind_speeds, self.flow_field.reference_wind_height)
+            abl = solve(spec, self.flow_field.wind_speeds, self.flow_field.reference_wind_height)
+            shallow.check_rotor_inside(
+                self.wake.wake_velocity_parameters.get(PARAMETER_BLOCK), abl.boundary_layer_height,
+                self.flow_field.wind_speeds, self.flow_field.reference_wind_height,
+                self.farm.hub_heights, self.farm.rotor_diameters,
+            )
+        elif spec is not None:
+            shallow.policy(self.wake.wake_velocity_parameters.get(PARAMETER_BLOCK))
 
     return wrapper
 

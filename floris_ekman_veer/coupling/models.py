@@ -55,6 +55,7 @@ from floris_ekman_veer.atmosphere.turbulence import (
     wake_expansion_rate,
 )
 from floris_ekman_veer.coupling.inflow import solved_atmosphere
+from floris_ekman_veer.coupling.shallow import POLICIES as SHALLOW_POLICIES
 from floris_ekman_veer.coupling.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
@@ -215,6 +216,9 @@ class _EkmanWakeModel(BaseModel):
     #: plus wake-added, from FLORIS's turbulence model) in the same smooth maximum, for farms.
     wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
+    #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
+    #: or "raise"; read by the inflow hook when the model is built (coupling/shallow.py).
+    shallow_boundary_layer: str = choice_field("warn", SHALLOW_POLICIES)
 
     #: Where the block sits in a FLORIS input (error messages name it).
     input_path = f"wake.wake_velocity_parameters.{VELOCITY_MODEL_NAME}"

@@ -14,6 +14,7 @@ result of running each distinct atmosphere on its own (tests/test_optimization.p
 from __future__ import annotations
 
 import inspect
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -21,6 +22,7 @@ import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 
 from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
 
 #: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
 PER_CONDITION_OPTIONS = (
@@ -88,7 +90,10 @@ def optimize_yaw(
 
     frames = []
     with tqdm(total=n_findex, desc=f"{optimizer_class.__name__}", unit="condition",
-              disable=not progress) as bar:
+              disable=not progress) as bar, warnings.catch_warnings():
+        # fmodel's own build counted its shallow conditions; the optimiser's many re-builds
+        # (tiled, masked condition sets) would repeat that count in ever different numbers.
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
         for atmosphere, index in runs:
             subset = condition_subset(fmodel, index, atmosphere)
             kwargs = {

@@ -1,0 +1,88 @@
+"""Conditions whose boundary layer is shallower than the rotor: counted, warned about, or refused.
+
+Weak winds under strong stable stratification give boundary layers tens of metres deep (SBL-6 at
+3 m/s: h = 47 m under a 90 m hub). The model runs there (docs/atmosphere.md#shallow-boundary-layer):
+the inflow above h is the geostrophic wind and the turbulence of the variance law is continued
+above h to its zero at h exp(B1/A1), so the ``ekman_veer`` wake expansion falls continuously to
+its floor. Those conditions lie outside what the paper validated, so when a model is built
+(its conditions known) they are counted in a :class:`ShallowBoundaryLayerWarning`, or, with::
+
+    wake:
+      wake_velocity_parameters:
+        ekman_veer:
+          shallow_boundary_layer: raise
+
+refused with a ValueError naming each such condition's index, wind speed, h and hub height.
+A condition is affected when any rotor's top (hub height + D/2) is above h.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+
+import numpy as np
+
+#: Key of the policy in ``wake.wake_velocity_parameters.ekman_veer``, and its values.
+POLICY_KEY = "shallow_boundary_layer"
+POLICIES = ("warn", "raise")
+POLICY_PATH = f"wake.wake_velocity_parameters.ekman_veer.{POLICY_KEY}"
+
+_SHOWN = 5  # conditions listed in a message
+
+
+class ShallowBoundaryLayerWarning(UserWarning):
+    """Some conditions have a boundary layer shallower than the rotor (outside the paper's
+    validated range; the model's behaviour there is documented, continuous and finite)."""
+
+
+def policy(block: Mapping | None) -> str:
+    """The validated policy of an ``ekman_veer`` parameter block ("warn" by default)."""
+    value = (block or {}).get(POLICY_KEY, "warn")
+    if value not in POLICIES:
+        raise ValueError(f"{POLICY_PATH} must be one of {list(POLICIES)}; got {value!r}")
+    return value
+
+
+def check_rotor_inside(
+    block: Mapping | None, boundary_layer_height, wind_speeds, reference_height: float,
+    hub_heights, rotor_diameters,
+) -> np.ndarray:
+    """Warn about (policy "warn") or refuse (policy "raise") conditions with a rotor top above h.
+
+    ``boundary_layer_height`` and ``wind_speeds`` per condition; ``hub_heights`` and
+    ``rotor_diameters`` per turbine. Returns the boolean mask of affected conditions.
+    """
+    mode = policy(block)
+    h = np.asarray(boundary_layer_height, dtype=float).reshape(-1)
+    speeds = np.broadcast_to(np.asarray(wind_speeds, dtype=float).reshape(-1), h.shape)
+    hubs = np.asarray(hub_heights, dtype=float).reshape(-1)
+    tops = hubs + 0.5 * np.asarray(rotor_diameters, dtype=float).reshape(-1)
+    highest = np.argmax(tops)
+    affected = tops[highest] > h
+    if not np.any(affected):
+        return affected
+    hub, top = hubs[highest], tops[highest]
+    index = np.flatnonzero(affected)
+    listed = "; ".join(
+        f"condition {i}: wind speed {speeds[i]:.6g} m/s at {reference_height:.6g} m, "
+        f"h = {h[i]:.4g} m, hub height {hub:.6g} m (rotor top {top:.6g} m)"
+        for i in index[:_SHOWN]
+    )
+    more = f"; and {index.size - _SHOWN} more" if index.size > _SHOWN else ""
+    hub_above = int(np.count_nonzero(h[index] <= hub))
+    if mode == "raise":
+        raise ValueError(
+            f"{index.size} of {h.size} conditions have a boundary layer shallower than the rotor "
+            f"(rotor top above h), refused by {POLICY_PATH} = 'raise': {listed}{more}"
+        )
+    warnings.warn(
+        f"{index.size} of {h.size} conditions have a boundary layer shallower than the rotor "
+        f"(rotor top above h; {hub_above} with the hub at or above h), outside the paper's "
+        f"validated range: the inflow above h is the geostrophic wind and the wake expansion "
+        f"falls continuously to its floor (docs/atmosphere.md#shallow-boundary-layer). "
+        f"{listed}{more}. Set {POLICY_PATH}: raise to refuse them.",
+        ShallowBoundaryLayerWarning,
+        stacklevel=4,
+    )
+    return affected
