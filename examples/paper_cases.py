@@ -9,7 +9,7 @@ and -0.5 K/h). FLORIS drives the ABL by the wind speed at its reference height, 
 that speed is set to |(U, V)(z_h)| of the ABL with G = 15 m/s. The turbulence intensity is set to
 the atmosphere's I_u(z_h) (the ekman_veer models do not use it: they take k_w from the ABL).
 
-Models (paper Section 5.4): M-1 = ``ekman_veer`` velocity + deflection; M-2 = the same with the
+Models (paper Section 4.4): M-1 = ``ekman_veer`` velocity + deflection; M-2 = the same with the
 veer deflection off; M-3 = ``bastankhah2014`` (Bastankhah & Porte-Agel 2014) with no deflection
 (a zero deflection model defined here: FLORIS's ``none`` refuses yawed turbines); behind a yawed
 disk M-3 only sees its thrust coefficient.

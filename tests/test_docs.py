@@ -267,3 +267,39 @@ def test_atmosphere_backing_layer_table_is_what_the_model_gives():
         assert_printed(speed, v[peak], case)
         assert_printed(height, z[peak], case)
         assert 0.26 < top / h < 0.30
+
+
+# ------------------------------------------------------------------------- citations of the paper
+#: Equation labels of Narasimhan, Gayme & Meneveau (JRSE 2025), as in its LaTeX source. ``GDL``
+#: stands for the label ``eqn:GDL`` and ``eqn:avoidnumbers1a``/``b`` for the two parts of
+#: ``eqn:avoidnumbers1`` (g and g').
+PAPER_EQUATIONS = {
+    "du_model", "Cx", "sigma_tilde", "A_star", "ind_factor", "x0_transition", "sigma_width",
+    "polar_angle", "wake_shape_function", "xi0_theta", "xi_emp", "that", "upup_var", "Iu_model",
+    "kw_model_high_Iu", "kw_CNBL_SBL_model", "yc_xz", "yhatc", "yc_veer", "U_vel", "V_vel",
+    "eqn:avoidnumbers1", "eqn:avoidnumbers1a", "eqn:avoidnumbers1b", "h_hat_model", "GDL",
+    "eqn:GDL", "A_model_GDL", "B_model_GDL", "eps_z", "eps_y", "P0_ref", "P_hyp", "Ud", "P_ratio",
+    "eps_P",
+}
+#: The paper's sections and subsections.
+PAPER_SECTIONS = {"1", "2", "2.1", "2.2", "2.3", "2.4", "2.5", "3", "3.1", "4", "4.1", "4.2",
+                  "4.3", "4.3.1", "4.3.2", "4.4", "5"}
+
+EQUATION_CITATION = re.compile(r"Eqs?\.\s*((?:\([\w:]+\)(?:,\s*|\s+and\s+|\s+to\s+)?)+)")
+
+
+def test_cited_equations_and_sections_are_the_papers():
+    wrong, cited = [], 0
+    for path in SOURCES:
+        if path == Path(__file__).resolve():
+            continue
+        text = path.read_text(errors="replace")
+        for group in EQUATION_CITATION.findall(text):
+            cited += group.count("(")
+            wrong += [f"{relative(path)}: Eq. ({label})" for label in re.findall(r"\(([\w:]+)\)", group)
+                      if label not in PAPER_EQUATIONS]
+        wrong += [f"{relative(path)}: Section {number}"
+                  for number in re.findall(r"\bSections? (\d+(?:\.\d+)*)", text)
+                  if number not in PAPER_SECTIONS]
+    assert cited > 100  # the code cites the paper's equations throughout
+    assert not wrong, "\n".join(wrong)
