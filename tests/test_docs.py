@@ -89,7 +89,8 @@ def test_cited_doc_pages_and_anchors_exist():
         if not target.is_file():
             missing.append(f"{where}: docs/{page} does not exist")
         elif anchor and anchor.rstrip("-") not in anchors(target):
-            missing.append(f"{where}: docs/{page}#{anchor} has no such heading")
+            missing.append(f"{where}: docs/{page}#{anchor} has no such heading (add the section "
+                           "to the page, or cite an existing one)")
     assert not missing, "\n".join(missing)
 
 
@@ -155,7 +156,8 @@ def test_tests_cited_by_the_docs_exist():
         for name in re.findall(r"`(test_\w+)`", page.read_text())
     }
     assert len(cited) > 20
-    missing = sorted(f"docs/{page}: {name}" for page, name in cited if name not in defined)
+    missing = sorted(f"docs/{page} cites {name}, which no test defines: update the page to what "
+                     "the tests pin now" for page, name in cited if name not in defined)
     assert not missing, "\n".join(missing)
 
 
