@@ -461,6 +461,41 @@ def test_m3_behind_a_yawed_rotor_is_undeflected():
     assert np.all(fields[20.0][:, 8, 1] < fields[20.0][:, 0, 1] - 0.5)
 
 
+@pytest.mark.parametrize("case", ["cnbl", "sbl6"])
+def test_m3_behind_a_yawed_disk_takes_the_rotor_normal_loading(case):
+    """M-3 has no yaw: behind the fixed-C_T' disk yawed by beta it is the Gaussian of 2014 with
+    the disk's rotor-normal loading C_T(beta) cos^2(beta) = 4 a(beta) (1 - a(beta))
+    (docs/wake_model.md#m-3), written out here: its potential core is M-1's 2 a(beta), and the
+    wake is shallower than behind the un-yawed disk (never deeper, as C_T(beta) would make it)."""
+    cfg = config(case)
+    cfg["wake"]["model_strings"]["velocity_model"] = "bastankhah2014"
+    cfg["wake"]["wake_deflection_parameters"]["ekman_veer"].update(veer=False, yaw_deflection=False)
+    abl = atmosphere_of(cfg)
+    k_w, u_h = paper_k_w(abl, HUB), abl.speed(HUB)
+    x_d = np.array([0.5, 4.0, 6.0, 10.0])[:, None]
+    y, z = np.array([0.0, 30.0, -70.0])[None, :], HUB + 20.0
+    inflow = abl.hub_aligned_velocity(z, HUB)[0]
+    centre = {}
+    for yaw in (0.0, 20.0, -20.0):
+        fmodel = FlorisModel(cfg)
+        fmodel.set(yaw_angles=[[yaw]])
+        a = disk_induction(yaw)
+        ct = 4.0 * a * (1.0 - a)
+        assert ct == pytest.approx(disk_thrust_coefficient(yaw) * np.cos(np.deg2rad(yaw)) ** 2)
+        beta_bp = 0.5 * (1.0 + np.sqrt(1.0 - ct)) / np.sqrt(1.0 - ct)
+        sigma_d = k_w * x_d + 0.2 * np.sqrt(beta_bp)
+        # far wake of Bastankhah & Porte-Agel (2014), capped at the core deficit 2a
+        c = np.minimum(1.0 - np.sqrt(np.clip(1.0 - ct / (8.0 * sigma_d**2), 0.0, 1.0)), 2.0 * a)
+        expected = inflow - c * u_h * np.exp(-(y**2 + (z - HUB) ** 2) / (2 * (sigma_d * D) ** 2))
+        np.testing.assert_allclose(sample(fmodel, x_d * D, y, z), expected, rtol=0.0, atol=1e-9)
+        # half a diameter behind the rotor the deficit is the potential core's 2a(beta), as M-1's
+        assert c[0, 0] == pytest.approx(2.0 * a, rel=1e-12)
+        centre[yaw] = c[:, 0]
+    assert disk_induction(20.0) == pytest.approx(0.226966, abs=1e-6)
+    np.testing.assert_array_equal(centre[20.0], centre[-20.0])
+    assert np.all(centre[20.0] < centre[0.0])
+
+
 def test_southern_hemisphere_is_the_mirror_image():
     """f_c -> -f_c with veer on: the field at (x, y, z) with yaw beta in the south equals the
     northern one at (x, -y, z) with yaw -beta; so do the powers of a mirrored farm."""
@@ -887,16 +922,20 @@ def test_thrust_coefficient_beyond_momentum_theory():
 
 def test_heavily_loaded_yawed_rotor_limits_the_normal_loading():
     """Yawed by 20 deg, the NREL 5 MW at 3 m/s (C_T = 0.9999) loads its rotor normal with
-    C_T cos^2 = 0.883 < 0.96: M-1 evaluates it as it is (no warning). M-3 has no yaw in its
-    momentum theory, so there C_T itself is limited to 0.96 (warning). Both stay finite."""
-    for velocity_model, warns in (("ekman_veer", False), ("bastankhah2014", True)):
+    C_T cos^2 = 0.883 < 0.96: M-1 evaluates it as it is, and M-3, which takes that rotor-normal
+    loading as its thrust coefficient (docs/wake_model.md#m-3), too (no warning); un-yawed, the
+    same rotor is limited (warning) by both. All stay finite."""
+    for velocity_model, yaw, warns in (
+        ("ekman_veer", 20.0, False), ("bastankhah2014", 20.0, False),
+        ("ekman_veer", 0.0, True), ("bastankhah2014", 0.0, True),
+    ):
         cfg = config("farm_sbl6", wind_speeds=[3.0], reference_wind_height=HUB_5MW)
         cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
             config("cnbl")["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"])
         cfg["wake"]["model_strings"]["velocity_model"] = velocity_model
         cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 630.0], [0.0, 0.0]
         fmodel = FlorisModel(cfg)
-        fmodel.set(yaw_angles=[[20.0, 0.0]])
+        fmodel.set(yaw_angles=[[yaw, 0.0]])
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             fmodel.run()

@@ -95,12 +95,12 @@ _MERGE_EXPONENT_RANGE = ("finite and >= 1", lambda v: np.isfinite(v) and v >= 1.
 _THRUST_LIMIT_RANGE = ("in (0, 1)", lambda v: 0.0 < v < 1.0)
 
 
-def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=None):
+def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
     """C_T = ct_i / cos(yaw) (docs/conventions.md#thrust-coefficient-and-yaw), limited to the momentum-theory range.
 
-    The limit acts on the rotor-normal loading C_T cos^2(loading_yaw) (default: the yaw itself,
-    as in Eqs. A_star and ind_factor; 0 for a formula without yaw, M-3). ``yaw`` in radians.
-    Returns the C_T the wake formulas use; warns when the limit acts.
+    The limit acts on the rotor-normal loading C_T cos^2(yaw), as in Eqs. A_star and
+    ind_factor. ``yaw`` in radians. Returns the C_T the wake formulas use; warns when the limit
+    acts.
     """
     if np.any(np.abs(yaw) >= np.pi / 2):
         raise ValueError(
@@ -108,7 +108,7 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient, loading_yaw=No
             f"{np.rad2deg(yaw.flat[np.argmax(np.abs(yaw))]):.6g} degrees"
         )
     ct = np.asarray(ct_i, dtype=float) / np.cos(yaw)
-    limit = max_thrust_coefficient / np.cos(yaw if loading_yaw is None else loading_yaw) ** 2
+    limit = max_thrust_coefficient / np.cos(yaw) ** 2
     heavy = ct > limit
     if np.any(heavy):
         warnings.warn(
@@ -275,10 +275,7 @@ class _EkmanWakeModel(BaseModel):
             dy=y - y_i - deflection_field_i,
             dz=z - hub_height_i,
             yaw=yaw,
-            ct=unyawed_thrust_coefficient(
-                ct_i, yaw, self.max_thrust_coefficient,
-                loading_yaw=yaw if self.yawed_momentum_theory else 0.0,
-            ),
+            ct=self.wake_thrust_coefficient(ct_i, yaw),
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
             k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
@@ -292,9 +289,9 @@ class _EkmanWakeModel(BaseModel):
         safe_u = np.where(flowing, u_initial, 1.0)
         return np.where(flowing, deficit * hub_speed / safe_u, 0.0)
 
-    #: Whether the model's momentum theory is that of the yawed rotor (C_T cos^2 beta); M-3's
-    #: is the unyawed one (C_T).
-    yawed_momentum_theory = True
+    def wake_thrust_coefficient(self, ct_i, yaw):
+        """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
+        return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         """Delta u / U_h of one wake; each model defines it."""
@@ -404,11 +401,24 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
     k* = ``k_star`` if given, else the paper's k_w (Eq. kw_CNBL_SBL_model, or the local
     turbulence variant), so that M-1 and M-3 differ only by their physics, not their mixing.
     The deficit is relative to U_h, the ambient hub-height speed.
+
+    Thrust coefficient behind a yawed rotor (docs/wake_model.md#m-3): the Gaussian of 2014 knows
+    no yaw, only a thrust coefficient, and is given the rotor-normal loading
+    C_T cos^2(beta) = ct_i cos(beta) (for the paper's fixed-C_T' disk 4a(1 - a) with the yawed
+    disk's induction a(beta) of Eq. ind_factor: 0.7491 un-yawed, 0.7018 at 20 deg). Its
+    momentum theory then returns the disk's own induction (potential-core deficit 2a(beta), as
+    M-1's), and its wake is shallower behind a yawed rotor than behind the un-yawed one, as the
+    momentum the disk removes says. FLORIS's gauss uses the same product, ct_i cos(yaw), in its
+    far-wake deficit. The un-yawed-basis C_T(beta) (0.7948 at 20 deg) would be the thrust of a
+    rotor facing the wind with the yawed disk's loading, deeper than the un-yawed wake.
     """
 
     k_star: float | None = number_field(None, *_POSITIVE, optional=True)
-    yawed_momentum_theory = False
     input_path = f"wake.wake_velocity_parameters.{GAUSSIAN_2014_NAME}"
+
+    def wake_thrust_coefficient(self, ct_i, yaw):
+        """Rotor-normal loading C_T cos^2(yaw), limited like M-1's (see the class docstring)."""
+        return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient) * np.cos(yaw) ** 2
 
     def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star
