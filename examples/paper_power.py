@@ -12,8 +12,9 @@ P/P0 = P(x_T, y_T) / P0 with P0 = 1/2 rho pi R^2 C_T' [U_h (1 - a)]^3 (Eq. P0_re
 FLORIS gives the downstream ``actuator-disk`` turbine, 1/2 rho pi R^2 C_T' [(1 - a) U_d]^3 with
 U_d its rotor average of u (Eqs. P_hyp, Ud), so P/P0 = (U_d/U_h)^3, Eq. (P_ratio). FLORIS runs
 all cases and yaws as conditions of one model (per-condition atmospheres) and the y_T of one x_T as
-rows of ``ROW_SIZE`` downstream turbines, which do not interact (no wake reaches a turbine in the
-same rotor plane; tests/test_examples.py checks a row against two-turbine farms). The rotor average is
+a few rows of downstream turbines at least ``ROW_SPACING`` apart, which do not interact (no wake
+reaches a turbine in the same rotor plane; tests/test_examples.py checks a row against two-turbine
+farms). The rotor average is
 FLORIS's, on the quadrature ``ROTOR_SOLVER``; it is checked against a direct disk integration of
 Eq. (P_ratio): a polar Gauss rule (16 x 48 points) over the disk of the flow FLORIS samples behind
 the upstream turbine alone.
@@ -57,8 +58,9 @@ from floris_ekman_veer.coupling.turbine import induction_factor  # noqa: E402
 ROTOR_SOLVER = {"type": "turbine_cubature_grid", "turbine_grid_points": 10}
 X_T_OVER_D = (4.0, 6.0, 8.0, 10.0)
 Y_T_OVER_D = np.linspace(-4.0, 4.0, 81)
-#: Downstream disks per FLORIS run (one row at one x_T; see the module docstring).
-ROW_SIZE = 9
+#: Least lateral distance [D] of two downstream disks in one FLORIS run (rotors must not
+#: intersect; a sparse row also keeps FLORIS's cost, quadratic in the turbine count, low).
+ROW_SPACING = 1.05
 #: Direct disk integration of Eq. P_ratio: Gauss-Legendre in r (weight r) x uniform in theta.
 DISK_RADIAL, DISK_ANGULAR = 16, 48
 
@@ -93,6 +95,19 @@ def reference_power(case: Case, air_density: float) -> float:
 
 
 # ----------------------------------------------------------------------------------- P/P0
+def separated_rows(y_t, spacing=ROW_SPACING) -> list[np.ndarray]:
+    """Indices of y_T (in D) split into rows whose neighbours are at least ``spacing`` apart."""
+    y_t = np.asarray(y_t, float)
+    rows: list[list[int]] = []
+    for k in np.argsort(y_t):
+        row = next((row for row in rows if y_t[k] - y_t[row[-1]] >= spacing), None)
+        if row is None:
+            rows.append([k])
+        else:
+            row.append(k)
+    return [np.array(row) for row in rows]
+
+
 def floris_power_ratios(cases: list[Case], name: str, betas=BETAS, x_t=X_T_OVER_D,
                         y_t=Y_T_OVER_D, solver=ROTOR_SOLVER) -> np.ndarray:
     """P/P0 from FLORIS's power of the downstream disk, shape (cases, betas, x_t, y_t)."""
@@ -102,9 +117,8 @@ def floris_power_ratios(cases: list[Case], name: str, betas=BETAS, x_t=X_T_OVER_
     p0 = np.repeat([reference_power(case, density) for case in cases], len(betas))
     y_t = np.asarray(y_t, float)
     ratios = np.empty((len(cases) * len(betas), len(x_t), y_t.size))
-    # FLORIS's cost grows with the square of the number of turbines: rows of ROW_SIZE
     for k, x in enumerate(x_t):
-        for row in np.array_split(np.arange(y_t.size), -(-y_t.size // ROW_SIZE)):
+        for row in separated_rows(y_t):
             yaw_angles = np.zeros((yaw.size, 1 + row.size))
             yaw_angles[:, 0] = yaw
             fmodel.set(layout_x=[0.0] + [x * D] * row.size, layout_y=[0.0] + list(y_t[row] * D),

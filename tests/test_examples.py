@@ -143,10 +143,14 @@ def test_floris_rotor_average_matches_the_disk_integral(power, cases):
 
 @pytest.mark.parametrize("name", ["M-1", "GCH", "cc"])
 def test_a_row_of_downstream_disks_equals_two_turbine_farms(cases, name):
-    """paper_power puts all y_T of one x_T in one row of turbines: none wakes another, so each
-    sees what it sees alone behind the yawed upstream turbine."""
+    """paper_power puts the y_T of one x_T in rows of turbines (rotors apart): none wakes another,
+    so each sees what it sees alone behind the yawed upstream turbine."""
     chosen = [cases["SBL-6"]]
-    y_t = np.array([-1.0, 0.0, 0.5])
+    y_t = np.array([-1.5, 0.0, 1.2])
+    assert len(paper_power.separated_rows(y_t)) == 1
+    rows = paper_power.separated_rows(np.linspace(-4.0, 4.0, 81))
+    assert sorted(np.concatenate(rows)) == list(range(81))
+    assert all(np.all(np.diff(row) * 0.1 >= paper_power.ROW_SPACING - 1e-9) for row in rows)
     row = paper_power.floris_power_ratios(chosen, name, betas=(20.0,), x_t=(6.0,), y_t=y_t)
     pairs = [paper_power.floris_power_ratios(chosen, name, betas=(20.0,), x_t=(6.0,), y_t=[y])
              for y in y_t]
