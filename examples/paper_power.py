@@ -2,8 +2,9 @@
 
     python examples/paper_power.py [--output DIR] [--gallery DIR]
 
-The paper's Section 4.4.2 (Narasimhan, Gayme & Meneveau, JRSE 2025): an un-yawed actuator disk
-(the same as the upstream one, C_T' = 1.33, D = z_h = 100 m) at x_T/D = 4, 6, 8, 10 and
+The power losses of the paper's Section 4.4 (Narasimhan, Gayme & Meneveau, JRSE 2025): an
+un-yawed actuator disk (the same as the upstream one, C_T' = 1.33, D = z_h = 100 m) at
+x_T/D = 4, 6, 8, 10 and
 y_T/D in [-4, 4] behind the paper's turbine yawed by beta = 0, +20, -20 deg, in CNBL, SBL-4,
 SBL-5 and SBL-6 (``inputs/cnbl.yaml``, ``sbl4.yaml``, ``sbl5.yaml``, ``sbl6.yaml``), for M-1, M-2,
 M-3 and FLORIS's GCH and cc on the same Ekman inflow (models as in ``examples/paper_cases.py``).
