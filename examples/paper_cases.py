@@ -376,7 +376,7 @@ def gallery_cross_planes_figure(case: Case, output: Path) -> Path:
 
     return contour_figure(
         (len(BETAS), len(CROSS_X_OVER_D)), (13, 5.6), panel, "y/D (looking downstream)", "z/D",
-        f"{case.name}: M-1 wake (Delta u/U_h) behind a disk yawed by beta; dashed: rotor",
+        rf"{case.name}: M-1 wake $\Delta u/U_h$ behind a disk yawed by $\beta$; dashed: rotor",
         output / f"{case.name.replace('-', '').lower()}_cross_planes.png", dpi=70,
     )
 
