@@ -13,7 +13,8 @@ It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 st
          FLORIS's inflow stays the Ekman U(z) (and ``wind_veer`` stays 0, see below).
 
 Every model gets the atmosphere's I_u(z_h) as turbulence intensity (the ekman_veer models take
-their wake expansion k_w from the ABL itself; gauss reads the TI). ``--gauss-wind-veer`` also
+their wake expansion k_w from the ABL itself, plus FLORIS's wake-added turbulence: the input's
+wake_expansion: local_turbulence; gauss reads the TI). ``--gauss-wind-veer`` also
 gives gauss the rotor-layer veer as FLORIS's ``wind_veer`` (as
 ``floris_ekman_veer.coupling.comparison.builtin_inflow_settings`` suggests). It is off by default:
 FLORIS's gauss narrows its initial width by cos(wind_veer) and tilts its ellipse, and with this

@@ -22,6 +22,7 @@ what establishes correctness.
 from __future__ import annotations
 
 import copy
+import math
 import warnings
 from pathlib import Path
 
@@ -796,6 +797,9 @@ def farm(layout, wind_directions=WIND_DIRECTIONS, wind_speeds=WIND_SPEEDS, yaw=N
                  wind_speeds=list(wind_speeds),
                  turbulence_intensities=[0.06] * len(wind_speeds))
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = list(layout[0]), list(layout[1])
+    # The baselines pin the paper's k_w (the farm input takes local_turbulence, pinned by
+    # test_local_turbulence_adds_only_the_wake_added_turbulence).
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_expansion"] = "ambient"
     fmodel = FlorisModel(cfg)
     if yaw is not None:
         fmodel.set(yaw_angles=np.tile(yaw, (len(wind_speeds), 1)))
@@ -966,6 +970,37 @@ def test_hub_above_the_boundary_layer_takes_the_floor_expansion():
     fmodel.run()
     powers = fmodel.get_turbine_powers()
     assert np.all(np.isfinite(powers)) and powers[0, 1] < powers[0, 0]
-    k_w = fmodel.core.wake.velocity_model.expansion_rate(abl, HUB_5MW, abl.speed(HUB_5MW), 0.06)
+    k_w = fmodel.core.wake.velocity_model.expansion_rate(abl, HUB_5MW, abl.speed(HUB_5MW), 0.06,
+                                                         0.06)
     assert float(k_w) == pytest.approx(0.021, rel=1e-15)
 
+
+
+def test_local_turbulence_adds_only_the_wake_added_turbulence():
+    """wake_expansion: local_turbulence (docs/coupling.md#wake-expansion-in-farms):
+    I^2 = I_u(z_h)^2 + (TI^2 - TI_0^2), FLORIS's wake-added part on top of the ABL's I_u."""
+    cfg = config("farm_sbl6", atmosphere={"stability_parameter": 0.0}, wind_speeds=[8.0],
+                 turbulence_intensities=[0.06])
+    cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 882.0, 1764.0], [0.0] * 3
+    abl = atmosphere_of(cfg)
+    speed = abl.speed(HUB_5MW)
+    model = FlorisModel(cfg).core.wake.velocity_model
+    assert model.wake_expansion == "local_turbulence"  # what the farm input uses
+    ambient = float(abl.wake_expansion_rate(HUB_5MW))
+    i_u = float(abl.turbulence_intensity(HUB_5MW, reference_height=HUB_5MW))
+    for floris_ti in (0.03, 0.06, 0.11):  # unwaked: the paper's k_w, whatever FLORIS's TI
+        assert float(model.expansion_rate(abl, HUB_5MW, speed, floris_ti, floris_ti)) == ambient
+    added = 0.08  # waked: sqrt(TI_0^2 + 0.08^2) at the turbine
+    expected = (0.021**6 + (0.33 * math.hypot(i_u, added)) ** 6) ** (1 / 6)
+    for floris_ti in (0.03, 0.11):
+        local = model.expansion_rate(abl, HUB_5MW, speed, math.hypot(floris_ti, added), floris_ti)
+        assert float(local) == pytest.approx(expected, rel=1e-12)
+    # Through FLORIS: the front turbine is unchanged, the waked ones recover faster.
+    powers = {}
+    for mode in ("ambient", "local_turbulence"):
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_expansion"] = mode
+        fmodel = FlorisModel(cfg)
+        fmodel.run()
+        powers[mode] = fmodel.get_turbine_powers()[0]
+    assert powers["local_turbulence"][0] == powers["ambient"][0]
+    assert np.all(powers["local_turbulence"][2:] > 1.05 * powers["ambient"][2:])

@@ -6,8 +6,8 @@ reference wind, :func:`builtin_inflow_settings` gives each of them the best info
 
 ``turbulence_intensities``
     I_u(z_h) of the atmosphere (Townsend-Perry, paper Eq. Iu_model, normalised by the hub-height
-    speed): every built-in model reads the ambient TI (wake expansion, added turbulence). Zero for a
-    hub at or above the ABL top (no boundary-layer turbulence there).
+    speed): every built-in model reads the ambient TI (wake expansion, added turbulence). Above h
+    the variance law is continued to its zero at h exp(B1/A1) (docs/atmosphere.md#shallow-boundary-layer).
 ``wind_veer``
     The direction change across the rotor layer, ``EkmanABL.wind_direction_change(z_h - R,
     z_h + R)`` [deg], positive = veering (clockwise with height, the northern-hemisphere sense).

@@ -52,6 +52,7 @@ from floris_ekman_veer.atmosphere.turbulence import (
     MIXING_LAYER_FLOOR,
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
+    streamwise_turbulence_intensity,
     wake_expansion_rate,
 )
 from floris_ekman_veer.coupling.inflow import solved_atmosphere
@@ -144,6 +145,7 @@ class Ambient:
     turbine_x: np.ndarray  # rotated turbine positions, (n_findex, n_turbines)
     turbine_y: np.ndarray
     turbine_hub_heights: np.ndarray  # (n_turbines,)
+    floris_turbulence: np.ndarray  # FLORIS's ambient turbulence intensity, (n_findex, 1, 1, 1)
 
     @classmethod
     def of(cls, grid: Grid, flow_field: FlowField) -> Ambient:
@@ -162,6 +164,7 @@ class Ambient:
             *(np.broadcast_to(a, (n_findex, 1, 1, hub_heights.size)).reshape(shape)
               for a in (speed, u_hub / speed, v_hub / speed)),
             x, y, coordinates[:, 2],
+            np.asarray(flow_field.turbulence_intensities, dtype=float).reshape(-1, 1, 1, 1),
         )
 
     def hub_height_at(self, x_i, y_i):
@@ -212,8 +215,8 @@ class _EkmanWakeModel(BaseModel):
     k_w_floor: float = number_field(MIXING_LAYER_FLOOR, *_POSITIVE)
     k_w_exponent: float = number_field(MERGE_EXPONENT, *_MERGE_EXPONENT_RANGE)
     #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
-    #: "local_turbulence": alpha' times FLORIS's turbulence intensity at the turbine (ambient
-    #: plus wake-added, from FLORIS's turbulence model) in the same smooth maximum, for farms.
+    #: "local_turbulence": the same with FLORIS's wake-added turbulence at the turbine (from its
+    #: turbulence model) added in quadrature to I_u(z_h), for farms (see expansion_rate).
     wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
@@ -224,15 +227,30 @@ class _EkmanWakeModel(BaseModel):
     input_path = f"wake.wake_velocity_parameters.{VELOCITY_MODEL_NAME}"
     from_dict = classmethod(_from_input_block)
 
-    def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity):
-        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant."""
+    def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity,
+                       floris_turbulence):
+        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant.
+
+        ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
+        waked, with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
+        ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
+        so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
+        (docs/coupling.md#wake-expansion-in-farms).
+        """
         if self.wake_expansion == "ambient":
             return wake_expansion_rate(
                 abl.friction_velocity, abl.boundary_layer_height, hub_height, hub_speed,
                 A1=self.A1, B1=self.B1, alpha_prime=self.alpha_prime, floor=self.k_w_floor,
                 n=self.k_w_exponent,
             )
-        turbulent = self.alpha_prime * np.asarray(turbulence_intensity, dtype=float)
+        ambient = streamwise_turbulence_intensity(
+            hub_height, abl.friction_velocity, abl.boundary_layer_height, hub_speed, self.A1,
+            self.B1,
+        )
+        added_squared = np.maximum(
+            np.asarray(turbulence_intensity, dtype=float) ** 2 - floris_turbulence**2, 0.0
+        )
+        turbulent = self.alpha_prime * np.sqrt(ambient**2 + added_squared)
         return (self.k_w_floor**self.k_w_exponent + turbulent**self.k_w_exponent) ** (
             1.0 / self.k_w_exponent
         )
@@ -278,7 +296,8 @@ class _EkmanWakeModel(BaseModel):
             ct=self.wake_thrust_coefficient(ct_i, yaw),
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
-            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i),
+            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i,
+                                    ambient.floris_turbulence),
             local_u=local_u,
             local_v=local_v,
         )
