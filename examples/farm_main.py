@@ -53,6 +53,7 @@ from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
+from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 
@@ -288,8 +289,7 @@ def cross_plane_figure(farm: Farm, output: Path, speed: float) -> Path:
                             max_speed=speed_levels[-1], clevels=speed_levels,
                             levels=speed_levels[::2], title=LABELS[name])
         # Deficit: the ambient hub-aligned U(z) of the Ekman inflow minus the waked u.
-        ambient, _ = abl.hub_aligned_velocity(plane.df.x2.to_numpy()[None, :],
-                                              farm.reference_height, below_roughness="zero")
+        ambient, _ = ambient_velocity(abl, plane.df.x2.to_numpy()[None, :], farm.reference_height)
         deficit = copy.deepcopy(plane)
         values = (ambient[0] - plane.df.u.to_numpy()) / u_hub
         deficit.df["u"] = np.where(np.abs(values) < 1e-9, 0.0, values)  # round-off: -1e-16

@@ -62,6 +62,7 @@ from floris.flow_visualization import visualize_cut_plane  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
+from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
 from floris_ekman_veer.wake.deficit import max_deficit, potential_core_length  # noqa: E402
 
 INPUTS = REPOSITORY / "inputs"
@@ -169,8 +170,7 @@ class Case:
 
     def ambient(self, z) -> np.ndarray:
         """Hub-aligned ambient U(z) (FLORIS's inflow: the reference height is the hub height)."""
-        u, _ = self.abl.hub_aligned_velocity(np.asarray(z, float), self.reference_height,
-                                             below_roughness="zero")
+        u, _ = ambient_velocity(self.abl, np.asarray(z, float), self.reference_height)
         return u
 
     def thrust_coefficient(self, beta: float) -> float:

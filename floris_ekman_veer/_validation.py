@@ -148,3 +148,50 @@ def choice_field(default: str, options):
     return attrs.field(default=default, converter=attrs.Converter(
         convert, takes_self=True, takes_field=True
     ))
+
+
+# ------------------------------------------------------------------ real-valued arrays (physics)
+# The physics classes take numbers or arrays of them (one entry per condition); a string or a
+# boolean is refused there too, where numpy would silently read "10" as 10.0 and True as 1.0.
+
+
+def _is_real(value) -> bool:
+    """True for a real number, or a (nested) sequence or numeric array of real numbers; False
+    for strings, booleans, None and anything else numpy would silently coerce to float."""
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "iuf":
+            return True
+        return value.dtype.kind == "O" and all(_is_real(v) for v in value.ravel())
+    if isinstance(value, (list, tuple)):
+        return all(_is_real(v) for v in value)
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def real_array(name: str, value, valid: str = "finite") -> np.ndarray:
+    """``value`` as a float array, required real numbers (a number, a list or a numeric array):
+    a string such as ``"10"``, a boolean or None raises instead of being coerced. ``valid``
+    describes the valid range for the message."""
+    if not _is_real(value):
+        raise ValueError(
+            f"{name} must be a real number or an array of real numbers ({valid}); got "
+            f"{_describe(value)}"
+        )
+    return np.asarray(value, dtype=float)
+
+
+def require_at(ok, name: str, valid: str, value) -> None:
+    """:func:`require` for a scalar input, :func:`require_each` for an array one (entries named
+    by their condition index: the first axis is the condition)."""
+    ndim = np.ndim(ok)
+    if ndim == 0:
+        require(ok, name, valid, value)
+    else:
+        labels = ("condition",) + tuple(f"axis-{k} index" for k in range(1, ndim))
+        require_each(ok, name, valid, value, labels)
+
+
+def finite_real(name: str, value, valid: str = "finite") -> np.ndarray:
+    """``value`` as a float array of real numbers (see :func:`real_array`), required finite."""
+    array = real_array(name, value, valid)
+    require_at(np.isfinite(array), name, valid, array)
+    return array

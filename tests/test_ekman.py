@@ -161,11 +161,12 @@ def test_du_dz_jumps_at_matching_height(abl):
 
 
 def test_v_zero_at_ground(abl):
-    """V(0) = 0 exactly (with below_roughness='zero' the code returns 0 below z0), and the
-    formula itself tends to 0 at the ground with no V_g offset left over."""
-    assert abl.velocity(0.0, below_roughness="zero")[1] == 0.0
+    """U = V = 0 exactly at the ground, and the printed V formula itself tends to 0 at the
+    ground with no V_g offset left over (evaluated above the sublayer of a tiny z0)."""
+    u0, v0 = abl.velocity(0.0)
+    assert u0 == 0.0 and v0 == 0.0
     tiny = EkmanABL(**{**STATES["CNBL"], "roughness_length": 1e-12})
-    v = tiny.velocity(np.array([1e-12, 1e-10]))[1]
+    v = tiny.velocity(np.array([1e-11, 1e-10]))[1]
     assert np.all(np.abs(v) < 1e-9)
     assert abs(v[1]) > abs(v[0])  # V ~ z near the ground, not round-off of V_g
 
@@ -206,15 +207,80 @@ def test_profile_matches_printed_equations_inside_abl(abl):
         assert v == pytest.approx(hand_v(z, abl), rel=1e-9, abs=1e-12)
 
 
-def test_below_roughness(abl):
-    z0 = float(abl.roughness_length)
-    assert float(abl.velocity(z0)[0]) == 0.0  # ln(1) = 0 and z - z0 = 0
-    u, v = abl.velocity(np.array([0.0, 0.5 * z0]), below_roughness="zero")
-    assert np.all(u == 0.0) and np.all(v == 0.0)
-    with pytest.raises(ValueError, match="heights z must be >= roughness_length z0"):
-        abl.velocity(np.array([0.5 * z0, 10.0]))
-    with pytest.raises(ValueError, match="below_roughness must be 'raise' or 'zero'"):
-        abl.velocity(10.0, below_roughness="clip")
+def hand_sublayer_height(a):
+    """z_s = z0 exp(1 + kappa (5 mu + 0.3 mu_N) z0 f/u*): where the tangent of the surface-layer
+    law passes through the ground, (u*/kappa) ln(z/z0) + m u* (xi - xi0) = z dU/dz."""
+    u, f, z0, mu, mu_n, _ = hand_state(a)
+    return z0 * math.exp(1 + KAPPA * (5 * mu + 0.3 * mu_n) * z0 * f / u)
+
+
+def test_roughness_sublayer(abl):
+    """docs/atmosphere.md#roughness-sublayer: below z_s the wind is (z/z_s) (U, V)(z_s), the log
+    law's tangent through the ground; U and dU/dz continuous at z_s, U > 0 for z > 0."""
+    z_s = hand_sublayer_height(abl)
+    assert float(abl.roughness_sublayer_height) == pytest.approx(z_s, rel=1e-12)
+    assert 2.718 * float(abl.roughness_length) < z_s < 0.2 * float(abl.boundary_layer_height)
+    u_s, v_s = hand_u_surface(z_s, abl), hand_v(z_s, abl)
+    for fraction in (0.0, 1e-6, 0.3, 0.999999):
+        u, v = (float(c) for c in abl.velocity(fraction * z_s))
+        assert u == pytest.approx(fraction * u_s, rel=1e-12, abs=1e-300)
+        assert v == pytest.approx(fraction * v_s, rel=1e-9, abs=1e-300)
+    # continuity of U and of its slope at z_s (the tangent property), hand slope of the log law
+    u_star, f, _, mu, mu_n, _ = hand_state(abl)
+    hand_slope = u_star / (KAPPA * z_s) + (5 * mu + 0.3 * mu_n) * f
+    assert u_s / z_s == pytest.approx(hand_slope, rel=1e-12)
+    dz = 1e-7 * z_s
+    u_lo, u_hi = abl.velocity(np.array([z_s - dz, z_s + dz]))[0]
+    assert (u_hi - u_lo) / (2 * dz) == pytest.approx(hand_slope, rel=1e-5)
+    # above z_s the printed law, at z0 no longer zero
+    z = 1.5 * z_s
+    assert float(abl.velocity(z)[0]) == pytest.approx(hand_u_surface(z, abl), rel=1e-12)
+    z = np.geomspace(1e-6, 50.0, 400) * float(abl.roughness_length)
+    u, _ = abl.velocity(z)
+    assert np.all(u > 0) and np.all(np.diff(u) > 0)
+
+
+def test_sublayer_capped_at_matching_height():
+    """A boundary layer so shallow that e z0 reaches its matching height 0.2 h: the sublayer ends
+    there (U continuous, its slope not)."""
+    a = EkmanABL.from_reference_wind(
+        3.4, 135.8, latitude=-38.0, roughness_length=0.003, brunt_vaisala_frequency=0.0137,
+        surface_heat_flux=-0.0061,
+    )
+    z_m = 0.2 * float(a.boundary_layer_height)
+    assert hand_sublayer_height(a) > z_m
+    assert float(a.roughness_sublayer_height) == pytest.approx(z_m, rel=1e-14)
+    u_m = float(a.velocity(z_m)[0])
+    assert u_m == pytest.approx(hand_u_surface(z_m, a), rel=1e-12)
+    assert float(a.velocity(0.5 * z_m)[0]) == pytest.approx(0.5 * u_m, rel=1e-12)
+
+
+@pytest.mark.parametrize("method", ["velocity", "speed", "wind_angle"])
+def test_heights_must_be_finite_and_above_ground(abl, method):
+    call = getattr(abl, method)
+    for bad in (np.nan, -1.0, [10.0, np.nan], "10", True):
+        with pytest.raises(ValueError, match=r"^z must be"):
+            call(bad)
+
+
+def test_nan_heights_raise_in_every_profile_method(abl):
+    """NaN never comes out (and V(NaN) is not a finite number): each method names its input."""
+    calls = {
+        "z": lambda x: abl.hub_aligned_velocity(x, 90.0),
+        "reference_height": lambda x: abl.hub_aligned_velocity(50.0, x),
+        "z1": lambda x: abl.wind_direction_change(x, 90.0),
+        "z2": lambda x: abl.wind_direction_change(50.0, x),
+        "hub_height": lambda x: abl.wake_expansion_rate(x),
+    }
+    for name, call in calls.items():
+        with pytest.raises(ValueError, match=rf"^{name} must be .*got nan"):
+            call(np.array([50.0, np.nan]))
+    with pytest.raises(ValueError, match=r"^z must be >= roughness_length"):
+        abl.turbulence_intensity(np.nan)
+    with pytest.raises(ValueError, match=r"^reference_height must be >= roughness_length"):
+        abl.turbulence_intensity(50.0, reference_height=np.nan)
+    with pytest.raises(ValueError, match=r"^z must be >= roughness_length"):
+        abl.turbulence_intensity(0.5 * float(abl.roughness_length))
 
 
 # ------------------------------------------------------------------------- the GDL and the solve
@@ -584,13 +650,15 @@ BASE = dict(geostrophic_wind=10.0, latitude=45.0, roughness_length=0.1)
     (dict(roughness_length=-0.1), r"roughness_length must be > 0 m"),
     (dict(geostrophic_wind=0.0), r"geostrophic_wind must be > 0 m/s"),
     (dict(geostrophic_wind=-5.0), r"geostrophic_wind must be > 0 m/s"),
-    (dict(geostrophic_wind=np.nan), r"geostrophic_wind must be finite"),
-    (dict(geostrophic_wind=np.inf), r"geostrophic_wind must be finite"),
+    (dict(geostrophic_wind=np.nan), r"geostrophic_wind must be > 0 m/s; got nan"),
+    (dict(geostrophic_wind=np.inf), r"geostrophic_wind must be > 0 m/s; got inf"),
     (dict(latitude=None, coriolis_parameter=0.0),
-     r"coriolis_parameter must be \|f_c\| >= .*1/s \(\|latitude\| >= 1 deg"),
-    (dict(latitude=0.5), r"latitude must be 1 <= \|latitude\| <= 90 degrees"),
-    (dict(latitude=-0.5), r"latitude must be 1 <= \|latitude\| <= 90 degrees"),
-    (dict(latitude=95.0), r"latitude must be 1 <= \|latitude\| <= 90 degrees"),
+     r"coriolis_parameter must be .* <= \|f_c\| <= 2 Omega = 0.0001454 1/s \(\|latitude\| 1 to 90"),
+    (dict(latitude=None, coriolis_parameter=0.01),
+     r"coriolis_parameter must be .* <= \|f_c\| <= 2 Omega.*; got 0.01"),
+    (dict(latitude=0.5), r"latitude must be 1 <= \|latitude\| <= 90 deg"),
+    (dict(latitude=-0.5), r"latitude must be 1 <= \|latitude\| <= 90 deg"),
+    (dict(latitude=95.0), r"latitude must be 1 <= \|latitude\| <= 90 deg"),
     (dict(coriolis_parameter=1e-4),
      r"give exactly one of coriolis_parameter \[1/s\] or latitude \[deg\]"),
     (dict(latitude=None), r"give exactly one of coriolis_parameter \[1/s\] or latitude \[deg\]"),
@@ -610,7 +678,7 @@ BASE = dict(geostrophic_wind=10.0, latitude=45.0, roughness_length=0.1)
      r"give at most one of brunt_vaisala_frequency \[1/s\] or lapse_rate \[K/m\]"),
     (dict(brunt_vaisala_frequency=-0.01), r"brunt_vaisala_frequency must be >= 0 1/s"),
     (dict(lapse_rate=-0.001), r"lapse_rate must be >= 0 K/m"),
-    (dict(c_g=0.0), r"c_g must be a positive finite number"),
+    (dict(c_g=0.0), r"c_g must be > 0 and finite \(a model constant\); got 0"),
     (dict(matching_fraction=1.2), r"matching_fraction must be in \(0, 1\)"),
 ])
 def test_bad_input_raises(changes, pattern):
@@ -620,7 +688,7 @@ def test_bad_input_raises(changes, pattern):
 
 
 def test_bad_input_in_arrays_names_offending_values():
-    with pytest.raises(ValueError, match=r"roughness_length must be > 0 m; got -1, 0"):
+    with pytest.raises(ValueError, match=r"roughness_length must be > 0 m; got -1 at condition 1, 0 at condition 3"):
         EkmanABL(**{**BASE, "roughness_length": np.array([0.1, -1.0, 0.2, 0.0])})
 
 
@@ -635,8 +703,8 @@ def test_hub_at_or_above_h_is_continuous_down_to_the_floor():
 
 
 @pytest.mark.parametrize("speed, height, pattern", [
-    (8.0, 0.1, r"height must be above roughness_length"),
-    (8.0, 0.05, r"height must be above roughness_length"),
+    (8.0, 0.1, r"height must be > roughness_length z0; got 0.1"),
+    (8.0, 0.05, r"height must be > roughness_length z0; got 0.05"),
     (0.0, 100.0, r"speed must be > 0 m/s"),
     (-3.0, 100.0, r"speed must be > 0 m/s"),
 ])

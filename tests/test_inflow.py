@@ -36,7 +36,7 @@ def expected_profile(fmodel, z):
         flow_field.wind_speeds[:, None, None, None], flow_field.reference_wind_height,
         **STABLE_ATMOSPHERE,
     )
-    U, _ = abl.hub_aligned_velocity(z, flow_field.reference_wind_height, below_roughness="zero")
+    U, _ = inflow.ambient_velocity(abl, z, flow_field.reference_wind_height)
     return U
 
 
@@ -100,18 +100,58 @@ def test_v_and_w_initial_stay_zero():
 
 
 @pytest.mark.filterwarnings("ignore:invalid value encountered in divide:RuntimeWarning")  # FLORIS's
-# gauss divides by u_initial, which is 0 below z0 (as FLORIS's power law is at z = 0)
-def test_points_use_profile_and_zero_below_roughness():
+# gauss divides by u_initial, which is 0 at and below the ground (as FLORIS's power law is at z = 0)
+def test_points_use_profile_with_roughness_sublayer():
+    """Below the ground U = 0; in the roughness sublayer (z < z_s ~ e z0) U is linear in z,
+    positive, docs/atmosphere.md#roughness-sublayer; above it the profile."""
     fmodel = ekman_model()
     z = np.array([-1.0, 0.0, 0.05, 0.1, 1.0, 40.0, 90.0, 300.0])
     x = np.full_like(z, -2000.0)  # far upstream: free stream only
     u = fmodel.sample_flow_at_points(x, np.zeros_like(z), z)
     np.testing.assert_allclose(u, expected_profile(fmodel, z)[:, 0, 0, :], rtol=0, atol=1e-12)
-    assert not u[:, :3].any()  # below z0 = 0.1 m
+    assert not u[:, :2].any() and np.all(u[:, 2:] > 0)
+    abl = inflow.solved_atmosphere(fmodel.core.flow_field)
+    z_s = abl.roughness_sublayer_height[:, 0, 0, 0]
+    assert np.all((z_s > 0.1) & (z_s < 0.3))  # about e z0, z0 = 0.1 m
+    u_s = inflow.ambient_velocity(abl, z_s[:, None, None, None], 90.0)[0][:, 0, 0, 0]
+    np.testing.assert_allclose(u[:, 2:4], u_s[:, None] * z[2:4] / z_s[:, None], rtol=1e-12)
 
 
-@pytest.mark.filterwarnings("ignore:invalid value encountered in divide:RuntimeWarning")  # FLORIS's
-# gauss divides by u_initial, which is 0 below z0 (as FLORIS's power law is at z = 0)
+# FLORIS's horizontal-plane grid carries helper points on or below the ground, which the plane
+# discards; its gauss divides by the inflow there (plain FLORIS: a NaN power law; here 0).
+@pytest.mark.filterwarnings("ignore:invalid value encountered in divide:RuntimeWarning")
+@pytest.mark.parametrize("wake", list(EXAMPLE_WAKES))
+def test_no_nan_near_the_ground_in_any_floris_model(wake):
+    """The inflow brings no NaN into any FLORIS model: cross, y and horizontal planes down to 1 mm
+    and points just above the ground and inside the roughness, behind a yawed turbine (FLORIS has
+    no planes or points for the legacy turbopark: its run only). Upstream of the farm u is the inflow, > 0 down to 1 mm; in the wake
+    FLORIS's cc, whose deficit scales with the hub speed, may go below 0 near the ground, where
+    the log-law inflow is far weaker than a power law's."""
+    atmosphere = dict(STABLE_ATMOSPHERE, roughness_length=0.5, cooling_rate=-0.5)
+    fmodel = ekman_model(wake, atmosphere=atmosphere, layout_x=(0.0, 630.0),
+                         layout_y=(0.0, 40.0), wind_speeds=(8.0,))
+    fmodel.set(yaw_angles=[[20.0, 0.0]])
+    if wake != "turbopark":
+        planes = [
+            fmodel.calculate_cross_plane(downstream_dist=300.0, y_resolution=9, z_resolution=9,
+                                         y_bounds=(-150.0, 150.0), z_bounds=(0.001, 200.0)),
+            fmodel.calculate_y_plane(x_resolution=9, z_resolution=9, crossstream_dist=0.0,
+                                     x_bounds=(-200.0, 1200.0), z_bounds=(0.001, 200.0)),
+            fmodel.calculate_horizontal_plane(height=0.3, x_resolution=9, y_resolution=5,
+                                              x_bounds=(-200.0, 1200.0), y_bounds=(-100.0, 100.0)),
+        ]
+        for plane in planes:
+            assert np.all(np.isfinite(plane.df.u.to_numpy()))
+        upstream = planes[1].df[planes[1].df.x1 < -100.0]
+        assert len(upstream) and np.all(upstream.u > 0)
+    z = np.array([0.001, 0.01, 0.3, 0.6, 2.0, 90.0])
+    for x in (-300.0, 300.0) if wake != "turbopark" else ():
+        u = fmodel.sample_flow_at_points(np.full_like(z, x), np.zeros_like(z), z)
+        assert np.all(np.isfinite(u)) and (x > 0 or np.all(u > 0))
+    fmodel.run()
+    assert np.all(np.isfinite(fmodel.get_turbine_powers()))
+
+
 def test_vertical_plane_uses_profile():
     fmodel = ekman_model(wind_speeds=(8.0,))
     plane = fmodel.calculate_y_plane(x_resolution=5, z_resolution=30, crossstream_dist=0.0,
@@ -407,10 +447,10 @@ def test_worker_dict_prepares_the_unpickling_process(monkeypatch):
         ({"obukhov_length": 100.0}, "contradictory keys.*cooling_rate.*obukhov_length"),
         ({"lapse_rate": 0.003}, "contradictory keys.*brunt_vaisala_frequency.*lapse_rate"),
         ({"geostrophic_wind": 12.0}, "geostrophic_wind is not allowed"),
-        ({"roughness_length": "rough"}, "roughness_length must be a number"),
-        ({"cooling_rate": [[-0.1, -0.2]]}, "cooling_rate must be a finite number or a 1-D list"),
-        ({"cooling_rate": float("nan")}, "cooling_rate must be a finite"),
-        ({"cooling_rate": 1.0}, "ekman_veer.atmosphere: .*cooling_rate"),  # heating: EkmanABL
+        ({"roughness_length": "rough"}, "atmosphere.roughness_length must be a real number"),
+        ({"cooling_rate": [[-0.1, -0.2]]}, "atmosphere.cooling_rate must be a number or a 1-D list"),
+        ({"cooling_rate": float("nan")}, r"atmosphere.cooling_rate must be <= 0 K/h and finite.*got nan"),
+        ({"cooling_rate": 1.0}, r"ekman_veer.atmosphere.cooling_rate must be <= 0 K/h.*got 1"),  # heating
         ({"roughness_length": None}, "missing required key.*roughness_length"),
     ],
 )
@@ -469,8 +509,7 @@ def test_ambient_v_would_change_gch(monkeypatch):
     def with_ambient_v(self, grid):
         hooked(self, grid)
         abl = inflow.solved_atmosphere(self)
-        _, V = abl.hub_aligned_velocity(grid.z_sorted, self.reference_wind_height,
-                                        below_roughness="zero")
+        _, V = inflow.ambient_velocity(abl, grid.z_sorted, self.reference_wind_height)
         self.v_initial_sorted = np.broadcast_to(V, self.u_initial_sorted.shape).copy()
         self.v_sorted = self.v_initial_sorted.copy()
 

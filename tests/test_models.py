@@ -34,6 +34,7 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.coupling.inflow import ambient_velocity
 from floris_ekman_veer.coupling.models import (
     EkmanVeerVelocityDeficit,
     EkmanVeerVelocityDeflection,
@@ -238,7 +239,7 @@ def test_planes_are_finite_down_to_the_ground_and_match_points(case):
     fmodel.set(layout_x=[0.0, 500.0], layout_y=[0.0, 30.0], yaw_angles=[[20.0, -10.0]])
 
     def inflow(z):
-        return abl.hub_aligned_velocity(z, HUB, below_roughness="zero")[0]
+        return ambient_velocity(abl, z, HUB)[0]
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)  # no divide-by-zero or invalid values

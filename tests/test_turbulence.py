@@ -106,7 +106,7 @@ def test_ekman_turbulence_intensity_normalisation():
         assert hub[k] == pytest.approx(variance / u_h, rel=1e-13)
     assert local[2] == pytest.approx(hub[2], rel=1e-15)
     assert float(a.turbulence_intensity(1.7 * h)) == 0.0  # above h exp(B1/A1) = 1.62 h
-    with pytest.raises(ValueError, match="heights z must be >= roughness_length z0"):
+    with pytest.raises(ValueError, match="z must be >= roughness_length z0"):
         a.turbulence_intensity(0.05)
 
 

@@ -23,9 +23,8 @@ fixed-point steps then bracketed secant steps on the physical branch U_g > 0.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import elementwise
 
-from floris_ekman_veer._validation import finite, require
+from floris_ekman_veer._validation import finite_real, real_array, require_at
 from floris_ekman_veer.atmosphere.turbulence import (
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
@@ -39,23 +38,63 @@ GRAVITY = 9.81
 EARTH_ROTATION_RATE = 7.27e-5
 #: Below this |latitude| the f-plane Ekman balance degenerates (f_c -> 0 at the equator).
 MIN_ABS_LATITUDE = 1.0
+#: Valid range of |f_c| [1/s]: 2 Omega sin(1 deg) (the equatorial limit above) to 2 Omega (a pole).
+MIN_CORIOLIS_PARAMETER = 2.0 * EARTH_ROTATION_RATE * np.sin(np.deg2rad(MIN_ABS_LATITUDE))
+MAX_CORIOLIS_PARAMETER = 2.0 * EARTH_ROTATION_RATE
 #: Paper's free-atmosphere Brunt-Vaisala frequency N_inf [1/s] (Table 1 caption).
 PAPER_BRUNT_VAISALA_FREQUENCY = 6.1e-3
 #: Paper's reference potential temperature Theta_0 [K] (Table 1 caption).
 PAPER_POTENTIAL_TEMPERATURE = 265.0
 
+_STABLE_ONLY = "unstable (convective) conditions are not covered by this model"
+#: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#valid-input-ranges
+#: state it. Every input is a real number or an array of them (strings and booleans are refused).
+VALID_RANGES = {
+    "geostrophic_wind": "> 0 m/s",
+    "coriolis_parameter": (
+        f"{MIN_CORIOLIS_PARAMETER:.4g} <= |f_c| <= 2 Omega = {MAX_CORIOLIS_PARAMETER:.4g} 1/s "
+        "(|latitude| 1 to 90 deg, negative in the south; the Ekman balance has no solution at "
+        "the equator, f_c = 0)"
+    ),
+    "latitude": (
+        f"{MIN_ABS_LATITUDE:g} <= |latitude| <= 90 deg, negative in the south (the Ekman model "
+        "has no solution at the equator, where f_c = 0)"
+    ),
+    "roughness_length": "> 0 m",
+    "reference_potential_temperature": "> 0 K",
+    "brunt_vaisala_frequency": ">= 0 1/s",
+    "lapse_rate": ">= 0 K/m (a neutral or stably stratified free atmosphere)",
+    "stability_parameter": f">= 0 and finite ({_STABLE_ONLY})",
+    "cooling_rate": f"<= 0 K/h and finite, surface cooling ({_STABLE_ONLY})",
+    "surface_heat_flux": f"<= 0 K m/s and finite, downward heat flux ({_STABLE_ONLY})",
+    "obukhov_length": f"> 0 m, stable; inf for neutral ({_STABLE_ONLY})",
+    **{name: "> 0 and finite (a model constant)"
+       for name in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns")},
+    "matching_fraction": "in (0, 1)",
+}
+
 _STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
 _SOLVER_TOLERANCE = 1e-14
 _SOLVER_MAX_ITERATIONS = 200
 
+# Marks a construction that only validates the inputs (EkmanABL.check_inputs).
+_INPUTS_ONLY = object()
+
+
+def _checked(name, value, ok, valid=None):
+    """``value`` as a float array of real numbers with ``ok`` true everywhere (finite implied),
+    else ValueError naming ``name``, its valid range (default its VALID_RANGES entry) and the
+    offending entries."""
+    valid = VALID_RANGES[name] if valid is None else valid
+    array = finite_real(name, value, valid)
+    require_at(ok(array), name, valid, array)
+    return array
+
 
 def coriolis_parameter_from_latitude(latitude):
     """f_c = 2 Omega sin(phi) [1/s]; latitude in degrees, negative in the south."""
-    latitude = finite("latitude", latitude)
-    require(
-        (np.abs(latitude) >= MIN_ABS_LATITUDE) & (np.abs(latitude) <= 90.0),
-        "latitude", "1 <= |latitude| <= 90 degrees (the Ekman model has no solution at the "
-        "equator, where f_c = 0)", latitude,
+    latitude = _checked(
+        "latitude", latitude, lambda lat: (np.abs(lat) >= MIN_ABS_LATITUDE) & (np.abs(lat) <= 90.0)
     )
     return 2.0 * EARTH_ROTATION_RATE * np.sin(np.deg2rad(latitude))
 
@@ -145,19 +184,6 @@ def secant_root(residual, lo, hi, tolerance=_SOLVER_TOLERANCE):
     return x, bracketed & (np.abs(r) <= tolerance)
 
 
-def chandrupatla_root(residual, lo, hi, args, tolerance):
-    """Element-wise roots of an increasing residual that may kink: SciPy's vectorised
-    bracket search from [lo, hi], then Chandrupatla's method; ``residual(x, *args)`` is
-    called on the unconverged elements only. Returns (x, converged)."""
-    bracket = elementwise.bracket_root(residual, lo, hi, args=args)
-    xl, xr = bracket.bracket
-    found = elementwise.find_root(
-        residual, (np.where(bracket.success, xl, lo), np.where(bracket.success, xr, hi)),
-        args=args, tolerances=dict(xatol=0.0, xrtol=4 * np.finfo(float).eps, fatol=tolerance),
-    )
-    return found.x, bracket.success & found.success
-
-
 class EkmanABL:
     """Coupled Ekman-surface-layer atmospheric boundary layer, solved for given G.
 
@@ -209,34 +235,44 @@ class EkmanABL:
         matching_fraction=0.2,
     ):
         self._set_constants(von_karman, c_g, stress_decay, c_tn, c_cn, c_ns, matching_fraction)
-
-        g_wind = finite("geostrophic_wind", geostrophic_wind)
-        require(g_wind > 0, "geostrophic_wind", "> 0 m/s", g_wind)
-        self.geostrophic_wind = g_wind
         self._set_coriolis(coriolis_parameter, latitude)
-
-        z0 = finite("roughness_length", roughness_length)
-        require(z0 > 0, "roughness_length", "> 0 m", z0)
-        self.roughness_length = z0
-
-        theta0 = finite("reference_potential_temperature", reference_potential_temperature)
-        require(theta0 > 0, "reference_potential_temperature", "> 0 K", theta0)
-        self.reference_potential_temperature = theta0
+        self.roughness_length = _checked("roughness_length", roughness_length, lambda z0: z0 > 0)
+        self.reference_potential_temperature = _checked(
+            "reference_potential_temperature", reference_potential_temperature, lambda t: t > 0
+        )
         self._set_free_atmosphere(brunt_vaisala_frequency, lapse_rate)
         self._set_stability_closure(
             stability_parameter, cooling_rate, surface_heat_flux, obukhov_length
         )
+        if geostrophic_wind is _INPUTS_ONLY:
+            return
+        self.geostrophic_wind = _checked("geostrophic_wind", geostrophic_wind, lambda g: g > 0)
         self._solve()
+
+    @classmethod
+    def check_inputs(cls, **inputs):
+        """Validate EkmanABL keyword inputs without the geostrophic wind (types, ranges and
+        exclusive choices, as the constructor does) and return the unsolved instance; raises
+        ValueError naming the input, its valid range (`VALID_RANGES`) and, for arrays, the
+        index of the offending entries."""
+        if "geostrophic_wind" in inputs:
+            raise ValueError("check_inputs takes the inputs without geostrophic_wind")
+        return cls(geostrophic_wind=_INPUTS_ONLY, **inputs)
+
+    @staticmethod
+    def valid_range(name):
+        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`)."""
+        return VALID_RANGES.get(name, "see EkmanABL")
 
     # ----------------------------------------------------------------------------- inputs
     def _set_constants(self, kappa, c_g, decay, c_tn, c_cn, c_ns, matching):
         for name, value in dict(
-            von_karman=kappa, c_g=c_g, stress_decay=decay, c_tn=c_tn, c_cn=c_cn, c_ns=c_ns
+            von_karman=kappa, c_g=c_g, stress_decay=decay, c_tn=c_tn, c_cn=c_cn, c_ns=c_ns,
+            matching_fraction=matching,
         ).items():
-            if not (np.isscalar(value) and np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive finite number; got {value!r}")
-        if not (np.isscalar(matching) and 0.0 < matching < 1.0):
-            raise ValueError(f"matching_fraction must be in (0, 1); got {matching!r}")
+            ok = (lambda v: (v > 0) & (v < 1)) if name == "matching_fraction" else (lambda v: v > 0)
+            if np.ndim(_checked(name, value, ok)) != 0:
+                raise ValueError(f"{name} must be a single number ({VALID_RANGES[name]}); got {value!r}")
         self.von_karman, self.c_g, self.stress_decay = float(kappa), float(c_g), float(decay)
         self.c_tn, self.c_cn, self.c_ns = float(c_tn), float(c_cn), float(c_ns)
         self.matching_fraction = float(matching)
@@ -250,12 +286,9 @@ class EkmanABL:
         if latitude is not None:
             f_c = coriolis_parameter_from_latitude(latitude)
         else:
-            f_c = finite("coriolis_parameter", coriolis_parameter)
-            f_min = 2.0 * EARTH_ROTATION_RATE * np.sin(np.deg2rad(MIN_ABS_LATITUDE))
-            require(
-                np.abs(f_c) >= f_min,
-                "coriolis_parameter", f"|f_c| >= {f_min:.4g} 1/s (|latitude| >= 1 deg; the Ekman "
-                "balance has no solution at the equator, f_c = 0)", f_c,
+            f_c = _checked(
+                "coriolis_parameter", coriolis_parameter,
+                lambda f: (np.abs(f) >= MIN_CORIOLIS_PARAMETER) & (np.abs(f) <= MAX_CORIOLIS_PARAMETER),
             )
         self.coriolis_parameter = f_c
         self._f = np.abs(f_c)
@@ -267,17 +300,12 @@ class EkmanABL:
                 "give at most one of brunt_vaisala_frequency [1/s] or lapse_rate [K/m]"
             )
         if lapse_rate is not None:
-            gamma = finite("lapse_rate", lapse_rate)
-            require(
-                gamma >= 0, "lapse_rate",
-                ">= 0 K/m (a neutral or stably stratified free atmosphere)", gamma,
-            )
+            gamma = _checked("lapse_rate", lapse_rate, lambda g: g >= 0)
             n_inf = np.sqrt(GRAVITY / self.reference_potential_temperature * gamma)
         else:
             if brunt_vaisala_frequency is None:
                 brunt_vaisala_frequency = PAPER_BRUNT_VAISALA_FREQUENCY
-            n_inf = finite("brunt_vaisala_frequency", brunt_vaisala_frequency)
-            require(n_inf >= 0, "brunt_vaisala_frequency", ">= 0 1/s", n_inf)
+            n_inf = _checked("brunt_vaisala_frequency", brunt_vaisala_frequency, lambda n: n >= 0)
         self.brunt_vaisala_frequency = n_inf
         self.zilitinkevich_number = n_inf / self._f
 
@@ -292,20 +320,16 @@ class EkmanABL:
                 "give at most one stability input among stability_parameter, cooling_rate, "
                 f"surface_heat_flux, obukhov_length; got {sorted(given)}"
             )
-        self.stability_input = next(iter(given), "stability_parameter")
-        raw = given.get(self.stability_input, 0.0)
-        value = np.asarray(raw, dtype=float)
-        unstable = "unstable (convective) conditions are not covered by this model"
+        self.stability_input = name = next(iter(given), "stability_parameter")
+        value = real_array(name, given.get(name, 0.0), VALID_RANGES[name])
         # L = +inf is the neutral limit of the Obukhov length; everything else must be finite.
-        neutral_obukhov = (value == np.inf) & (self.stability_input == "obukhov_length")
-        require(np.isfinite(value) | neutral_obukhov, self.stability_input, "finite", value)
-        valid, valid_range = {
-            "stability_parameter": (value >= 0, ">= 0"),
-            "cooling_rate": (value <= 0, "<= 0 K/h (surface cooling)"),
-            "surface_heat_flux": (value <= 0, "<= 0 K m/s (downward heat flux)"),
-            "obukhov_length": (value > 0, "> 0 m (stable; np.inf for neutral)"),
-        }[self.stability_input]
-        require(valid, self.stability_input, f"{valid_range}: {unstable}", value)
+        ok = {
+            "stability_parameter": lambda v: np.isfinite(v) & (v >= 0),
+            "cooling_rate": lambda v: np.isfinite(v) & (v <= 0),
+            "surface_heat_flux": lambda v: np.isfinite(v) & (v <= 0),
+            "obukhov_length": lambda v: (v > 0) & ~np.isnan(v),
+        }[name]
+        require_at(ok(value), name, VALID_RANGES[name], value)
         self._stability_value = value
 
     # ----------------------------------------------------------------------------- solver
@@ -355,14 +379,24 @@ class EkmanABL:
         )
         return ValueError(f"the ABL solve did not converge ({reason}) for inputs {details}")
 
-    def _solve(self):
+    def _parameters(self, geostrophic_wind, shape=()):
+        """The per-condition parameters of the solve, broadcast together (and to ``shape``)."""
         params = dict(
-            g=self.geostrophic_wind, f=self._f, z0=self.roughness_length,
+            g=geostrophic_wind, f=self._f, z0=self.roughness_length,
             value=self._stability_value, mu_n=self.zilitinkevich_number,
             theta0=self.reference_potential_temperature,
         )
-        shape = np.broadcast_shapes(*(np.shape(v) for v in params.values()))
-        flat = {k: np.broadcast_to(v, shape).ravel() for k, v in params.items()}
+        shape = np.broadcast_shapes(shape, *(np.shape(v) for v in params.values()))
+        return {k: np.broadcast_to(v, shape) for k, v in params.items()}, shape
+
+    def _surface_layer_exists(self, u_star, h_hat, p):
+        """The state is a model state if the matching height (matching_fraction * h, which
+        grows with u*) lies above z0; below it the stable boundary layer has collapsed."""
+        return self.matching_fraction * h_hat * u_star / p["f"] > p["z0"]
+
+    def _solve(self):
+        params, shape = self._parameters(self.geostrophic_wind)
+        flat = {k: v.ravel() for k, v in params.items()}
         # A few steps of the contracting fixed-point form (rate ~ 1/(ln Ro - A) ~ 0.1) put
         # u* within ~0.1 %; bracketed secant steps then converge on the physical branch.
         log_kg = np.log(self.von_karman * flat["g"])
@@ -381,7 +415,7 @@ class EkmanABL:
         # The root is unique, but it is a model state only if the surface layer exists:
         # the matching height (matching_fraction * h, which grows with u*) above z0.
         u_star, _, h_hat, _, _, _ = self._state(x, flat)
-        collapsed = self.matching_fraction * h_hat * u_star / flat["f"] <= flat["z0"]
+        collapsed = ~self._surface_layer_exists(u_star, h_hat, flat)
         if np.any(collapsed):
             raise self._failure(
                 collapsed.reshape(shape),
@@ -405,42 +439,61 @@ class EkmanABL:
         self.cross_isobaric_angle = np.rad2deg(np.arctan2(v_g, u_g))[()]
 
     # ----------------------------------------------------------------------------- profiles
-    def _heights(self, z, below_roughness):
-        z = np.asarray(z, dtype=float)
-        if below_roughness not in ("raise", "zero"):
-            raise ValueError(f"below_roughness must be 'raise' or 'zero'; got {below_roughness!r}")
-        under = z < self.roughness_length
-        if below_roughness == "raise" and np.any(under):
-            raise ValueError(
-                "heights z must be >= roughness_length z0 (the log law is undefined below z0; "
-                f"pass below_roughness='zero' for U = V = 0 there); got min z = {np.min(z):.6g} m"
-            )
-        return z, under
+    @property
+    def roughness_sublayer_height(self):
+        """z_s [m], the top of the roughness sublayer (docs/atmosphere.md#roughness-sublayer).
 
-    def velocity(self, z, below_roughness="raise"):
-        """(U, V)(z) [m/s] in the surface-stress frame, Eqs. (U_vel) and (V_vel).
+        The height where the tangent of the surface-layer law U(z) passes through the ground,
+        z_s = z0 exp(1 + kappa (5 mu + 0.3 mu_N) z0 f_c/u*) (about e z0), capped at the matching
+        height matching_fraction * h (reached only by a boundary layer near collapse).
+        """
+        most_slope = 5.0 * self.stability_parameter + 0.3 * self.zilitinkevich_number
+        xi0 = self.roughness_length * self._f / self.friction_velocity
+        # (exponent capped where z_s would be > e^50 z0: far above the matching height anyway)
+        tangent = self.roughness_length * np.exp(np.minimum(1.0 + self.von_karman * most_slope * xi0, 50.0))
+        return np.minimum(tangent, self.matching_fraction * self.boundary_layer_height)
+
+    def _heights(self, z, name, ok=lambda z: z >= 0, valid=">= 0 m (at or above the ground)"):
+        return _checked(name, z, ok, valid)
+
+    def _direction_heights(self, z, name):
+        return self._heights(z, name, lambda z: z > 0, "> 0 m (the wind has no direction at the ground)")
+
+    def velocity(self, z):
+        """(U, V)(z) [m/s] in the surface-stress frame, Eqs. (U_vel) and (V_vel); heights z >= 0.
 
         U: Monin-Obukhov law up to the matching height 0.2 h, Ekman layer up to h, U_g above;
         continuous at 0.2 h by construction of A (dU/dz jumps there). V: one expression on
-        0 <= z <= h with V(0) = 0 exactly; where g(xi) >= 1 (z > 0.9973 h, since c_g > 1)
+        0 <= z <= h, V_g above; where g(xi) >= 1 (z > 0.9973 h, since c_g > 1)
         the sqrt(1 - g^2) terms take their physical limit 0 (docs/atmosphere.md#lateral-velocity-near-the-abl-top). The slight
         backing of V near the ground is a property of the published formula and is kept.
-        At z = z0, U = 0; for z < z0 raise (default) or return 0 with below_roughness='zero'.
+
+        Roughness sublayer (docs/atmosphere.md#roughness-sublayer): below z_s =
+        `roughness_sublayer_height` (about e z0, where the log law's tangent passes through the
+        ground) the wind is (z/z_s) (U, V)(z_s): zero at the ground, positive for z > 0, U
+        continuous with its slope at z_s, the direction that of z_s. The log law alone would
+        give U = 0 at z0 while V(z0) != 0, hence a wind at right angles to the surface stress
+        and U < 0 below z0.
         """
-        z, under = self._heights(z, below_roughness)
-        u_star, h_hat, f = self.friction_velocity, self.h_hat, self._f
-        xi = z * f / u_star
-        xi0 = self.roughness_length * f / u_star
+        return self._velocity(self._heights(z, "z"))
+
+    def _velocity(self, z):
+        u_star, h_hat = self.friction_velocity, self.h_hat
+        z_s = self.roughness_sublayer_height
+        sublayer = z < z_s
+        scale = np.where(sublayer, z / z_s, 1.0)
+        z = np.where(sublayer, z_s, z)
+        xi = z * self._f / u_star
+        xi0 = self.roughness_length * self._f / u_star
         # z/h; the profile formulas live on [0, h]. Taken as z/h (not xi/h_hat) so that
         # z = h gives eta = 1 exactly: sqrt(1 - eta) would turn round-off into ~1e-8 of U.
-        eta = np.clip(z / self.boundary_layer_height, 0.0, 1.0)
+        eta = np.minimum(z / self.boundary_layer_height, 1.0)
         g, dg = stress_shape(eta, h_hat, self.c_g, self.stress_decay)
         stress = (1.0 - eta) ** 1.5
         u_g = self.geostrophic_components[0]
         ekman_u = -dg * stress + 1.5 * g / h_hat * np.sqrt(1.0 - eta) + u_g / u_star
         most_slope = 5.0 * self.stability_parameter + 0.3 * self.zilitinkevich_number
-        safe_xi = np.where(under, xi0, xi)
-        surface_u = np.log(safe_xi / xi0) / self.von_karman + most_slope * (safe_xi - xi0)
+        surface_u = np.log(xi / xi0) / self.von_karman + most_slope * (xi - xi0)
         u = np.where(eta <= self.matching_fraction, surface_u, ekman_u) * u_star
 
         one_minus_g2 = 1.0 - g**2
@@ -449,47 +502,59 @@ class EkmanABL:
         # kappa V_g/u* = -B = -3 kappa/(2 h_hat): writing V_g through B makes V(0) = 0 exact.
         veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * np.sqrt(1.0 - eta) - 1.0)
         v = self._hemisphere * u_star * np.where(real, veer_terms, -1.5 / h_hat)
-        u = np.where(under, 0.0, u)
-        v = np.where(under, 0.0, v)
-        return u, v
+        return u * scale, v * scale
 
-    def wind_angle(self, z, below_roughness="raise"):
-        """Mathematical flow angle atan2(V, U) [deg] in the surface-stress frame."""
-        u, v = self.velocity(z, below_roughness)
+    def wind_angle(self, z):
+        """Mathematical flow angle atan2(V, U) [deg] in the surface-stress frame (z > 0)."""
+        return self._wind_angle(z, "z")
+
+    def _wind_angle(self, z, name):
+        u, v = self._velocity(self._direction_heights(z, name))
         return np.rad2deg(np.arctan2(v, u))
 
-    def hub_aligned_velocity(self, z, reference_height, below_roughness="raise"):
+    def hub_aligned_velocity(self, z, reference_height):
         """(U, V)(z) rotated so that V(reference_height) = 0 and U(reference_height) > 0.
 
-        This is the frame of the wake model (docs/conventions.md#hub-aligned-frame): x along the wind at hub height.
+        This is the frame of the wake model (docs/conventions.md#hub-aligned-frame): x along the
+        wind at hub height. Heights z >= 0; reference_height > 0.
         """
-        u_ref, v_ref = self.velocity(reference_height)
+        u_ref, v_ref = self._velocity(self._direction_heights(reference_height, "reference_height"))
         speed = np.hypot(u_ref, v_ref)
         cos_a, sin_a = u_ref / speed, v_ref / speed
-        u, v = self.velocity(z, below_roughness)
+        u, v = self.velocity(z)
         return u * cos_a + v * sin_a, v * cos_a - u * sin_a
 
-    def speed(self, z, below_roughness="raise"):
-        """Horizontal wind speed |(U, V)|(z) [m/s]."""
-        return np.hypot(*self.velocity(z, below_roughness))
+    def speed(self, z):
+        """Horizontal wind speed |(U, V)|(z) [m/s], heights z >= 0."""
+        return np.hypot(*self.velocity(z))
 
     def wind_direction_change(self, z1, z2):
         """Change of wind direction from z1 to z2 [deg], positive = veering (clockwise with
         height, as the meteorological direction increases). Northern-hemisphere Ekman
         layers veer with height, so this is positive there for z2 > z1."""
-        return self.wind_angle(z1) - self.wind_angle(z2)
+        return self._wind_angle(z1, "z1") - self._wind_angle(z2, "z2")
+
+    def _log_layer_heights(self, z, name):
+        return self._heights(
+            z, name, lambda z: z >= self.roughness_length,
+            ">= roughness_length z0 (the Townsend-Perry law holds above the roughness)",
+        )
 
     def turbulence_intensity(self, z, reference_height=None, A1=TOWNSEND_PERRY_A1, B1=TOWNSEND_PERRY_B1):
-        """Streamwise turbulence intensity I_u(z), Eq. (Iu_model).
+        """Streamwise turbulence intensity I_u(z), Eq. (Iu_model), for z >= z0.
 
         Normalised by the speed at ``reference_height`` (the paper's U_h) when given, else by
         the local speed |(U, V)(z)| (the two agree at the reference height). Above h the
         variance law is continued to its zero at h exp(B1/A1) and is zero higher up
         (docs/atmosphere.md#shallow-boundary-layer).
         """
-        z = np.asarray(z, dtype=float)
-        reference_speed = self.speed(z if reference_height is None else reference_height)
-        self._heights(z, "raise")
+        z = self._log_layer_heights(z, "z")
+        if reference_height is None:
+            reference_speed = np.hypot(*self._velocity(z))
+        else:
+            reference_speed = np.hypot(
+                *self._velocity(self._log_layer_heights(reference_height, "reference_height"))
+            )
         return streamwise_turbulence_intensity(
             z, self.friction_velocity, self.boundary_layer_height, reference_speed, A1, B1
         )
@@ -499,11 +564,12 @@ class EkmanABL:
 
         ``constants`` may override A1, B1, alpha_prime, floor and n. A hub at or above h takes
         the continued law (docs/atmosphere.md#shallow-boundary-layer): the floor from
-        h exp(B1/A1) up.
+        h exp(B1/A1) up. Raises ValueError for a hub below the roughness length.
         """
+        hub_height = self._log_layer_heights(hub_height, "hub_height")
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,
-            self.speed(hub_height), **constants,
+            np.hypot(*self._velocity(hub_height)), **constants,
         )
 
     # ----------------------------------------------------------------------------- drivers
@@ -511,52 +577,85 @@ class EkmanABL:
     def from_reference_wind(cls, speed, height, tolerance=1e-13, **inputs):
         """Solve the ABL whose wind speed at ``height`` is ``speed`` (instead of giving G).
 
-        FLORIS drives farms by the wind speed at a reference height; here G is found so that
-        |(U, V)(height)| = speed, vectorised over arrays of speeds (and of other inputs), by
-        SciPy's bracketed Chandrupatla iteration on ln G (see `chandrupatla_root`).
+        FLORIS drives farms by the wind speed at a reference height. The solve is one scalar
+        root per condition in ln u* (docs/atmosphere.md#reference-wind-solve): for a given u*
+        the closure, h_hat, A, B and hence G = (u*/kappa) sqrt((ln Ro - A)^2 + B^2) are
+        explicit, so the speed at ``height`` is an explicit, increasing function of u*. Its
+        domain is bounded below by the collapse threshold (the physical GDL branch ln Ro > A
+        and a surface layer, matching_fraction * h > z0, exist only above some u*); trial
+        states below it count as "below the root", the bracket widens upward without bound
+        (the speed grows with u*), and bracketed secant steps, bisecting where the secant
+        leaves the bracket, converge whenever a solution exists. When none does (the speed is
+        below the slowest wind the atmosphere supports at that height), the ValueError gives
+        the condition, the speed and height asked for and that slowest speed.
+        Vectorised over arrays of speeds, heights and inputs (distinct conditions solved once).
         """
         if "geostrophic_wind" in inputs:
             raise ValueError("from_reference_wind takes speed and height instead of geostrophic_wind")
-        speed = finite("speed", speed)
-        require(speed > 0, "speed", "> 0 m/s", speed)
-        height = finite("height", height)
-        if "roughness_length" in inputs:
-            z0 = finite("roughness_length", inputs["roughness_length"])
-            require(height > z0, "height", "above roughness_length", height)
+        speed = _checked("speed", speed, lambda s: s > 0, "> 0 m/s")
+        template = cls.check_inputs(**inputs)
+        height = _checked("height", height, lambda h: h > 0, "> roughness_length z0")
+        z0 = template.roughness_length
+        require_at(
+            height > z0, "height", "> roughness_length z0",
+            np.broadcast_to(height, np.broadcast_shapes(height.shape, np.shape(z0))),
+        )
 
         # Conditions repeat (a wind rose has few distinct speeds): solve each distinct
         # (speed, height, atmosphere) once.
-        arrays = {k: np.asarray(v, float) for k, v in inputs.items() if np.ndim(v) > 0}
-        shape = np.broadcast_shapes(np.shape(speed), np.shape(height), *map(np.shape, arrays.values()))
+        per_condition = dict(
+            coriolis_parameter=template.coriolis_parameter,
+            roughness_length=template.roughness_length,
+            brunt_vaisala_frequency=template.brunt_vaisala_frequency,
+            reference_potential_temperature=template.reference_potential_temperature,
+            **{template.stability_input: template._stability_value},
+        )
+        shape = np.broadcast_shapes(
+            speed.shape, height.shape, *(np.shape(v) for v in per_condition.values())
+        )
         columns = np.stack(
-            [np.broadcast_to(a, shape).ravel() for a in (speed, height, *arrays.values())], axis=1
+            [np.broadcast_to(a, shape).ravel() for a in (speed, height, *per_condition.values())],
+            axis=1,
         )
-        distinct, inverse = np.unique(columns, axis=0, return_inverse=True)
-        scalars = {k: v for k, v in inputs.items() if k not in arrays}
-
-        def log_speed_error(log_g, idx):
-            row = distinct[idx]
-            abl = cls(
-                geostrophic_wind=np.exp(log_g), **scalars,
-                **{k: row[:, 2 + i] for i, k in enumerate(arrays)},
-            )
-            return np.log(abl.speed(row[:, 1])) - np.log(row[:, 0])
-
-        # U(height; G) is increasing but its log-slope ranges ~0.3 to ~5 and kinks where the
-        # ABL top crosses the height: start the bracket search at G = speed.
-        log_g0 = np.log(distinct[:, 0])
-        log_g, converged = chandrupatla_root(
-            log_speed_error, log_g0 - 0.1, log_g0 + 0.1, args=(np.arange(len(distinct)),),
-            tolerance=tolerance,
+        distinct, first, inverse = np.unique(columns, axis=0, return_index=True, return_inverse=True)
+        constants = {
+            k: getattr(template, k)
+            for k in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns", "matching_fraction")
+        }
+        rows = cls.check_inputs(
+            **{k: distinct[:, 2 + i] for i, k in enumerate(per_condition)}, **constants
         )
-        if not np.all(converged):
-            bad = distinct[~converged][0]
-            raise ValueError(
-                f"from_reference_wind found no ABL with speed {bad[0]:.6g} m/s at height "
-                f"{bad[1]:.6g} m for the inputs {inputs!r}"
+        target, at = distinct[:, 0], distinct[:, 1]
+        p, _ = rows._parameters(np.nan)
+
+        def exists(log_u_star):
+            u_star, _, h_hat, _, _, along = rows._state(log_u_star, p)
+            return (along > 0) & rows._surface_layer_exists(u_star, h_hat, p)
+
+        def log_speed_error(log_u_star):
+            with np.errstate(all="ignore"):
+                rows._set_solution(log_u_star, p)
+                error = np.log(np.hypot(*rows._velocity(at))) - np.log(target)
+            return np.where(exists(log_u_star) & np.isfinite(error), error, -np.inf)
+
+        log_u_star = _largest_root(log_speed_error, exists, rows, target, at, p, tolerance)
+        if np.any(np.isnan(log_u_star)):
+            failing = np.flatnonzero(np.isnan(log_u_star))
+            bad = failing[np.argmin(first[failing])]  # the first condition that fails
+            raise _no_reference_wind(
+                target[bad], at[bad], log_speed_error.slowest[bad],
+                np.unravel_index(first[bad], shape), shape, inputs,
             )
-        geostrophic_wind = np.exp(log_g)[inverse.ravel()].reshape(shape)
-        return cls(geostrophic_wind=geostrophic_wind, **inputs)
+        rows._set_solution(log_u_star, p)
+        u_star = rows.friction_velocity
+        _, _, _, _, b, along = rows._state(log_u_star, p)
+        g = (u_star * np.hypot(along, b) / rows.von_karman)[inverse.ravel()].reshape(shape)
+
+        abl = template
+        abl.geostrophic_wind = g
+        abl._params, _ = abl._parameters(g, shape)
+        abl._set_solution(log_u_star[inverse.ravel()].reshape(shape), abl._params)
+        return abl
 
     def __repr__(self):
         return (
@@ -564,6 +663,99 @@ class EkmanABL:
             f"h={self.boundary_layer_height!r}, mu={self.stability_parameter!r}, "
             f"alpha_0={self.cross_isobaric_angle!r} deg)"
         )
+
+
+#: Points of the scan in ln u* that brackets the largest root of the reference-wind solve.
+_SCAN_POINTS = 64
+
+
+def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
+    """ln u* of the deepest ABL whose speed at ``height`` is ``target`` (the reference-wind
+    solve, docs/atmosphere.md#reference-wind-solve); NaN where no ABL reaches it, with the
+    slowest speed reached stored as ``log_speed_error.slowest``.
+
+    Bounds from the physics: below, the collapse threshold (the smallest u* with a physical
+    GDL branch and a surface layer, found by bisection, the state being explicit in u*) or a
+    twentieth of the log-law guess, whichever is larger; above, the guess raised until the
+    speed exceeds the target (the speed grows without bound with u*). Near collapse the
+    speed at a fixed height can fall while u* and h grow, so two states may give one speed: a
+    scan of the bracket picks its last sign change (the state continuous with stronger winds),
+    which bracketed secant steps then refine.
+    """
+    # Neutral log law at the reference height: within a factor ~2 of the root.
+    guess = np.log(abl.von_karman * target / np.log(height / p["z0"]))
+    # Collapse threshold: bisection between a collapsed state and an existing one (states
+    # exist for all u* above it); e^-45 of the guess stands for "no threshold".
+    high = guess.copy()
+    for _ in range(60):
+        missing = ~exists(high)
+        if not np.any(missing):
+            break
+        high = np.where(missing, high + 1.0, high)
+    low = np.minimum(guess - 3.0, high - 3.0)
+    for _ in range(15):
+        above = exists(low)
+        if not np.any(above):
+            break
+        low = np.where(above, low - 3.0, low)
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        ok = exists(mid)
+        high, low = np.where(ok, mid, high), np.where(ok, low, mid)
+        if np.all(high - low <= 1e-13 * np.maximum(1.0, np.abs(high))):
+            break
+    threshold = high
+    # Scan from a twentieth of the guess, or lower where the speed there still exceeds the target.
+    lower = np.maximum(guess - 3.0, threshold)
+    for _ in range(20):
+        step = (lower > threshold) & (log_speed_error(lower) >= 0)
+        if not np.any(step):
+            break
+        lower = np.where(step, np.maximum(lower - 3.0, threshold), lower)
+    upper = np.maximum(guess + 0.5, lower + 0.5)
+    for _ in range(60):
+        short = log_speed_error(upper) < 0
+        if not np.any(short):
+            break
+        upper = np.where(short, upper + 1.0, upper)
+    grid = lower + (upper - lower) * np.linspace(0.0, 1.0, _SCAN_POINTS)[:, None]
+    errors = log_speed_error(grid)
+    log_speed_error.slowest = target * np.exp(np.min(errors, axis=0))
+    crossing = (errors[:-1] < 0) & (errors[1:] >= 0)
+    found = np.any(crossing, axis=0)
+    last = _SCAN_POINTS - 2 - np.argmax(crossing[::-1], axis=0)
+    columns = np.arange(target.size)
+    lo, hi = grid[last, columns], grid[last + 1, columns]
+    root, converged = secant_root(log_speed_error, lo, hi, tolerance)
+    return np.where(found & converged, root, np.nan)
+
+
+def _no_reference_wind(speed, height, slowest, index, shape, inputs):
+    """The ValueError of a reference wind that no ABL of the inputs reaches, in the caller's
+    terms: the speed and height asked for, the condition index and the inputs there, and the
+    slowest wind these inputs support at that height."""
+    varying = [i for i, n in zip(index, shape) if n > 1]
+    where = (
+        "" if not varying
+        else f" at condition {varying[0] if len(varying) == 1 else tuple(int(i) for i in index)}"
+    )
+    given = ", ".join(
+        f"{k}={np.broadcast_to(np.asarray(v, float), shape)[index]:.6g}" for k, v in inputs.items()
+    )
+    if np.isfinite(slowest):
+        reason = (
+            f"the slowest wind these inputs support at {height:.6g} m is {slowest:.4g} m/s; "
+            "at lower speeds the stable boundary layer collapses (its surface layer, "
+            "matching_fraction * h, shrinks to the roughness length, or the geostrophic drag law "
+            "loses its physical branch). Give a higher speed, a lower reference height or "
+            "weaker stratification"
+        )
+    else:
+        reason = "the stable boundary layer collapses at every speed for these inputs"
+    return ValueError(
+        f"from_reference_wind: no ABL has a wind speed of {speed:.6g} m/s at {height:.6g} m"
+        f"{where} ({given}): {reason}"
+    )
 
 
 def friction_velocity_fixed_point(abl, iterations=200):

@@ -53,6 +53,7 @@ import numpy as np
 from floris_ekman_veer.coupling.inflow import (
     CONFIG_PATH,
     AtmosphereSpec,
+    ambient_velocity,
     atmosphere_of,
     solve,
 )
@@ -177,8 +178,7 @@ def native_inflow_set_kwargs(fmodel, z=None, x_bounds=None, y_bounds=None) -> di
     # interpolation of such data is exactly linear in z within each layer.
     x, y, zz = np.meshgrid(x_bounds, y_bounds, z, indexing="ij")
     x, y, zz = x.ravel(), y.ravel(), zz.ravel()
-    U, _ = abl.hub_aligned_velocity(zz.reshape(1, 1, 1, -1), flow_field.reference_wind_height,
-                                    below_roughness="zero")
+    U, _ = ambient_velocity(abl, zz.reshape(1, 1, 1, -1), flow_field.reference_wind_height)
     multipliers = np.broadcast_to(U, (flow_field.n_findex, 1, 1, zz.size)).reshape(
         flow_field.n_findex, -1) / flow_field.wind_speeds[:, None]
     return {

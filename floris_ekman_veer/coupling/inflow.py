@@ -39,14 +39,16 @@ What the hook sets
 * ``u_initial_sorted`` (and ``u_sorted``) = the hub-aligned streamwise component U(z) of the
   analytic profile at every grid height, in the frame rotated so that V(reference_wind_height) = 0:
   FLORIS's wind direction is read as the direction at its reference height, and
-  U(reference_wind_height) equals FLORIS's wind speed. Points below the roughness length get 0
-  (FLORIS's gauss models divide by u_initial and warn there, as they do at z = 0 with the power
-  law).
+  U(reference_wind_height) equals FLORIS's wind speed. In the roughness sublayer (below about
+  e z0) the profile falls linearly to 0 at the ground (docs/atmosphere.md#roughness-sublayer), so
+  U > 0 at every z > 0 and no FLORIS model meets a zero inflow above the ground (FLORIS's gauss
+  models divide by u_initial; at z = 0 U = 0, as with FLORIS's power law). Points below the
+  ground get 0.
   ``wind_shear`` is ignored (the atmosphere defines the shear); 2-D/3-D heterogeneous speed
   multipliers, if also given, multiply the profile.
 * ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U, by a centred difference of the
   analytic profile (relative step 1e-4: relative error about 1e-8; EkmanABL exposes no analytic
-  gradient), 0 below z0. GCH's secondary steering uses it.
+  gradient), 0 below the ground. GCH's secondary steering uses it.
 * ``v_initial_sorted`` stays zero. FLORIS's solvers read ``v`` as *wake-induced* transverse
   velocity: GCH derives an effective yaw from the rotor-averaged ``v`` of each turbine (secondary
   steering) and feeds ``v``/``w`` into yaw-added recovery, so ambient veer in ``v_initial`` would
@@ -207,18 +209,19 @@ class AtmosphereSpec:
                 raise ValueError(
                     f"{CONFIG_PATH}: contradictory keys {clash}, give at most one of {list(group)}"
                 )
-        inputs, lengths = {}, {}
-        for name, value in given.items():
-            array = _as_float_array(name, value)
-            if array.ndim == 0:
-                inputs[name] = float(array)
-            else:
-                lengths[name] = array.size
-                inputs[name] = array.reshape(-1, 1, 1, 1)
+        arrays = {name: _as_float_array(name, value) for name, value in given.items()}
+        lengths = {name: a.size for name, a in arrays.items() if a.ndim == 1}
         if len(set(lengths.values())) > 1:
+            listed = ", ".join(f"{CONFIG_PATH}.{k} has {n}" for k, n in lengths.items())
             raise ValueError(
-                f"{CONFIG_PATH}: per-condition lists must all have length n_findex; got {lengths}"
+                "per-condition lists must all have one value per condition (length n_findex); "
+                f"got {listed}"
             )
+        # Ranges, once, by EkmanABL's own checks (per-condition entries named by condition index).
+        _check_ranges(arrays)
+        inputs = {
+            name: float(a) if a.ndim == 0 else a.reshape(-1, 1, 1, 1) for name, a in arrays.items()
+        }
         n_conditions = next(iter(lengths.values()), None)
         key = tuple(sorted(
             (k, v if isinstance(v, float) else v.tobytes()) for k, v in inputs.items()
@@ -231,12 +234,15 @@ class AtmosphereSpec:
         ``n_findex = 0`` (an input file whose conditions are set later with ``set()``) passes.
         """
         if self.n_conditions is not None and n_findex and self.n_conditions != n_findex:
-            per_condition = sorted(k for k, v in self.inputs.items() if not isinstance(v, float))
+            per_condition = ", ".join(
+                f"{CONFIG_PATH}.{k}" for k, v in sorted(self.inputs.items())
+                if not isinstance(v, float)
+            )
             raise ValueError(
-                f"{CONFIG_PATH}: per-condition values {per_condition} have length "
-                f"{self.n_conditions} but FLORIS has n_findex = {n_findex} conditions; give "
-                "lists of length n_findex or scalars (replace the atmosphere and the conditions "
-                "together with floris_ekman_veer.coupling.inflow.set_atmosphere)"
+                f"{per_condition} must have one value per condition (length n_findex = "
+                f"{n_findex}) or be a single number; got {self.n_conditions} values (replace the "
+                "atmosphere and the conditions together with "
+                "floris_ekman_veer.coupling.inflow.set_atmosphere)"
             )
 
     def sliced(self, index) -> dict:
@@ -248,18 +254,26 @@ class AtmosphereSpec:
 
 
 def _as_float_array(name: str, value) -> np.ndarray:
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"{CONFIG_PATH}.{name} must be a number or a list of numbers, got {value!r}"
-        ) from None
-    if isinstance(value, bool) or array.ndim > 1 or not np.all(np.isfinite(array)):
-        raise ValueError(
-            f"{CONFIG_PATH}.{name} must be a finite number or a 1-D list of finite numbers "
-            f"(one per condition), got {value!r}"
-        )
+    """A number or a 1-D list of numbers (one per condition) as a float array; strings ("0.1",
+    "ten") and booleans are refused, never coerced."""
+    from floris_ekman_veer._validation import real_array
+
+    valid = f"{_abl_class().valid_range(name)}; one number, or a list of one per condition"
+    array = real_array(f"{CONFIG_PATH}.{name}", value, valid)
+    if array.ndim > 1:
+        raise ValueError(f"{CONFIG_PATH}.{name} must be a number or a 1-D list ({valid}); got {value!r}")
     return array
+
+
+def _check_ranges(arrays: Mapping) -> None:
+    """Check the atmosphere's values with EkmanABL's own input checks (the one validation path),
+    naming the parameter by its place in the FLORIS input."""
+    try:
+        _abl_class().check_inputs(**arrays)
+    except ValueError as error:
+        message = str(error)
+        named = any(message.startswith(f"{name} ") for name in arrays)
+        raise ValueError(f"{CONFIG_PATH}.{message}" if named else f"{CONFIG_PATH}: {message}") from None
 
 
 def atmosphere_of(core: Core) -> AtmosphereSpec | None:
@@ -312,7 +326,10 @@ def solve(spec: AtmosphereSpec, wind_speeds, reference_height: float):
             wind_speeds[:, None, None, None], reference_height, **spec.inputs
         )
     except ValueError as error:
-        raise ValueError(f"{CONFIG_PATH}: {error}") from error
+        raise ValueError(
+            f"{CONFIG_PATH} driven by flow_field.wind_speeds at flow_field.reference_wind_height: "
+            f"{error}"
+        ) from error
     with _SOLVE_LOCK:
         _SOLVE_CACHE[key] = abl
         while len(_SOLVE_CACHE) > _SOLVE_CACHE_SIZE:
@@ -323,8 +340,8 @@ def solve(spec: AtmosphereSpec, wind_speeds, reference_height: float):
 def inflow_profile(abl, z, reference_height: float):
     """Hub-aligned streamwise velocity U(z) and dU/dz at heights ``z``.
 
-    The frame is rotated so that V(reference_height) = 0; heights below the roughness length give
-    U = dU/dz = 0. ``z`` broadcasts against the ABL's ``(n_findex, 1, 1, 1)`` shape; the result
+    The frame is rotated so that V(reference_height) = 0; heights below the ground give
+    U = dU/dz = 0 (see :func:`ambient_velocity`). ``z`` broadcasts against the ABL's ``(n_findex, 1, 1, 1)`` shape; the result
     has the broadcast shape. The profile is evaluated only at the distinct heights of ``z`` (a
     rotor grid of 100 turbines of one hub height has 3 of them, whatever n_findex and however
     FLORIS sorted the turbines) and gathered back, which gives the same numbers as evaluating at
@@ -365,24 +382,34 @@ def _distinct_heights(z: np.ndarray):
     return heights, inverse, reduced.shape
 
 
+def ambient_velocity(abl, z, reference_height: float):
+    """Hub-aligned ambient (U, V)(z) on a FLORIS grid: the profile of
+    :meth:`EkmanABL.hub_aligned_velocity` at z >= 0 (with its roughness sublayer,
+    docs/atmosphere.md#roughness-sublayer, so U > 0 for every z > 0), and 0 below the ground
+    (z < 0, where FLORIS's power law has no value either)."""
+    z = np.asarray(z, dtype=float)
+    above = z >= 0.0
+    U, V = abl.hub_aligned_velocity(np.where(above, z, 0.0), reference_height)
+    return np.where(above, U, 0.0), np.where(above, V, 0.0)
+
+
 # Relative height step of the centred difference for dU/dz: truncation ~ step^2 (1e-8 relative
 # for the log law), round-off ~ 1e-16 U / (step z) (1e-12 relative at hub height).
 _GRADIENT_STEP = 1e-4
 
 
 def _profile_and_gradient(abl, z, reference_height):
-    # dU/dz of the hub-aligned U by a centred difference of EkmanABL.hub_aligned_velocity (the
-    # ABL class exposes no analytic gradient); one-sided where the lower point would fall below
-    # z0, and 0 below z0. Across the kinks at 0.2 h and h the difference averages the two slopes
-    # within +-1e-4 z of the kink.
-    U, _ = abl.hub_aligned_velocity(z, reference_height, below_roughness="zero")
-    z0 = np.asarray(abl.roughness_length)
-    upper_z = z * (1.0 + _GRADIENT_STEP)
-    lower_z = np.maximum(z * (1.0 - _GRADIENT_STEP), z0)
-    upper, _ = abl.hub_aligned_velocity(upper_z, reference_height, below_roughness="zero")
-    lower, _ = abl.hub_aligned_velocity(lower_z, reference_height, below_roughness="zero")
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dUdz = np.where(z >= z0, (upper - lower) / (upper_z - lower_z), 0.0)
+    # dU/dz of the hub-aligned U by a centred difference of the profile (the ABL class exposes
+    # no analytic gradient), with step 1e-4 max(z, z0): one-sided at the ground, where the
+    # roughness sublayer's U is linear in z, and 0 below it. Across the kinks at 0.2 h and h
+    # the difference averages the two slopes within +-1e-4 z of the kink.
+    U, _ = ambient_velocity(abl, z, reference_height)
+    step = _GRADIENT_STEP * np.maximum(z, np.asarray(abl.roughness_length))
+    upper_z = z + step
+    lower_z = np.maximum(z - step, 0.0)
+    upper, _ = ambient_velocity(abl, upper_z, reference_height)
+    lower, _ = ambient_velocity(abl, lower_z, reference_height)
+    dUdz = np.where(z >= 0.0, (upper - lower) / (upper_z - lower_z), 0.0)
     return U, dUdz
 
 

@@ -55,7 +55,7 @@ from floris_ekman_veer.atmosphere.turbulence import (
     streamwise_turbulence_intensity,
     wake_expansion_rate,
 )
-from floris_ekman_veer.coupling.inflow import solved_atmosphere
+from floris_ekman_veer.coupling.inflow import ambient_velocity, solved_atmosphere
 from floris_ekman_veer.coupling.shallow import POLICIES as SHALLOW_POLICIES
 from floris_ekman_veer.coupling.names import (
     DEFLECTION_MODEL_NAME,
@@ -151,7 +151,7 @@ class Ambient:
     def of(cls, grid: Grid, flow_field: FlowField) -> Ambient:
         abl = solved_atmosphere(flow_field)
         reference_height = flow_field.reference_wind_height
-        u, v = abl.hub_aligned_velocity(grid.z_sorted, reference_height, below_roughness="zero")
+        u, v = ambient_velocity(abl, grid.z_sorted, reference_height)
         coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
         hub_heights = np.unique(coordinates[:, 2])
         u_hub, v_hub = abl.hub_aligned_velocity(hub_heights.reshape(1, 1, 1, -1), reference_height)
