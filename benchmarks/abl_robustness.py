@@ -1,4 +1,4 @@
-"""Robustness of the ABL inflow over random valid inputs (run by hand; docs/atmosphere.md#robustness).
+"""Robustness of the ABL inflow over random valid inputs (run by hand; docs/atmosphere.md#reference-wind-solve).
 
 Usage::
 
@@ -16,7 +16,7 @@ N 0-0.02 1/s. For each it reports
   speed at the reference height, and a solution exists if the target speed lies between the
   scan's smallest and largest speeds;
 * the hub-aligned streamwise U just above the ground (heights z0 * [0.01 .. 30]) where the solve
-  succeeds: count of cases with U < 0 anywhere, and the minimum U/G.
+  succeeds: count of cases with U < 0 anywhere, the minimum U/G and the deepest ABL among them.
 """
 
 from __future__ import annotations
@@ -66,6 +66,7 @@ def main(n_per_kind=800, seed=0):
     rng = np.random.default_rng(seed)
     total = failed = solvable = negative = 0
     worst = 0.0
+    deepest_negative = 0.0  # largest h among the cases with U < 0
     examples = []
     start = time.perf_counter()
     for kind in KINDS:
@@ -89,6 +90,7 @@ def main(n_per_kind=800, seed=0):
             if np.min(u) < 0:
                 negative += 1
                 worst = min(worst, float(np.min(u) / abl.geostrophic_wind))
+                deepest_negative = max(deepest_negative, float(abl.boundary_layer_height))
                 if len(examples) < 6:
                     examples.append(("U < 0", speed, height, inputs))
         failed += kind_failed
@@ -96,7 +98,8 @@ def main(n_per_kind=800, seed=0):
         print(f"{kind:20s} inputs {n_per_kind}: from_reference_wind failures {kind_failed} "
               f"(with a solution: {kind_solvable})")
     print(f"all kinds: inputs {total}, failures {failed}, of which solvable {solvable}; "
-          f"hub-aligned U < 0 near the ground in {negative} solved cases (min U/G {worst:.3g}); "
+          f"hub-aligned U < 0 near the ground in {negative} solved cases (min U/G {worst:.3g}, "
+          f"largest h among them {deepest_negative:.3g} m); "
           f"{time.perf_counter() - start:.0f} s")
     for example in examples:
         print("solvable failure:", example)

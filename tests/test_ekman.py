@@ -539,6 +539,48 @@ def test_from_reference_wind_per_element_atmospheres():
         assert a.friction_velocity[i] == pytest.approx(float(s.friction_velocity), rel=1e-10)
 
 
+#: Inputs the former solve (Chandrupatla on ln G) failed although an ABL reaches the speed.
+EDGE_CASES = [
+    (11.27, 136.6, dict(surface_heat_flux=-0.014, roughness_length=0.28, latitude=19.8)),
+    (11.27, 136.6, dict(surface_heat_flux=-0.014, roughness_length=0.28, latitude=19.8,
+                        brunt_vaisala_frequency=0.0161)),
+    (15.36, 26.36, dict(latitude=-15.52, roughness_length=0.7517, brunt_vaisala_frequency=0.01746,
+                        cooling_rate=-1.748)),
+    (17.42, 69.09, dict(latitude=-12.40, roughness_length=1.434e-4,
+                        brunt_vaisala_frequency=0.01667, surface_heat_flux=-0.02187)),
+    (9.24, 37.42, dict(latitude=-19.94, roughness_length=0.02054,
+                       brunt_vaisala_frequency=0.005411, surface_heat_flux=-0.01659)),
+]
+
+
+@pytest.mark.parametrize("speed, height, inputs", EDGE_CASES)
+def test_from_reference_wind_finds_the_collapse_edge_cases(speed, height, inputs):
+    """Near the collapse threshold: the solve returns a valid ABL with the speed, which the
+    forward solve from its G reproduces (an independent route to the same state)."""
+    a = EkmanABL.from_reference_wind(speed, height, **inputs)
+    assert float(a.speed(height)) == pytest.approx(speed, rel=1e-12)
+    assert 0.2 * float(a.boundary_layer_height) > inputs["roughness_length"]
+    assert float(a.geostrophic_components[0]) > 0
+    b = EkmanABL(geostrophic_wind=a.geostrophic_wind, **inputs)
+    assert float(b.friction_velocity) == pytest.approx(float(a.friction_velocity), rel=1e-10)
+    assert float(b.speed(height)) == pytest.approx(speed, rel=1e-10)
+
+
+def test_from_reference_wind_takes_the_deepest_of_two_states():
+    """Near collapse the speed at a fixed height can fall while G grows: at 8.7 m/s and 136.6 m
+    two states qualify (G between 12 and 13.5 m/s, and above 13.5 m/s); the deeper one is taken."""
+    inputs = dict(surface_heat_flux=-0.014, roughness_length=0.28, latitude=19.8)
+    g = np.linspace(12.0, 13.5, 7)
+    speeds = EkmanABL(geostrophic_wind=g, **inputs).speed(136.6)
+    assert np.all(np.diff(speeds) < 0)  # the fold: speed falls as G grows
+    a = EkmanABL.from_reference_wind(8.7, 136.6, **inputs)
+    assert float(a.speed(136.6)) == pytest.approx(8.7, rel=1e-12)
+    assert float(a.geostrophic_wind) > 13.5
+    shallow = g[np.argmin(np.abs(speeds - 8.7))]
+    assert float(EkmanABL(geostrophic_wind=shallow, **inputs).boundary_layer_height) < float(
+        a.boundary_layer_height)
+
+
 def test_from_reference_wind_above_abl_top_gives_g():
     """A reference height above h: the speed there is G itself."""
     a = EkmanABL.from_reference_wind(10.0, 1500.0, **ATMOSPHERE)

@@ -1,4 +1,4 @@
-"""Invalid atmosphere input, table-driven (docs/atmosphere.md#valid-input-ranges).
+"""Invalid atmosphere input, table-driven (docs/atmosphere.md#input-ranges).
 
 Every row gives an invalid input, in Python (EkmanABL and its methods) or in the FLORIS input
 (``wake.wake_velocity_parameters.ekman_veer.atmosphere``, from YAML or a dict alike), and asserts

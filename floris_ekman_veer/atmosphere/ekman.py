@@ -47,7 +47,7 @@ PAPER_BRUNT_VAISALA_FREQUENCY = 6.1e-3
 PAPER_POTENTIAL_TEMPERATURE = 265.0
 
 _STABLE_ONLY = "unstable (convective) conditions are not covered by this model"
-#: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#valid-input-ranges
+#: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#input-ranges
 #: state it. Every input is a real number or an array of them (strings and booleans are refused).
 VALID_RANGES = {
     "geostrophic_wind": "> 0 m/s",
@@ -721,12 +721,15 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     grid = lower + (upper - lower) * np.linspace(0.0, 1.0, _SCAN_POINTS)[:, None]
     errors = log_speed_error(grid)
     log_speed_error.slowest = target * np.exp(np.min(errors, axis=0))
-    crossing = (errors[:-1] < 0) & (errors[1:] >= 0)
+    crossing = np.isfinite(errors[:-1]) & (errors[:-1] < 0) & (errors[1:] >= 0)
     found = np.any(crossing, axis=0)
     last = _SCAN_POINTS - 2 - np.argmax(crossing[::-1], axis=0)
     columns = np.arange(target.size)
     lo, hi = grid[last, columns], grid[last + 1, columns]
     root, converged = secant_root(log_speed_error, lo, hi, tolerance)
+    # Just below h, U(z) has a square-root slope in u*: there round-off stops the residual a
+    # little above 1e-13 with the bracket at machine precision; 1e-9 in ln speed is then taken.
+    converged |= np.abs(log_speed_error(root)) <= max(tolerance, 1e-9)
     return np.where(found & converged, root, np.nan)
 
 
