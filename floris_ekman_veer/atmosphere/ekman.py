@@ -172,15 +172,19 @@ def secant_root(residual, lo, hi, tolerance=_SOLVER_TOLERANCE):
     bracketed = (r_lo < 0) & (r_hi >= 0)
     x_prev, r_prev, x, r = lo, r_lo, hi, r_hi
     for _ in range(_SOLVER_MAX_ITERATIONS):
-        if np.all(~bracketed | (np.abs(r) <= tolerance)):
+        # Converged elements are frozen, so that each element's root does not depend on the
+        # others solved with it (a chunk of conditions gives the numbers of the whole set).
+        active = bracketed & (np.abs(r) > tolerance)
+        if not np.any(active):
             break
         with np.errstate(divide="ignore", invalid="ignore"):
             secant = x - r * (x - x_prev) / (r - r_prev)
         inside = np.isfinite(secant) & (secant > lo) & (secant < hi)
-        x_prev, r_prev = x, r
-        x = np.where(inside, secant, 0.5 * (lo + hi))
+        x_prev, r_prev = np.where(active, x, x_prev), np.where(active, r, r_prev)
+        x = np.where(active, np.where(inside, secant, 0.5 * (lo + hi)), x)
         r = residual(x)
-        lo, hi = np.where(r < 0, x, lo), np.where(r < 0, hi, x)
+        below = active & (r < 0)
+        lo, hi = np.where(below, x, lo), np.where(active & ~below, x, hi)
     return x, bracketed & (np.abs(r) <= tolerance)
 
 
@@ -638,12 +642,12 @@ class EkmanABL:
                 error = np.log(np.hypot(*rows._velocity(at))) - np.log(target)
             return np.where(exists(log_u_star) & np.isfinite(error), error, -np.inf)
 
-        log_u_star = _largest_root(log_speed_error, exists, rows, target, at, p, tolerance)
+        log_u_star, slowest = _largest_root(log_speed_error, exists, rows, target, at, p, tolerance)
         if np.any(np.isnan(log_u_star)):
             failing = np.flatnonzero(np.isnan(log_u_star))
             bad = failing[np.argmin(first[failing])]  # the first condition that fails
             raise _no_reference_wind(
-                target[bad], at[bad], log_speed_error.slowest[bad],
+                target[bad], at[bad], slowest[bad],
                 np.unravel_index(first[bad], shape), shape, inputs,
             )
         rows._set_solution(log_u_star, p)
@@ -671,8 +675,8 @@ _SCAN_POINTS = 64
 
 def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     """ln u* of the deepest ABL whose speed at ``height`` is ``target`` (the reference-wind
-    solve, docs/atmosphere.md#reference-wind-solve); NaN where no ABL reaches it, with the
-    slowest speed reached stored as ``log_speed_error.slowest``.
+    solve, docs/atmosphere.md#reference-wind-solve), NaN where no ABL reaches it, and the
+    slowest speed the scanned states reach (for the message when none does).
 
     Bounds from the physics: below, the collapse threshold (the smallest u* with a physical
     GDL branch and a surface layer, found by bisection, the state being explicit in u*) or a
@@ -699,11 +703,12 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
             break
         low = np.where(above, low - 3.0, low)
     for _ in range(100):
+        active = high - low > 1e-13 * np.maximum(1.0, np.abs(high))  # the others are frozen
+        if not np.any(active):
+            break
         mid = 0.5 * (low + high)
         ok = exists(mid)
-        high, low = np.where(ok, mid, high), np.where(ok, low, mid)
-        if np.all(high - low <= 1e-13 * np.maximum(1.0, np.abs(high))):
-            break
+        high, low = np.where(active & ok, mid, high), np.where(active & ~ok, mid, low)
     threshold = high
     # Scan from a twentieth of the guess, or lower where the speed there still exceeds the target.
     lower = np.maximum(guess - 3.0, threshold)
@@ -720,7 +725,7 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
         upper = np.where(short, upper + 1.0, upper)
     grid = lower + (upper - lower) * np.linspace(0.0, 1.0, _SCAN_POINTS)[:, None]
     errors = log_speed_error(grid)
-    log_speed_error.slowest = target * np.exp(np.min(errors, axis=0))
+    slowest = target * np.exp(np.min(errors, axis=0))
     crossing = np.isfinite(errors[:-1]) & (errors[:-1] < 0) & (errors[1:] >= 0)
     found = np.any(crossing, axis=0)
     last = _SCAN_POINTS - 2 - np.argmax(crossing[::-1], axis=0)
@@ -730,7 +735,7 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     # Just below h, U(z) has a square-root slope in u*: there round-off stops the residual a
     # little above 1e-13 with the bracket at machine precision; 1e-9 in ln speed is then taken.
     converged |= np.abs(log_speed_error(root)) <= max(tolerance, 1e-9)
-    return np.where(found & converged, root, np.nan)
+    return np.where(found & converged, root, np.nan), slowest
 
 
 def _no_reference_wind(speed, height, slowest, index, shape, inputs):
@@ -745,7 +750,13 @@ def _no_reference_wind(speed, height, slowest, index, shape, inputs):
     given = ", ".join(
         f"{k}={np.broadcast_to(np.asarray(v, float), shape)[index]:.6g}" for k, v in inputs.items()
     )
-    if np.isfinite(slowest):
+    if slowest < speed:
+        reason = (
+            f"the speed at {height:.6g} m steps past it as the boundary-layer top crosses that "
+            "height (V steps onto V_g at 0.9973 h, docs/atmosphere.md#lateral-velocity-near-the-abl-top); "
+            "give a slightly different speed or height"
+        )
+    elif np.isfinite(slowest):
         reason = (
             f"the slowest wind these inputs support at {height:.6g} m is {slowest:.4g} m/s; "
             "at lower speeds the stable boundary layer collapses (its surface layer, "
