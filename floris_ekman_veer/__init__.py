@@ -10,14 +10,18 @@ FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
 (conditions chunked over a dask.distributed cluster; optional extra ``dask``).
 ``floris_ekman_veer.optimize_yaw(fmodel, optimizer_class, **options)`` runs FLORIS's yaw
 optimisers on scalar and per-condition atmospheres alike and returns FLORIS's ``df_opt``.
+``floris_ekman_veer.annual_energy(fmodel, wind_data, stability, optimizer_class, ...)`` gives the
+AEP per stability class, baseline and with wake steering, for ekman_veer and FLORIS's GCH.
 """
 
 from floris_ekman_veer._version import __version__
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.coupling.distributed import ParFlorisModel
+from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
 
-__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "optimize_yaw", "register"]
+__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "annual_energy", "optimize_yaw",
+           "register"]
 
 register()

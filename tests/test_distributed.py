@@ -36,11 +36,10 @@ SCRIPT = textwrap.dedent(
     def main():
         started = time.perf_counter()
         from distributed import Client, LocalCluster
-        from floris import FlorisModel
+        from floris import FlorisModel, WindRose
         from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-        import floris_ekman_veer
-        from floris_ekman_veer import ParFlorisModel
+        from floris_ekman_veer import ParFlorisModel, annual_energy
         from floris_ekman_veer.coupling import inflow
 
         farm = sys.argv[1]
@@ -50,7 +49,7 @@ SCRIPT = textwrap.dedent(
                           turbulence_intensities=np.full(7, 0.06))
         out = {}
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+                          dashboard_address=":0") as cluster, Client(cluster) as client:
             serial = FlorisModel(farm)
             serial.set(yaw_angles=np.tile([10.0, -5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
                                           (7, 1)), **conditions)
@@ -87,17 +86,32 @@ SCRIPT = textwrap.dedent(
             out["per_condition"] = np.max(np.abs(par_day_night.get_turbine_powers()
                                                  - day_night.get_turbine_powers())).item()
 
-            # FLORIS's optimiser takes the Dask model as it takes any ParFlorisModel.
-            serial.set(yaw_angles=np.zeros((7, 9)))
+            # FLORIS's optimiser and annual energy take the Dask model as any ParFlorisModel
+            # (a 3-turbine row of the farm: each optimiser pass is a round trip to the cluster).
+            row = FlorisModel(farm)
+            row.set(layout_x=[0.0, 882.0, 1764.0], layout_y=[0.0, 0.0, 0.0],
+                    wind_speeds=[8.0, 10.0], wind_directions=[266.0, 274.0],
+                    turbulence_intensities=[0.06, 0.06])
+            par_row = ParFlorisModel(row, interface="dask", client=client)
             kwargs = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
-            reference = YawOptimizationSR(serial, **kwargs).optimize(print_progress=False)
-            par.set(yaw_angles=np.zeros((7, 9)))
-            on_cluster = YawOptimizationSR(par, **kwargs).optimize(print_progress=False)
+            reference = YawOptimizationSR(row, **kwargs).optimize(print_progress=False)
+            on_cluster = YawOptimizationSR(par_row, **kwargs).optimize(print_progress=False)
             out["yaw_angles"] = np.max(np.abs(np.vstack(on_cluster.yaw_angles_opt)
                                               - np.vstack(reference.yaw_angles_opt))).item()
             out["yaw_power"] = np.max(np.abs(on_cluster.farm_power_opt.to_numpy()
                                              - reference.farm_power_opt.to_numpy())).item()
             out["yaw_steered"] = np.max(np.abs(np.vstack(reference.yaw_angles_opt))).item()
+
+            rose = WindRose(np.array([266.0, 274.0]), np.array([9.0]), ti_table=0.06)
+            atmosphere = inflow.atmosphere_of(row.core).sliced(slice(None))
+            stability = {"night": {"frequency": 1.0, "atmosphere": atmosphere}}
+            tables = [annual_energy(model, rose, stability, YawOptimizationSR,
+                                    models=["ekman_veer"], progress=False, **kwargs).table
+                      for model in (row, par_row)]
+            columns = ["aep_baseline_gwh", "aep_steered_gwh"]
+            out["aep"] = np.max(np.abs(tables[1][columns].to_numpy()
+                                       - tables[0][columns].to_numpy())).item()
+            out["aep_gain"] = tables[0]["gain_percent"].iloc[-1].item()
         out["seconds"] = time.perf_counter() - started
         print("RESULT " + json.dumps(out))
 
@@ -142,6 +156,11 @@ def test_dask_model_in_floris_optimiser(cluster_results):
     assert cluster_results["yaw_steered"] > 0.0  # the case does steer
     assert cluster_results["yaw_angles"] == 0.0
     assert cluster_results["yaw_power"] == 0.0
+
+
+def test_dask_model_in_annual_energy(cluster_results):
+    assert cluster_results["aep_gain"] > 0.0
+    assert cluster_results["aep"] == 0.0
 
 
 # ------------------------------------------------------------------------- bad input

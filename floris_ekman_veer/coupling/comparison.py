@@ -188,3 +188,30 @@ def native_inflow_set_kwargs(fmodel, z=None, x_bounds=None, y_bounds=None) -> di
         },
         "wind_shear": 0.0,
     }
+
+
+#: Wake set-ups of FLORIS's example inputs (examples/inputs/gch.yaml, gauss.yaml, cc.yaml of
+#: FLORIS 4.7): model names and the three GCH switches. Their parameter blocks are those of the
+#: input they are applied to (FLORIS's defaults where it has none).
+BUILTIN_WAKES = {
+    "gch": ({"velocity_model": "gauss", "deflection_model": "gauss"}, True),
+    "gauss": ({"velocity_model": "gauss", "deflection_model": "gauss"}, False),
+    "cc": ({"velocity_model": "cc", "deflection_model": "gauss"}, True),
+}
+GCH_SWITCHES = ("enable_secondary_steering", "enable_yaw_added_recovery",
+                "enable_transverse_velocities")
+
+
+def builtin_model(fmodel, name: str):
+    """A copy of ``fmodel`` running FLORIS's wake set-up ``name`` (a key of
+    :data:`BUILTIN_WAKES`) on the same farm, conditions and atmosphere block (so the same Ekman
+    inflow); its class (FlorisModel, ParFlorisModel...) is kept, operation set-points are not
+    (as with ``FlorisModel.copy()``). Combine with :func:`fair_builtin_set_kwargs` for the inflow scalars."""
+    if name not in BUILTIN_WAKES:
+        raise ValueError(f"builtin_model: name must be one of {sorted(BUILTIN_WAKES)}, got {name!r}")
+    model_strings, gch = BUILTIN_WAKES[name]
+    # As FlorisModel.copy(), from the Core's dictionary, with the wake edited.
+    config = fmodel.core.as_dict()
+    config["wake"]["model_strings"].update(model_strings)
+    config["wake"].update(dict.fromkeys(GCH_SWITCHES, gch))
+    return type(fmodel)(config, **fmodel.secondary_init_kwargs)

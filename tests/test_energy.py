@@ -1,0 +1,190 @@
+"""Annual energy per stability class (floris_ekman_veer.coupling.energy)."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+from floris import FlorisModel, TimeSeries, WindRose
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+from floris_ekman_veer.coupling import energy
+from floris_ekman_veer.coupling.comparison import builtin_inflow_settings, builtin_model
+from floris_ekman_veer.coupling.energy import annual_energy
+from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+
+FARM = Path(__file__).resolve().parents[1] / "inputs" / "farm_sbl6.yaml"
+YAW = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
+
+
+@pytest.fixture(scope="module")
+def row():
+    """The SBL-6 farm input cut to a 3-turbine row at 7 D (wind from 270 deg along it)."""
+    fmodel = FlorisModel(FARM)
+    fmodel.set(layout_x=[0.0, 882.0, 1764.0], layout_y=[0.0, 0.0, 0.0])
+    return fmodel
+
+
+@pytest.fixture(scope="module")
+def atmospheres(row):
+    night = atmosphere_of(row.core).sliced(slice(None))
+    return {"day": dict(night, stability_parameter=0.0), "night": night}
+
+
+ROSE = WindRose(wind_directions=np.array([265.0, 270.0, 275.0]),
+                wind_speeds=np.array([8.0, 10.0]), ti_table=0.06,
+                freq_table=np.array([[0.1, 0.2], [0.25, 0.15], [0.2, 0.1]]))
+
+
+def _floris_aep(fmodel, wind_data):
+    model = copy.deepcopy(fmodel)
+    model.set(wind_data=wind_data)
+    model.run()
+    return model.get_farm_AEP() / 1e9
+
+
+@pytest.mark.parametrize("model", ["ekman_veer", "gch"])
+def test_one_class_is_floris_get_farm_aep(row, atmospheres, model):
+    result = annual_energy(row, ROSE, {"night": {"frequency": 1.0,
+                                                 "atmosphere": atmospheres["night"]}},
+                           models=[model], turbulence_intensities="wind_data")
+    reference = row if model == "ekman_veer" else builtin_model(row, model)
+    expected = _floris_aep(reference, ROSE)
+    table = result.table.set_index("stability")
+    assert table.loc["night", "aep_baseline_gwh"] == pytest.approx(expected, rel=1e-12)
+    assert table.loc["all", "aep_baseline_gwh"] == pytest.approx(expected, rel=1e-12)
+    assert np.isnan(table.loc["all", "aep_steered_gwh"])
+
+
+def test_classes_weight_the_rose(row, atmospheres):
+    stability = {"day": {"frequency": 0.3, "atmosphere": atmospheres["day"]},
+                 "night": {"frequency": 0.7, "atmosphere": atmospheres["night"]}}
+    result = annual_energy(row, ROSE, stability, models=["ekman_veer"],
+                           turbulence_intensities="wind_data")
+    alone = {}
+    for name, atmosphere in atmospheres.items():
+        model = copy.deepcopy(row)
+        set_atmosphere(model, atmosphere)
+        alone[name] = _floris_aep(model, ROSE)
+    table = result.table.set_index("stability")["aep_baseline_gwh"]
+    assert table["day"] == pytest.approx(0.3 * alone["day"], rel=1e-12)
+    assert table["night"] == pytest.approx(0.7 * alone["night"], rel=1e-12)
+    assert table["all"] == pytest.approx(0.3 * alone["day"] + 0.7 * alone["night"], rel=1e-12)
+
+
+def test_time_series_records_equal_per_condition_atmosphere(row, atmospheres):
+    directions = np.array([270.0, 268.0, 272.0, 270.0, 275.0, 270.0])
+    speeds = np.array([8.0, 9.0, 10.0, 11.0, 8.0, 9.0])
+    series = TimeSeries(directions, speeds, turbulence_intensities=0.06)
+    records = ["night", "day", "day", "night", "night", "day"]
+    result = annual_energy(row, series, {name: {"atmosphere": a} for name, a in atmospheres.items()},
+                           records=records, models=["ekman_veer"],
+                           turbulence_intensities="wind_data")
+    # The same year as one model with a per-condition atmosphere, through FLORIS's AEP.
+    per_condition = copy.deepcopy(row)
+    mu = [atmospheres[name]["stability_parameter"] for name in records]
+    set_atmosphere(per_condition, dict(atmospheres["night"], stability_parameter=mu),
+                   wind_data=series)
+    per_condition.run()
+    table = result.table.set_index("stability")
+    assert table.loc["all", "aep_baseline_gwh"] == pytest.approx(
+        per_condition.get_farm_AEP() / 1e9, rel=1e-12)
+    assert table.loc["day", "frequency"] == pytest.approx(0.5)
+    assert table.loc["day", "n_conditions"] == 3
+
+
+def test_steered_energy_is_the_optimisers_power(row, atmospheres):
+    stability = {"day": {"frequency": 0.5, "atmosphere": atmospheres["day"]},
+                 "night": {"frequency": 0.5, "atmosphere": atmospheres["night"]}}
+    result = annual_energy(row, ROSE, stability, YawOptimizationSR, models=["ekman_veer", "gch"],
+                           progress=False, **YAW)
+    freq = ROSE.unpack_freq()
+    for (model, name), df_opt in result.optima.items():
+        row_ = result.table.set_index(["model", "stability"]).loc[(model, name)]
+        expected = 0.5 * energy.HOURS_PER_YEAR * np.sum(freq * df_opt["farm_power_opt"]) / 1e9
+        assert row_["aep_steered_gwh"] == pytest.approx(expected, rel=1e-12)
+        assert row_["aep_steered_gwh"] >= row_["aep_baseline_gwh"] * (1 - 1e-12)
+    # Every model on the same inflow: the class's I_u(z_h) per condition, for both models.
+    for name, atmosphere in atmospheres.items():
+        expected = builtin_inflow_settings(atmosphere, ROSE.unpack_for_reinitialize()[1], 90.0,
+                                           90.0, float(row.core.farm.rotor_diameters.flat[0]))
+        for model in ("ekman_veer", "gch"):
+            np.testing.assert_allclose(result.inflow[model, name]["turbulence_intensities"],
+                                       expected["turbulence_intensities"], rtol=1e-12)
+        assert result.inflow["gch", name]["wind_veer"] == pytest.approx(
+            np.mean(expected["wind_veer"]), rel=1e-12)
+    assert result.inflow["gch", "night"]["wind_veer"] > 20.0 > result.inflow["gch", "day"]["wind_veer"]
+    ax = result.plot()
+    assert len(ax.patches) == 2 * 2 * 3  # (baseline, gain) x models x (day, night, all)
+
+
+# ------------------------------------------------------------------------- bad input
+
+
+@pytest.fixture
+def no_work(monkeypatch):
+    """Fail if any class model is built: the errors must come before any work."""
+    def fail(*args, **kwargs):
+        raise AssertionError("a FLORIS model was built before the input was checked")
+
+    monkeypatch.setattr(energy, "_class_model", fail)
+
+
+def _classes(atmospheres, **changes):
+    stability = {"day": {"frequency": 0.4, "atmosphere": atmospheres["day"]},
+                 "night": {"frequency": 0.6, "atmosphere": atmospheres["night"]}}
+    for name, entry in changes.items():
+        stability[name] = entry
+    return stability
+
+
+@pytest.mark.parametrize("case, match", [
+    ("sum", r"must sum to 1; got 0\.9 \('day': 0\.4, 'night': 0\.5\)"),
+    ("unknown_key", r"stability\['night'\]: unknown key\(s\) \['freq'\]"),
+    ("negative", r"stability\['night'\]\['frequency'\] must be a number in \[0, 1\], got -0\.6"),
+    ("atmosphere_key", r"stability\['night'\]\['atmosphere'\]: .*unknown key\(s\) \['mu'\]"),
+    ("per_condition", r"stability\['night'\]\['atmosphere'\] must hold scalars"),
+    ("no_atmosphere", r"stability\['night'\]\['atmosphere'\] must be a mapping"),
+])
+def test_bad_stability_distribution(row, atmospheres, no_work, case, match):
+    night = atmospheres["night"]
+    entry = {
+        "sum": {"frequency": 0.5, "atmosphere": night},
+        "unknown_key": {"frequency": 0.6, "freq": 0.6, "atmosphere": night},
+        "negative": {"frequency": -0.6, "atmosphere": night},
+        "atmosphere_key": {"frequency": 0.6, "atmosphere": dict(night, mu=1.0)},
+        "per_condition": {"frequency": 0.6,
+                          "atmosphere": dict(night, stability_parameter=[0.0] * 6)},
+        "no_atmosphere": {"frequency": 0.6},
+    }[case]
+    with pytest.raises(ValueError, match=match):
+        annual_energy(row, ROSE, _classes(atmospheres, night=entry), YawOptimizationSR)
+
+
+def test_bad_records(row, atmospheres, no_work):
+    series = TimeSeries(np.full(3, 270.0), np.full(3, 8.0), turbulence_intensities=0.06)
+    classes = {name: {"atmosphere": a} for name, a in atmospheres.items()}
+    with pytest.raises(ValueError, match=r"records\[1\] = 'dusk' is not a class"):
+        annual_energy(row, series, classes, records=["day", "dusk", "night"])
+    with pytest.raises(ValueError, match=r"one stability class per TimeSeries record \(3\); got 2"):
+        annual_energy(row, series, classes, records=["day", "night"])
+    with pytest.raises(ValueError, match="need a floris.TimeSeries"):
+        annual_energy(row, ROSE, classes, records=["day"] * 6)
+    with pytest.raises(ValueError, match=r"remove 'frequency'"):
+        annual_energy(row, series, _classes(atmospheres), records=["day", "day", "night"])
+
+
+def test_bad_models_and_options(row, atmospheres, no_work):
+    stability = _classes(atmospheres)
+    with pytest.raises(ValueError, match="models must be distinct names"):
+        annual_energy(row, ROSE, stability, models=["ekman_veer", "jensen"])
+    with pytest.raises(ValueError, match="Ny_passes"):
+        annual_energy(row, ROSE, stability, YawOptimizationSR, Ny_passes=[4, 3])
+    with pytest.raises(ValueError, match="without an optimizer_class"):
+        annual_energy(row, ROSE, stability, minimum_yaw_angle=-20.0)
+    with pytest.raises(ValueError, match="turbulence_intensities must be one of"):
+        annual_energy(row, ROSE, stability, turbulence_intensities="input")
+    with pytest.raises(ValueError, match="WindRose or floris.TimeSeries"):
+        annual_energy(row, {"wind_speeds": [8.0]}, stability)
