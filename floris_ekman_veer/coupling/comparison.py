@@ -190,9 +190,9 @@ def native_inflow_set_kwargs(fmodel, z=None, x_bounds=None, y_bounds=None) -> di
     }
 
 
-#: Wake set-ups of FLORIS's example inputs (examples/inputs/gch.yaml, gauss.yaml, cc.yaml of
-#: FLORIS 4.7): model names and the three GCH switches. Their parameter blocks are those of the
-#: input they are applied to (FLORIS's defaults where it has none).
+#: Wake set-ups of FLORIS 4.7's example inputs (gch.yaml, gauss.yaml and cc.yaml in its
+#: examples folder): model names and the three GCH switches. Their parameter blocks are those
+#: of the input they are applied to (FLORIS's defaults where it has none).
 BUILTIN_WAKES = {
     "gch": ({"velocity_model": "gauss", "deflection_model": "gauss"}, True),
     "gauss": ({"velocity_model": "gauss", "deflection_model": "gauss"}, False),
