@@ -118,6 +118,12 @@ def inflow_seen(fmodel, atmospheres_: dict, speed: float) -> pd.DataFrame:
     """What each model is given, per atmosphere, at ``speed``."""
     rows = []
     input_ti = float(fmodel.core.flow_field.turbulence_intensities[0])
+    expansion = fmodel.core.wake.wake_velocity_parameters["ekman_veer"].get("wake_expansion",
+                                                                             "ambient")
+    ekman_use = {
+        "ambient": "k_w (Eq. kw_CNBL_SBL_model) from the ABL's I_u(z_h)",
+        "local_turbulence": "k_w from this TI plus FLORIS's wake-added TI",
+    }.get(expansion, f"wake_expansion: {expansion}")
     for label, atmosphere in atmospheres_.items():
         for name, model in models_on(fmodel, atmosphere, [270.0], speed).items():
             flow_field = model.core.flow_field
@@ -125,8 +131,7 @@ def inflow_seen(fmodel, atmospheres_: dict, speed: float) -> pd.DataFrame:
             rows.append({
                 "atmosphere": label, "model": name,
                 "turbulence_intensity": ti,
-                "used_as": ("k_w of Eq. kw_CNBL_SBL_model from the ABL's I_u(z_h)"
-                            if name == "ekman_veer" else "FLORIS ambient TI"),
+                "used_as": ekman_use if name == "ekman_veer" else "FLORIS ambient TI",
                 "wind_veer_deg": np.nan if name == "ekman_veer" else float(flow_field.wind_veer),
                 "input_file_ti": input_ti,
             })
