@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from floris import FlorisModel
+from floris import FlorisModel, UncertainFlorisModel
 from floris.optimization.yaw_optimization.yaw_optimizer_geometric import YawOptimizationGeometric
 from floris.optimization.yaw_optimization.yaw_optimizer_scipy import YawOptimizationScipy
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
@@ -171,3 +171,48 @@ def test_bad_optimizer_options_fail_before_any_work(monkeypatch, optimizer_class
         optimize_yaw(fmodel, optimizer_class, **options)
     with pytest.raises(ValueError, match="chunk_size"):
         optimize_yaw(fmodel, YawOptimizationSR, chunk_size=0)
+
+
+# ------------------------------------------------------------------ FLORIS's own classes directly
+
+
+@pytest.mark.parametrize("name", sorted(OPTIMIZERS))
+def test_floris_optimizer_classes_accept_per_condition_atmospheres(name):
+    optimizer_class, options = OPTIMIZERS[name]
+    if name == "scipy":  # one SLSQP iteration is enough to compare the two routes
+        options = dict(options, opt_options=dict(maxiter=1, disp=False, ftol=1e-8, eps=0.5))
+    reference = per_class_reference(gch_row, optimizer_class, options)
+    optimizer = optimizer_class(gch_row(per_condition(CLASSES), SPEEDS, DIRECTIONS), **options)
+    result = optimizer.optimize(print_progress=False) if name == "sr" else optimizer.optimize()
+    assert_same_optimum(result, reference)
+    np.testing.assert_array_equal(optimizer.yaw_angles_opt, np.vstack(reference.yaw_angles_opt))
+
+
+def uncertain(build):
+    def make(atmosphere, speeds, directions):
+        return UncertainFlorisModel(build(atmosphere, speeds, directions), wd_std=3.0,
+                                    wd_sample_points=[-3.0, 0.0, 3.0])
+    return make
+
+
+def test_uncertain_floris_model_per_condition_equals_per_class_models():
+    mixed = uncertain(gch_row)(per_condition(CLASSES), SPEEDS, DIRECTIONS)
+    mixed.run()
+    powers = mixed.get_turbine_powers()
+    assert powers.shape == (len(CLASSES), 3)
+    for atmosphere in (NEUTRAL, STABLE):
+        index = [i for i, a in enumerate(CLASSES) if a is atmosphere]
+        alone = uncertain(gch_row)(atmosphere, [SPEEDS[i] for i in index],
+                                   [DIRECTIONS[i] for i in index])
+        alone.run()
+        np.testing.assert_allclose(powers[index], alone.get_turbine_powers(), rtol=1e-12, atol=0)
+    # Conditions 0 and 1 differ only by their atmosphere: not merged by the de-duplication.
+    assert not np.allclose(powers[0], powers[1], rtol=1e-3)
+
+
+def test_yaw_optimisation_of_a_per_condition_uncertain_model_equals_per_class_runs():
+    optimizer_class, options = YawOptimizationSR, dict(OPTIMIZERS["sr"][1], Ny_passes=[3, 2])
+    reference = per_class_reference(uncertain(gch_row), optimizer_class, options)
+    result = optimize_yaw(uncertain(gch_row)(per_condition(CLASSES), SPEEDS, DIRECTIONS),
+                          optimizer_class, **options)
+    assert_same_optimum(result, reference)

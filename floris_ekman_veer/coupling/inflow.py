@@ -30,9 +30,9 @@ Per condition, the ABL is driven by FLORIS's wind speed at ``reference_wind_heig
 ``EkmanABL.from_reference_wind(wind_speeds[:, None, None, None], reference_wind_height, **atm)``,
 solved once for all conditions in one vectorised call. Any atmosphere value may instead be a list
 of length ``n_findex`` (e.g. a day/night cycle of cooling rates); it binds by position to FLORIS's
-conditions. Tools that tile, deduplicate or re-order conditions (UncertainFlorisModel, the yaw
-optimisers) cannot carry such lists and reject them with a ValueError; ParFlorisModel and the
-visualisation methods slice them.
+conditions. ParFlorisModel and the visualisation methods slice them; UncertainFlorisModel, which
+expands and deduplicates conditions, carries them through (coupling/uncertain.py), and the yaw
+optimisers, which tile and mask them, run once per distinct atmosphere (coupling/optimization.py).
 
 What the hook sets
 ------------------
@@ -584,27 +584,6 @@ def _slicing_set_for_viz(method):
     return wrapper
 
 
-def reject_per_condition_atmosphere(core: Core, tool: str) -> None:
-    """Raise ValueError if ``core`` carries per-condition atmosphere lists (for tools that tile,
-    deduplicate or re-order FLORIS's conditions, so that positions no longer match)."""
-    spec = atmosphere_of(core)
-    if spec is not None and spec.n_conditions is not None:
-        raise ValueError(
-            f"{tool} expands, deduplicates or re-orders FLORIS's conditions, so the per-condition "
-            f"lists in {CONFIG_PATH} cannot follow them. Use scalar atmosphere values and build "
-            f"one {tool} per atmosphere."
-        )
-
-
-def _rejecting_per_condition(method, tool: str, fmodel_of):
-    @functools.wraps(method)
-    def wrapper(self, *args, **kwargs):
-        reject_per_condition_atmosphere(fmodel_of(self, *args, **kwargs).core, tool)
-        return method(self, *args, **kwargs)
-
-    return wrapper
-
-
 def _patch(owner, name: str, make_wrapper) -> None:
     """Replace ``owner.name`` by ``make_wrapper(original)`` once (idempotent); the original is
     kept for :func:`uninstall_inflow_hook`."""
@@ -621,15 +600,13 @@ def install_inflow_hook() -> None:
     Patched: ``FlowField.initialize_velocity_field``; ``Core.__attrs_post_init__`` (validation),
     ``Core.initialize_domain``, ``steady_state_atmospheric_condition``, ``solve_for_viz``,
     ``solve_for_points``, ``solve_for_velocity_deficit_profiles`` (atmosphere context);
-    ``FlorisModel.set_for_viz`` (slices per-condition lists); ``UncertainFlorisModel._set_uncertain``
-    and ``YawOptimization.__init__`` (reject per-condition lists). ParFlorisModel's condition
-    splitting is installed, by
-    :func:`floris_ekman_veer.coupling.parallel.install_parallel_hook` (this module does not import
-    that one: imports point one way, docs/coupling.md#parallel-workers).
+    ``FlorisModel.set_for_viz`` (slices per-condition lists). ParFlorisModel's condition
+    splitting, UncertainFlorisModel's expansion and the yaw optimisers are installed by
+    :func:`floris_ekman_veer.coupling.parallel.install_parallel_hook`,
+    :func:`floris_ekman_veer.coupling.uncertain.install_uncertain_hook` and
+    :func:`floris_ekman_veer.coupling.optimization.install_optimizer_hook` (this module imports
+    none of them: imports point one way, docs/coupling.md#parallel-workers).
     """
-    from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
-    from floris.uncertain_floris_model import UncertainFlorisModel
-
     _patch(
         FlowField, "initialize_velocity_field",
         lambda original: functools.wraps(original)(_initialize_velocity_field),
@@ -644,14 +621,6 @@ def install_inflow_hook() -> None:
     ):
         _patch(Core, name, _with_core_atmosphere)
     _patch(FlorisModel, "set_for_viz", _slicing_set_for_viz)
-    _patch(
-        UncertainFlorisModel, "_set_uncertain",
-        lambda m: _rejecting_per_condition(m, "UncertainFlorisModel", lambda s: s.fmodel_unexpanded),
-    )
-    _patch(
-        YawOptimization, "__init__",
-        lambda m: _rejecting_per_condition(m, "a yaw optimiser", lambda s, fmodel, *a, **k: fmodel),
-    )
 
 
 def uninstall_inflow_hook() -> None:

@@ -13,6 +13,7 @@ result of running each distinct atmosphere on its own (tests/test_optimization.p
 
 from __future__ import annotations
 
+import functools
 import inspect
 import warnings
 from collections.abc import Mapping
@@ -21,7 +22,7 @@ import numpy as np
 import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 
-from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
 
 #: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
@@ -249,3 +250,79 @@ def check_optimizer_options(optimizer_class, options: Mapping, n_findex: int, n_
             f"optimize_yaw: {name} option opt_options must be a dict of "
             f"scipy.optimize.minimize options; got {options['opt_options']!r}"
         )
+
+
+# ---------------------------------------------------------------------------------------------
+# FLORIS's optimiser classes on per-condition atmospheres
+
+
+def _optimizer_classes() -> list[type]:
+    """YawOptimization and every subclass defined so far (FLORIS's three are imported here)."""
+    from floris.optimization.yaw_optimization import (  # noqa: F401  (define the subclasses)
+        yaw_optimizer_geometric,
+        yaw_optimizer_scipy,
+        yaw_optimizer_sr,
+    )
+
+    found, pending = [], [YawOptimization]
+    while pending:
+        cls = pending.pop()
+        found.append(cls)
+        pending.extend(cls.__subclasses__())
+    return found
+
+
+def _recording_init(original):
+    """Keep the user's own constructor call (the outermost ``__init__``): its options are those
+    :func:`optimize_yaw` needs to rebuild the optimiser per atmosphere."""
+
+    @functools.wraps(original)
+    def wrapper(self, *args, **kwargs):
+        if type(self).__init__ is wrapper and "_optimize_yaw_options" not in self.__dict__:
+            signature = inspect.signature(original)
+            own, model = list(signature.parameters)[:2]
+            arguments = signature.bind(self, *args, **kwargs).arguments
+            self._optimize_yaw_options = {
+                k: v for k, v in arguments.items() if k not in (own, model)
+            }
+        return original(self, *args, **kwargs)
+
+    return wrapper
+
+
+def _dispatching_optimize(original):
+    """On a per-condition atmosphere, ``optimize()`` is :func:`optimize_yaw` with the options
+    the optimiser was built with; its results are also stored as FLORIS stores them."""
+
+    @functools.wraps(original)
+    def wrapper(self, *args, **kwargs):
+        spec = atmosphere_of(self.fmodel.core)
+        if spec is None or spec.n_conditions is None:
+            return original(self, *args, **kwargs)
+        options = self.__dict__.get("_optimize_yaw_options")
+        if options is None:
+            raise ValueError(
+                f"{type(self).__name__} on a per-condition atmosphere: call "
+                "floris_ekman_veer.optimize_yaw(fmodel, optimizer_class, **options) (the "
+                "options of this subclass's constructor are not known here)"
+            )
+        bound = inspect.signature(original).bind(self, *args, **kwargs).arguments
+        progress = bound.get("print_progress")
+        df = optimize_yaw(self.fmodel, type(self), progress=progress, **options)
+        self.yaw_angles_opt = np.vstack(df.yaw_angles_opt.to_numpy())
+        self.farm_power_opt = (
+            None if df.farm_power_opt.isna().all() else df.farm_power_opt.to_numpy(dtype=float)
+        )
+        return df
+
+    return wrapper
+
+
+def install_optimizer_hook() -> None:
+    """FLORIS's yaw optimiser classes accept per-condition atmospheres (idempotent;
+    ``register()`` calls it): their ``optimize()`` runs :func:`optimize_yaw`."""
+    for cls in _optimizer_classes():
+        if "__init__" in cls.__dict__:
+            _patch(cls, "__init__", _recording_init)
+        if "optimize" in cls.__dict__:
+            _patch(cls, "optimize", _dispatching_optimize)

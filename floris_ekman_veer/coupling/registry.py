@@ -3,10 +3,11 @@
 ``register()`` makes the wake models selectable by name in a FLORIS input
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
 bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
-inflow hook and ParFlorisModel support. Importing ``floris_ekman_veer`` calls it.
+inflow hook and the support of ParFlorisModel, UncertainFlorisModel and the yaw optimisers.
+Importing ``floris_ekman_veer`` calls it.
 
-This is the top of the coupling layer: it imports the model, turbine, inflow and parallel modules,
-and none of them imports it (docs/coupling.md#registry).
+This is the top of the coupling layer: it imports the model, turbine, inflow, parallel, uncertain
+and optimization modules, and none of them imports it (docs/coupling.md#registry).
 """
 
 from __future__ import annotations
@@ -66,7 +67,9 @@ def register() -> None:
         EkmanVeerVelocityDeflection,
         Gaussian2014VelocityDeficit,
     )
+    from floris_ekman_veer.coupling.optimization import install_optimizer_hook
     from floris_ekman_veer.coupling.parallel import install_parallel_hook
+    from floris_ekman_veer.coupling.uncertain import install_uncertain_hook
 
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
                 "velocity_model")
@@ -77,3 +80,5 @@ def register() -> None:
     register_operation_model()
     install_inflow_hook()
     install_parallel_hook()
+    install_uncertain_hook()
+    install_optimizer_hook()
