@@ -36,7 +36,7 @@ SCRIPT = textwrap.dedent(
     def main():
         started = time.perf_counter()
         from distributed import Client, LocalCluster
-        from floris import FlorisModel, WindRose
+        from floris import FlorisModel, UncertainFlorisModel, WindRose
         from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
         from floris_ekman_veer import ParFlorisModel, annual_energy
@@ -103,6 +103,17 @@ SCRIPT = textwrap.dedent(
             out["yaw_steered"] = np.max(np.abs(np.vstack(reference.yaw_angles_opt))).item()
 
             rose = WindRose(np.array([266.0, 274.0]), np.array([9.0]), ti_table=0.06)
+            aep = []
+            for model in (row.copy(), par_row.copy()):
+                model.set(wind_data=rose)
+                model.run()
+                aep.append(model.get_farm_AEP())
+            out["floris_aep"] = abs(aep[1] - aep[0])
+            uncertain = [UncertainFlorisModel(model, wd_std=3.0) for model in (row, par_row)]
+            for model in uncertain:
+                model.run()
+            out["uncertain"] = np.max(np.abs(uncertain[1].get_turbine_powers()
+                                             - uncertain[0].get_turbine_powers())).item()
             atmosphere = inflow.atmosphere_of(row.core).sliced(slice(None))
             stability = {"night": {"frequency": 1.0, "atmosphere": atmosphere}}
             tables = [annual_energy(model, rose, stability, YawOptimizationSR,
@@ -161,6 +172,11 @@ def test_dask_model_in_floris_optimiser(cluster_results):
 def test_dask_model_in_annual_energy(cluster_results):
     assert cluster_results["aep_gain"] > 0.0
     assert cluster_results["aep"] == 0.0
+    assert cluster_results["floris_aep"] == 0.0  # FLORIS's get_farm_AEP on a wind rose
+
+
+def test_dask_model_in_uncertain_floris_model(cluster_results):
+    assert cluster_results["uncertain"] == 0.0
 
 
 # ------------------------------------------------------------------------- bad input
