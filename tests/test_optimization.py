@@ -18,6 +18,7 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer
 from floris_ekman_veer import optimize_yaw
+from floris_ekman_veer.coupling import inflow, registry
 from floris_ekman_veer.coupling.optimization import atmosphere_groups
 
 from conftest import STABLE_ATMOSPHERE, make_config
@@ -216,3 +217,24 @@ def test_yaw_optimisation_of_a_per_condition_uncertain_model_equals_per_class_ru
     result = optimize_yaw(uncertain(gch_row)(per_condition(CLASSES), SPEEDS, DIRECTIONS),
                           optimizer_class, **options)
     assert_same_optimum(result, reference)
+
+
+def test_plain_floris_optimizer_and_uncertain_model_are_bitwise_unchanged():
+    """Without an atmosphere the wrappers of the optimisers and of UncertainFlorisModel are
+    FLORIS's own behaviour, bit for bit."""
+    def outputs():
+        fmodel = gch_row(None, [8.0, 9.0], [270.0, 275.0])
+        df = run_floris(YawOptimizationSR, fmodel, OPTIMIZERS["sr"][1])
+        ufmodel = UncertainFlorisModel(fmodel)
+        ufmodel.run()
+        return np.vstack(df.yaw_angles_opt), df.farm_power_opt.to_numpy(), \
+            ufmodel.get_turbine_powers()
+
+    hooked = outputs()
+    inflow.uninstall_inflow_hook()
+    try:
+        plain = outputs()
+    finally:
+        registry.register()
+    for a, b in zip(hooked, plain, strict=True):
+        np.testing.assert_array_equal(a, b)
