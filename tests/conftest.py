@@ -1,11 +1,31 @@
-"""Shared fixtures: the inflow hook and FLORIS inputs carrying an Ekman atmosphere."""
+"""Shared fixtures: the inflow hook and FLORIS inputs carrying an Ekman atmosphere; the
+hypothesis profiles."""
 
 import copy
+import os
 
 import pytest
 from floris import FlorisModel
+from hypothesis import HealthCheck, Phase, settings
 
 from floris_ekman_veer.coupling import inflow
+
+# Hypothesis profiles, selected by the environment variable HYPOTHESIS_PROFILE (README, "Set up"):
+# "ci" (default): few examples, derandomised (reproducible CI), no example database; "long": the
+# hand run, 2,000 random examples per property test. Tests that fix max_examples themselves keep
+# their count under both. Examples run whole FLORIS farms, hence no deadline; the property
+# suite's valid-by-construction filters discard some draws, hence filter_too_much is allowed.
+_RELAXED = [HealthCheck.too_slow, HealthCheck.filter_too_much]
+# No "explain" phase: it re-runs a failing FLORIS example dozens of times for a coverage report.
+_PHASES = [Phase.explicit, Phase.reuse, Phase.generate, Phase.target, Phase.shrink]
+settings.register_profile(
+    "ci", max_examples=20, deadline=None, derandomize=True, database=None,
+    suppress_health_check=_RELAXED, phases=_PHASES,
+)
+settings.register_profile(
+    "long", max_examples=2000, deadline=None, suppress_health_check=_RELAXED, phases=_PHASES,
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 #: The stable atmosphere of the issue's example (EkmanABL inputs without the wind speed).
 STABLE_ATMOSPHERE = {
