@@ -303,10 +303,12 @@ class _EkmanWakeModel(BaseModel):
         )
         deficit = self.normalised_deficit(wake, abl)
         # FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial. Where
-        # there is no inflow (at and below z0) there is no wake.
+        # there is no inflow (at and below z0) there is no wake. A wake at most stops the flow:
+        # where the Gaussian's tail, scaled by U_h, reaches an inflow slower than itself (next to
+        # the ground, where U(z) -> 0) Delta u is limited to U(z) (docs/wake_model.md#which-velocity-goes-where).
         flowing = (u_initial > 0) & (local_u > 0)
         safe_u = np.where(flowing, u_initial, 1.0)
-        return np.where(flowing, deficit * hub_speed / safe_u, 0.0)
+        return np.where(flowing, np.minimum(deficit * hub_speed / safe_u, 1.0), 0.0)
 
     def wake_thrust_coefficient(self, ct_i, yaw):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
