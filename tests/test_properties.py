@@ -25,7 +25,7 @@ a forward solve that finds no stable boundary layer (it collapses: matching heig
 The equator is excluded by the latitude range. Boundary layers shallower than the rotor are
 kept: they run with a ShallowBoundaryLayerWarning (docs/atmosphere.md) and must be as physical.
 ``hypothesis.event`` counts discards and shallow cases (``--hypothesis-show-statistics``).
-Sample points span z = 0 to 400 m, except that FLORIS's gauss is asked only for z > 0: at z = 0
+Sample points span z = 0 and 1 micrometre to 400 m, except that FLORIS's gauss is asked only for z > 0: at z = 0
 it returns NaN with FLORIS's own power-law inflow too (FLORIS's grid warns of non-positive z).
 
 Profiles (registered in tests/conftest.py): ``ci`` (the default: few examples, derandomised, so
@@ -114,6 +114,10 @@ def layouts(draw):
     return kinds, xy
 
 
+#: Sample heights: the ground itself, or 1 micrometre to 400 m (not the subnormal heights, below
+#: 1e-300 m, that a float draw would otherwise favour).
+heights = st.one_of(st.just(0.0), finite((1e-6, 400.0)))
+
 WAKES = {
     "M-1/M-2": dict(velocity_model="ekman_veer", deflection_model="ekman_veer"),
     "M-3": dict(velocity_model="bastankhah2014", deflection_model="ekman_veer"),
@@ -164,7 +168,7 @@ def cases(draw) -> dict:
             "gch": draw(st.booleans()),
         },
         "points": draw(st.lists(
-            st.tuples(finite((-1000.0, 4000.0)), finite((-1500.0, 1500.0)), finite((0.0, 400.0))),
+            st.tuples(finite((-1000.0, 4000.0)), finite((-1500.0, 1500.0)), heights),
             min_size=1, max_size=12,
         )),
         "plane_height": draw(finite((1.0, 300.0))),
@@ -317,9 +321,32 @@ def test_wake_never_reverses_the_flow_near_the_ground():
     ))
     u = fmodel.sample_flow_at_points(x, y, z)[0]
     abl = floris_ekman_veer.coupling.inflow.solved_atmosphere(fmodel.core.flow_field)
-    ambient = abl.hub_aligned_velocity(z, 100.0, below_roughness="zero")[0].ravel()
+    ambient = abl.hub_aligned_velocity(z, 100.0)[0].ravel()
     assert np.all(ambient > 0.0)
     assert np.all((u >= 0.0) & (u <= ambient * (1 + 1e-12)))
     stopped = u == 0.0
     assert 0 < np.count_nonzero(stopped) < u.size // 4  # the limit acts in a thin layer only
     assert np.max(z[stopped]) < 1.0
+
+
+def test_superposed_wakes_never_reverse_the_flow():
+    """Two CNBL disks in a row: where both wakes are limited to U(z) next to the ground, FLORIS's
+    sum of squares would give (1 - sqrt(2)) U(z); points and planes are bounded by u >= 0
+    (docs/wake_model.md#which-velocity-goes-where), and above that layer they are untouched."""
+    fmodel = FlorisModel("inputs/cnbl.yaml")
+    fmodel.set(layout_x=[0.0, 500.0], layout_y=[0.0, 0.0])
+    x, y, z = (a.ravel() for a in np.meshgrid(
+        np.linspace(600.0, 3000.0, 25), np.linspace(-300.0, 300.0, 21),
+        np.geomspace(0.1 * (1 + 1e-6), 3.0, 20), indexing="ij",
+    ))
+    u = fmodel.sample_flow_at_points(x, y, z)[0]
+    abl = floris_ekman_veer.coupling.inflow.solved_atmosphere(fmodel.core.flow_field)
+    ambient = abl.hub_aligned_velocity(z, 100.0)[0].ravel()
+    assert np.all(ambient > 0.0)
+    assert np.all((u >= 0.0) & (u <= ambient * (1 + 1e-12)))
+    plane = fmodel.calculate_y_plane(0.0, x_resolution=20, z_resolution=15,
+                                     x_bounds=(600.0, 3000.0), z_bounds=(0.1001, 2.0)).df
+    assert plane.u.min() >= 0.0
+    hub = fmodel.sample_flow_at_points(np.linspace(600.0, 3000.0, 25), np.zeros(25),
+                                       np.full(25, 100.0))[0]
+    assert np.all(hub < abl.speed(100.0)) and hub.min() < 0.6 * abl.speed(100.0)  # wakes

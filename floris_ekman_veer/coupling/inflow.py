@@ -490,6 +490,7 @@ def _with_core_atmosphere(method):
     from floris_ekman_veer.coupling import input_checks
 
     points = method.__name__ == "solve_for_points"
+    full_flow = points or method.__name__ == "solve_for_viz"
 
     @functools.wraps(method)
     def wrapper(self: Core, *args, **kwargs):
@@ -500,11 +501,27 @@ def _with_core_atmosphere(method):
                 input_checks.check_points(*args, **kwargs)
         token = _ACTIVE.set(atmosphere)
         try:
-            return method(self, *args, **kwargs)
+            result = method(self, *args, **kwargs)
         finally:
             _ACTIVE.reset(token)
+        if full_flow and input_checks.uses_wake_models(self):
+            result = _without_reversed_flow(self.flow_field, result)
+        return result
 
     return wrapper
+
+
+def _without_reversed_flow(flow_field: FlowField, result):
+    """Superposed wakes at most stop the flow: u = max(u, 0) on a full-flow grid (points, planes)
+    of the package's wake models.
+
+    Each wake's deficit is limited to the local inflow U(z) (the U_h-scaled Gaussian tail exceeds
+    it next to the ground, docs/wake_model.md#which-velocity-goes-where), but FLORIS's
+    sum-of-squares superposition of two such stopped wakes would give (1 - sqrt(2)) U(z). Rotor
+    points lie far above that layer, so turbine grids need no bound.
+    """
+    flow_field.u_sorted = np.maximum(flow_field.u_sorted, 0.0)
+    return None if result is None else np.maximum(result, 0.0)
 
 
 def _validating_post_init(method):
