@@ -103,8 +103,14 @@ def native_copy(fmodel):
 
 
 def test_native_export_reproduces_u_at_rotor_points():
+    """The export carries point values of the profile: at FLORIS's cubature points they are the
+    hook's inflow exactly; on the turbine grid the hook's points carry rotor-cell means instead
+    (docs/coupling.md#rotor-average), which the export cannot."""
     hooked = FlorisModel(make_config("jensen", wind_speeds=SPEEDS, wind_directions=(270.0, 280.0, 300.0)))
+    cubature = {"type": "turbine_cubature_grid", "turbine_grid_points": 3}
+    hooked.set(solver_settings=cubature)
     native = native_copy(hooked)
+    native.set(solver_settings=cubature)
     assert "ekman_veer" not in native.core.wake.wake_velocity_parameters
     for fmodel in (hooked, native):
         fmodel.run()

@@ -45,7 +45,9 @@ What the hook sets
   models divide by u_initial; at z = 0 U = 0, as with FLORIS's power law). Points below the
   ground get 0.
   ``wind_shear`` is ignored (the atmosphere defines the shear); 2-D/3-D heterogeneous speed
-  multipliers, if also given, multiply the profile.
+  multipliers, if also given, multiply the profile. On a ``turbine_grid`` each rotor point gets
+  instead the mean of the profile over its rotor cell, <U^m>^(1/m) with m = 3 (power curves) or
+  1 (the actuator disk) (:mod:`floris_ekman_veer.coupling.rotor`, docs/coupling.md#rotor-average).
 * ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U, by a centred difference of the
   analytic profile (relative step 1e-4: relative error about 1e-8; EkmanABL exposes no analytic
   gradient), 0 below the ground. GCH's secondary steering uses it.
@@ -116,8 +118,14 @@ def _check_floris_version(version: str) -> None:
 
 _check_floris_version(floris.__version__)
 
-from floris.core import Core, FlowField  # noqa: E402  (only after the version check)
+from floris.core import Core, FlowField, TurbineGrid  # noqa: E402  (only after the version check)
 from floris.floris_model import FlorisModel  # noqa: E402
+
+from floris_ekman_veer.coupling.rotor import (  # noqa: E402
+    TURBINE_MOMENTS,
+    turbine_grid_inflow,
+    turbine_moments,
+)
 
 
 PARAMETER_BLOCK = "ekman_veer"
@@ -473,6 +481,11 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
     finally:
         self.wind_shear = wind_shear
     U, dUdz = inflow_profile(abl, grid.z_sorted, self.reference_wind_height)
+    if isinstance(grid, TurbineGrid):
+        # Each rotor point carries the cubic mean of U over its rotor cell (coupling/rotor.py).
+        U = turbine_grid_inflow(
+            lambda z: inflow_profile(abl, z, self.reference_wind_height)[0], grid
+        )
     shape = self.u_initial_sorted.shape
     if self.het_map is not None:
         speed_ups = self.u_initial_sorted / self.wind_speeds[:, None, None, None]
@@ -500,9 +513,12 @@ def _with_core_atmosphere(method):
             if points:
                 input_checks.check_points(*args, **kwargs)
         token = _ACTIVE.set(atmosphere)
+        # Which rotor average each turbine takes (coupling/rotor.py).
+        moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
         try:
             result = method(self, *args, **kwargs)
         finally:
+            TURBINE_MOMENTS.reset(moments)
             _ACTIVE.reset(token)
         if full_flow and input_checks.uses_wake_models(self):
             result = _without_reversed_flow(self.flow_field, result)

@@ -32,12 +32,13 @@ Conventions (docs/conventions.md, docs/coupling.md), each pinned by tests:
 from __future__ import annotations
 
 import warnings
+import weakref
 from typing import Any
 
 import numpy as np
 import attrs
 from attrs import define, field
-from floris.core import BaseModel, FlowField, Grid
+from floris.core import BaseModel, FlowField, Grid, TurbineCubatureGrid, TurbineGrid
 from floris.utilities import rotate_coordinates_rel_west
 
 from floris_ekman_veer._validation import (
@@ -62,8 +63,26 @@ from floris_ekman_veer.coupling.names import (
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
 )
-from floris_ekman_veer.wake.deficit import normalised_deficit
+from floris_ekman_veer.coupling.rotor import (
+    RotorCells,
+    cell_deficit,
+    rotor_cells,
+    rotor_geometry,
+    row_interpolation,
+    ROWS_PER_POINT,
+    rows_profile,
+    sorted_moments,
+    sub_quadrature,
+)
+from floris_ekman_veer.wake.deficit import (
+    CURL_ALPHA,
+    WIDTH_FACTOR,
+    max_deficit,
+    normalised_deficit,
+    stream_tube_area_ratio,
+)
 from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
+from floris_ekman_veer.wake.fused import power_deficit_on_rows, rows_deficit_parameters
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
@@ -75,6 +94,18 @@ GLAUERT_THRUST_COEFFICIENT = 0.96
 #: deep: without the margin a turbine sits in its own wake (tests/test_models.py). FLORIS's gauss
 #: model uses the same 0.1 m.
 ROTOR_PLANE_MARGIN = 0.1
+
+#: A rotor is integrated in a wake where the deficit, with the widest width the wake can have,
+#: exceeds this fraction of U_h somewhere on it; elsewhere the wake is 0 (a power change of at
+#: most 3e-5 of a turbine that sees no other wake, far less where wakes combine).
+NEGLIGIBLE_DEFICIT = 1e-5
+
+#: Pairs (rotor, wake) integrated at once: bounds the sub-point arrays to about 2 MB each.
+PAIR_CHUNK = 1024
+
+#: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
+#: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
+MIN_BAND_PER_ROW = 0.4
 
 
 # --------------------------------------------------------------------------------- shared pieces
@@ -122,6 +153,10 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
     return np.where(heavy, limit, ct)
 
 
+#: The latest Ambient, keyed by the identities of its grid, flow field and inflow array.
+_AMBIENTS: dict = {}
+
+
 @define(frozen=True)
 class Ambient:
     """The ambient atmosphere of one FLORIS grid, evaluated once per model preparation.
@@ -146,12 +181,28 @@ class Ambient:
     turbine_y: np.ndarray
     turbine_hub_heights: np.ndarray  # (n_turbines,)
     floris_turbulence: np.ndarray  # FLORIS's ambient turbulence intensity, (n_findex, 1, 1, 1)
+    rotor: RotorAmbient | None = None  # turbine grids: the rotor cells (coupling/rotor.py)
+    #: Cubature grids: points per rotor side N (FLORIS's quadrature of point values), else None.
+    cubature_points: int | None = None
+    warned: set = field(factory=set)  # resolution warnings already given in this solve
 
     @classmethod
     def of(cls, grid: Grid, flow_field: FlowField) -> Ambient:
+        """The ambient of ``grid`` for ``flow_field``'s current inflow, shared by the velocity
+        and deflection models of one solve (built once per flow-field initialisation)."""
+        key = (id(grid), id(flow_field), id(flow_field.u_initial_sorted))
+        cached = _AMBIENTS.get(key)
+        if cached is not None and cached[0]() is grid and cached[1]() is flow_field:
+            return cached[2]
+        ambient = cls._build(grid, flow_field)
+        _AMBIENTS.clear()  # one solve at a time: keep only the latest
+        _AMBIENTS[key] = (weakref.ref(grid), weakref.ref(flow_field), ambient)
+        return ambient
+
+    @classmethod
+    def _build(cls, grid: Grid, flow_field: FlowField) -> Ambient:
         abl = solved_atmosphere(flow_field)
         reference_height = flow_field.reference_wind_height
-        u, v = ambient_velocity(abl, grid.z_sorted, reference_height)
         coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
         hub_heights = np.unique(coordinates[:, 2])
         u_hub, v_hub = abl.hub_aligned_velocity(hub_heights.reshape(1, 1, 1, -1), reference_height)
@@ -159,12 +210,21 @@ class Ambient:
         x, y, _, _, _ = rotate_coordinates_rel_west(flow_field.wind_directions, coordinates)
         n_findex = len(flow_field.wind_directions)
         shape = (n_findex, hub_heights.size)
+        rotor = RotorAmbient.of(grid, abl, reference_height) if is_rotor_grid(grid) else None
+        if rotor is None:
+            u, v = ambient_velocity(abl, grid.z_sorted, reference_height)
+        else:
+            # The cell path needs the ambient at the sub-point rows only; the deflection model's
+            # point values (for models that read them) need it at the grid's heights, which on a
+            # turbine grid are those of the rotor's point rows.
+            u, v = ambient_velocity(abl, grid.z_sorted[:, :, :1, :], reference_height)
         return cls(
             abl, u, v, hub_heights,
             *(np.broadcast_to(a, (n_findex, 1, 1, hub_heights.size)).reshape(shape)
               for a in (speed, u_hub / speed, v_hub / speed)),
             x, y, coordinates[:, 2],
             np.asarray(flow_field.turbulence_intensities, dtype=float).reshape(-1, 1, 1, 1),
+            rotor, grid.grid_resolution if isinstance(grid, TurbineCubatureGrid) else None,
         )
 
     def hub_height_at(self, x_i, y_i):
@@ -172,18 +232,62 @@ class Ambient:
         distance = (self.turbine_x - x_i[:, 0, 0]) ** 2 + (self.turbine_y - y_i[:, 0, 0]) ** 2
         return self.turbine_hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
 
-    def at_hub(self, hub_height):
-        """U_h and the ambient (U, V) at the grid in the frame where V(hub_height) = 0
-        (docs/conventions.md#hub-aligned-frame): FLORIS's frame rotated by the hub-height direction."""
+    def hub_frame(self, hub_height):
+        """U_h and the direction (cos, sin) of the wind at ``hub_height`` in FLORIS's frame
+        (shapes (n_findex, 1, 1, 1))."""
         if np.any(hub_height <= self.abl.roughness_length):
             raise ValueError("hub_height must be above the atmosphere's roughness_length")
         rows = np.arange(hub_height.shape[0])
         column = np.searchsorted(self.hub_heights, hub_height[:, 0, 0, 0])
         pick = lambda table: table[rows, column][:, None, None, None]  # noqa: E731
-        cos_a, sin_a = pick(self.hub_cos), pick(self.hub_sin)
+        return pick(self.hub_speed), pick(self.hub_cos), pick(self.hub_sin)
+
+    def at_hub(self, hub_height):
+        """U_h and the ambient (U, V) at the grid in the frame where V(hub_height) = 0
+        (docs/conventions.md#hub-aligned-frame): FLORIS's frame rotated by the hub-height direction."""
+        hub_speed, cos_a, sin_a = self.hub_frame(hub_height)
         u = self.u * cos_a + self.v * sin_a
         v = self.v * cos_a - self.u * sin_a
-        return pick(self.hub_speed), u, v
+        return hub_speed, u, v
+
+
+def is_rotor_grid(grid: Grid) -> bool:
+    """FLORIS's turbine grid (n x n points per rotor, equal-weight cubic mean): the grid on which
+    the models return rotor-cell averages (docs/coupling.md#rotor-average)."""
+    return isinstance(grid, TurbineGrid)
+
+
+@define(frozen=True)
+class RotorAmbient:
+    """The rotor cells of a turbine grid (coupling/rotor.py) and the ambient at their rows.
+
+    Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
+    radius; per sub-point row (n_findex, n_turbines, rows): height and the ambient (U, V) in
+    FLORIS's frame (U is FLORIS's inflow component, V the lateral one).
+    """
+
+    cells: RotorCells
+    moment: np.ndarray  # (n_findex, n_turbines): 3 (cubic mean) or 1 (plain mean), rotor.py
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    radius: np.ndarray
+    u_rows: np.ndarray
+    v_rows: np.ndarray
+    warned: set = field(factory=set)
+
+    @classmethod
+    def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
+        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(grid.grid_resolution))
+        x, y, z, radius, _ = rotor_geometry(grid)
+        u, v = rows_profile(
+            lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
+        )
+        return cls(cells, sorted_moments(grid), x, y, z, radius, u, v)
+
+    def row_heights(self, f=slice(None), j=slice(None)):
+        """Heights of the sub-point rows of rotors (f, j) (index arrays): (pairs, rows)."""
+        return self.z[f, j][..., None] + self.radius[f, j][..., None] * self.cells.row_z
 
 
 @define(frozen=True)
@@ -200,6 +304,7 @@ class _TurbineWake:
     k_w: np.ndarray
     local_u: np.ndarray
     local_v: np.ndarray
+    friction_velocity: np.ndarray
 
 
 @define
@@ -283,9 +388,19 @@ class _EkmanWakeModel(BaseModel):
         u_initial: np.ndarray,
         ambient: Ambient,
     ) -> np.ndarray:
-        """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid."""
+        """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid.
+
+        On a turbine grid, the rotor-cell deficit d_k of each point (docs/coupling.md#rotor-average);
+        on other grids (planes, points, cubature), the point value.
+        """
         abl = ambient.abl
         yaw = np.deg2rad(yaw_angle_i)
+        ct = self.wake_thrust_coefficient(ct_i, yaw)
+        if ambient.rotor is not None:
+            return self._rotor_cell_deficit(
+                x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, 0.5 * rotor_diameter_i,
+                turbulence_intensity_i, u_initial, ambient,
+            )
         hub_speed, local_u, local_v = ambient.at_hub(hub_height_i)
         dx = x - x_i
         wake = _TurbineWake(
@@ -293,15 +408,18 @@ class _EkmanWakeModel(BaseModel):
             dy=y - y_i - deflection_field_i,
             dz=z - hub_height_i,
             yaw=yaw,
-            ct=self.wake_thrust_coefficient(ct_i, yaw),
+            ct=ct,
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
             k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i,
                                     ambient.floris_turbulence),
             local_u=local_u,
             local_v=local_v,
+            friction_velocity=abl.friction_velocity,
         )
-        deficit = self.normalised_deficit(wake, abl)
+        if ambient.cubature_points is not None:
+            self._check_cubature(wake, deflection_field_i, ambient)
+        deficit = self.normalised_deficit(wake)
         # FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial. Where
         # there is no inflow (at and below z0) there is no wake. A wake at most stops the flow:
         # where the Gaussian's tail, scaled by U_h, reaches an inflow slower than itself (next to
@@ -314,7 +432,152 @@ class _EkmanWakeModel(BaseModel):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
-    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+    def _rotor_cell_deficit(
+        self, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+        turbulence_intensity_i, u_initial, ambient,
+    ):
+        """d_k of every rotor cell of the grid in turbine i's wake (coupling/rotor.py).
+
+        Only the rotors downstream of turbine i that its wake can reach (the deficit's Gaussian
+        above exp(-REACH^2/2) somewhere on the rotor, with the widest possible width) are
+        integrated; the others get 0.
+        """
+        rotor = ambient.rotor
+        cells = rotor.cells
+        n_findex, n_turbines = rotor.x.shape
+        result = np.zeros((n_findex, n_turbines, cells.n**2))
+        dx = rotor.x - x_i[:, 0, 0]
+        f, j = np.nonzero(dx > ROTOR_PLANE_MARGIN)
+        if f.size == 0:
+            return result.reshape(u_initial.shape)
+        abl = ambient.abl
+        hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
+        k_w = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i,
+                                  ambient.floris_turbulence)
+        rows = getattr(deflection_field_i, "rows", None)
+        if rows is None:
+            # Another deflection model: its centre at the point rows, interpolated in height.
+            centre = deflection_field_i[f, j, 0, :] @ row_interpolation(cells.n, cells.row_z)
+        else:
+            centre = rows[f, j]
+        lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
+        dz = rotor.row_heights(f, j) - hub_height_i[f, 0, 0, 0][:, None]
+        radius_j = rotor.radius[f, j][:, None]
+        gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
+        pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+        x_pair = dx[f, j]
+        width = self.width_bound(x_pair, pick(k_w), pick(radius_i), pick(ct), pick(yaw))
+        # The deficit C(x) exp(-gap / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
+        # 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
+        amplitude = self.amplitude_bound(x_pair, pick(k_w), pick(radius_i), pick(ct), pick(yaw))
+        reach = np.min(gap, axis=1) < 2.0 * width**2 * np.log(
+            np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT
+        )
+        f, j, x_pair = f[reach], j[reach], x_pair[reach]
+        lateral, dz, radius_j, centre = lateral[reach], dz[reach], radius_j[reach], centre[reach]
+        per_pair = {
+            "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
+            "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
+        }
+        per_pair = {k: pick(v)[:, None, None] for k, v in per_pair.items()}  # f: reached pairs
+        # In chunks of pairs, so that the sub-point arrays stay small (peak memory).
+        for start in range(0, f.size, PAIR_CHUNK):
+            chunk = slice(start, start + PAIR_CHUNK)
+            fc, jc = f[chunk], j[chunk]
+            pair = {k: v[chunk] for k, v in per_pair.items()}
+            u_rows, v_rows = rotor.u_rows[fc, jc][..., None], rotor.v_rows[fc, jc][..., None]
+            wake = _TurbineWake(
+                dx=x_pair[chunk, None, None],
+                dy=lateral[chunk, :, None] + radius_j[chunk, :, None] * cells.sub_y,
+                dz=dz[chunk, :, None],
+                yaw=pair["yaw"],
+                ct=pair["ct"],
+                radius=pair["radius"],
+                hub_speed=pair["hub_speed"],
+                k_w=pair["k_w"],
+                local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
+                local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
+                friction_velocity=pair["friction_velocity"],
+            )
+            self._check_resolution(wake, centre[chunk], radius_j[chunk], cells, rotor.warned)
+            # No flow (at and below z0): no wake.
+            ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
+            moment = rotor.moment[fc, jc][:, None, None]
+            power_deficit = self.power_deficit(wake, ambient_u, cells.weight, moment)
+            result[fc, jc] = cell_deficit(
+                power_deficit, u_initial[fc, jc].reshape(fc.size, -1), moment[:, 0], cells
+            )
+        return result.reshape(u_initial.shape)
+
+    def power_deficit(self, wake: _TurbineWake, ambient_u, weight, moment) -> np.ndarray:
+        """weight (U^m - (U - Delta u)^m) of the wake at the sub-points, m = ``moment`` (3 or 1;
+        coupling/rotor.py)."""
+        du = self.normalised_deficit(wake) * wake.hub_speed
+        removed = np.where(moment == 3.0, ambient_u**3 - (ambient_u - du) ** 3, du)
+        return np.where(ambient_u > 0, weight * removed, 0.0)
+
+    def amplitude_bound(self, x, k_w, radius, ct, yaw):
+        """The largest deficit Delta u / U_h of the wake at x: C(x), Eq. (Cx)."""
+        return max_deficit(x, k_w, radius, ct, yaw)
+
+    def width_bound(self, x, k_w, radius, ct, yaw):
+        """An upper bound of the wake width sigma(theta, x) over all polar angles [m]."""
+        r_tube = radius * np.sqrt(stream_tube_area_ratio(ct, yaw))
+        return k_w * x + WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)
+
+    def _check_cubature(self, wake, deflection_field, ambient):
+        """Warn once per solve when, on a cubature grid (point values), a wake band within reach
+        of a rotor is thinner than the spacing of its points, 2 R / N."""
+        if "cubature" in ambient.warned:
+            return
+        downstream = wake.dx[..., 0, 0] > 0.0  # (n_findex, n_turbines)
+        if not np.any(downstream):
+            return
+        radius = np.broadcast_to(wake.radius[..., 0, 0], downstream.shape)
+        width = self.width_bound(wake.dx[..., 0, 0], wake.k_w[..., 0, 0], radius,
+                                 wake.ct[..., 0, 0], wake.yaw[..., 0, 0]) / (1.0 + CURL_ALPHA)
+        centre = np.asarray(deflection_field)
+        spread = np.max(centre, axis=(2, 3)) - np.min(centre, axis=(2, 3))
+        height = np.max(wake.dz, axis=(2, 3)) - np.min(wake.dz, axis=(2, 3))
+        shear = spread / np.where(height > 0, height, 1.0)
+        thickness = width / np.sqrt(1.0 + shear**2)
+        near = downstream & (np.min(np.abs(wake.dy), axis=(2, 3)) < 3.0 * width + radius)
+        spacing = 2.0 * radius / ambient.cubature_points
+        if np.any(near & (thickness < spacing)):
+            ambient.warned.add("cubature")
+            warnings.warn(
+                "a wake band is thinner than the spacing of the turbine_cubature_grid points "
+                f"(N = {ambient.cubature_points}), whose point values cannot resolve it: use "
+                "solver type turbine_grid (rotor-cell averages, docs/coupling.md#rotor-average)",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+
+    def _check_resolution(self, wake, centre, radius_j, cells, warned):
+        """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
+        if "rows" in warned:
+            return
+        width = wake.k_w[:, 0, 0] * wake.dx[:, 0, 0] + WIDTH_FACTOR * wake.radius[:, 0, 0] * np.sqrt(
+            stream_tube_area_ratio(wake.ct[:, 0, 0], wake.yaw[:, 0, 0])
+        ) * np.cos(wake.yaw[:, 0, 0])
+        height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
+        shear = np.abs(centre[:, -1] - centre[:, 0]) / height
+        thickness = width / np.sqrt(1.0 + shear**2)
+        spacing = 2.0 * radius_j[:, 0] / cells.rows
+        if np.any(thickness < MIN_BAND_PER_ROW * spacing):
+            warned.add("rows")
+            ratio = float(np.min(thickness / spacing))
+            warnings.warn(
+                f"a veer-sheared wake band is {ratio:.2f} sub-row spacings thin on a rotor, "
+                f"below the {MIN_BAND_PER_ROW} that its rotor-cell average resolves to 1 % in "
+                f"power: raise solver.turbine_grid_points (now {cells.n}; the cells' "
+                f"sub-quadrature has {cells.rows} rows per rotor, {ROWS_PER_POINT} per grid "
+                "point)",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+
+    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
         """Delta u / U_h of one wake; each model defines it."""
         raise NotImplementedError("BaseModel.normalised_deficit")
 
@@ -342,7 +605,18 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
-    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+    def power_deficit(self, wake: _TurbineWake, ambient_u, weight, moment) -> np.ndarray:
+        if self.polar_angle_centre != "wake_centre":
+            return super().power_deficit(wake, ambient_u, weight, moment)
+        # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
+        parameters = rows_deficit_parameters(
+            wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw, wake.friction_velocity,
+            wake.hub_speed, np.where(wake.local_u > 0, wake.local_u, 1.0), curl=self.curl,
+        )
+        return power_deficit_on_rows(wake.dy, wake.dz, parameters, wake.hub_speed, ambient_u,
+                                     weight, moment)
+
+    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0
         safe_u = np.where(flowing, wake.local_u, 1.0)
         polar_dy = None
@@ -352,7 +626,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
             )
         return normalised_deficit(
             wake.dx, wake.dy, wake.dz, k_w=wake.k_w, radius=wake.radius, ct=wake.ct,
-            yaw=wake.yaw, friction_velocity=abl.friction_velocity, hub_speed=wake.hub_speed,
+            yaw=wake.yaw, friction_velocity=wake.friction_velocity, hub_speed=wake.hub_speed,
             local_speed=safe_u, curl=self.curl, polar_dy=polar_dy,
         )
 
@@ -401,16 +675,61 @@ class EkmanVeerVelocityDeflection(BaseModel):
         # Without the vortex pair the yaw term vanishes: the offset is that of an unyawed rotor.
         yaw = np.deg2rad(yaw_i) if self.yaw_deflection else np.zeros_like(yaw_i, dtype=float)
         ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
-        hub_speed, local_u, local_v = ambient.at_hub(hub_height)
+        radius = 0.5 * rotor_diameter_i
+        if ambient.rotor is None:
+            hub_speed, local_u, local_v = ambient.at_hub(hub_height)
+            return self._offset(x - x_i, z, hub_height, radius, ct, yaw, hub_speed, local_u,
+                                local_v, ambient.abl.friction_velocity)
+        # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
+        # heights and at the rows of the rotor cells (coupling/rotor.py), downstream of turbine i
+        # only (upstream there is no wake: 0).
+        rotor = ambient.rotor
+        n_points = z.shape[-1]
+        hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
+        u = np.concatenate([np.broadcast_to(ambient.u[:, :, 0, :], z[:, :, 0, :].shape),
+                            rotor.u_rows], axis=-1)
+        v = np.concatenate([np.broadcast_to(ambient.v[:, :, 0, :], z[:, :, 0, :].shape),
+                            rotor.v_rows], axis=-1)
+        heights = np.concatenate([z[:, :, 0, :], rotor.row_heights()], axis=-1)
+        offsets = np.zeros(heights.shape)
+        dx = rotor.x - x_i[:, 0, 0]
+        f, j = np.nonzero(dx > 0.0)
+        if f.size:
+            column = lambda a: np.broadcast_to(a, yaw.shape)[f, 0, 0, 0][:, None]  # noqa: E731
+            cos_p, sin_p = column(cos_a), column(sin_a)
+            u_p, v_p = u[f, j], v[f, j]
+            offsets[f, j] = self._offset(
+                dx[f, j][:, None], heights[f, j], column(hub_height), column(radius),
+                column(ct), column(yaw), column(hub_speed), u_p * cos_p + v_p * sin_p,
+                v_p * cos_p - u_p * sin_p, column(ambient.abl.friction_velocity),
+            )
+        field_ = np.broadcast_to(offsets[:, :, None, :n_points], z.shape).view(RotorDeflection)
+        field_.rows = offsets[:, :, n_points:]
+        return field_
+
+    def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):
         flowing = local_u > 0
         offset = wake_centre_offset(
-            x - x_i, z, hub_height=hub_height, radius=0.5 * rotor_diameter_i, ct=ct, yaw=yaw,
-            friction_velocity=ambient.abl.friction_velocity, hub_speed=hub_speed,
+            dx, z, hub_height=hub_height, radius=radius, ct=ct, yaw=yaw,
+            friction_velocity=u_star, hub_speed=hub_speed,
             local_speed=np.where(flowing, local_u, 1.0),
             lateral_speed=np.where(flowing, local_v, 0.0), veer=self.veer,
             ground_image=self.ground_image,
         )
         return np.where(flowing, offset, 0.0)
+
+
+class RotorDeflection(np.ndarray):
+    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying in ``rows`` the
+    centre at the rows of the rotor cells' sub-quadrature (n_findex, n_turbines, rows), for the
+    velocity model's rotor-cell average. Arithmetic on it gives plain arrays (FLORIS's own
+    velocity models read it as the point field it is)."""
+
+    rows = None
+
+    def __array_wrap__(self, array, context=None, return_scalar=False):
+        result = array.view(np.ndarray)
+        return result[()] if return_scalar else result
 
 
 # --------------------------------------------------------------------------------- M-3
@@ -441,7 +760,14 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
         """Rotor-normal loading C_T cos^2(yaw), limited like M-1's (see the class docstring)."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient) * np.cos(yaw) ** 2
 
-    def normalised_deficit(self, wake: _TurbineWake, abl) -> np.ndarray:
+    def amplitude_bound(self, x, k_w, radius, ct, yaw):
+        return 1.0  # C <= 2a < 1
+
+    def width_bound(self, x, k_w, radius, ct, yaw):
+        k_star = k_w if self.k_star is None else self.k_star
+        return k_star * x + WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, 0.0))
+
+    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star
         diameter = 2.0 * wake.radius
         return bastankhah2014_deficit(

@@ -1,0 +1,159 @@
+"""Convergence of the rotor average on single wakes (hand-run study, not a test):
+
+    python benchmarks/bench_rotor_average.py [--reference 48x192] [--quick]
+
+For one upstream turbine and one downstream rotor, the downstream rotor's average velocity from
+each FLORIS rotor quadrature against a converged integral of the same wake over the rotor disk:
+
+* reference: a polar quadrature of the disk (Gauss-Legendre in r^2 x uniform angles, default
+  48 x 192 points, ``--reference``) of ``sample_flow_at_points`` (point values of the flow: the
+  ambient profile minus the wake), disk normal to the wind, averaged as the turbine's operation
+  model averages: the cubic mean <u^3>^(1/3) for the NREL 5 MW power curve, the plain mean <u>
+  for the paper's actuator disk (Eq. Ud);
+* ``3x3 points``: the 3 x 3 point values at +-R/2 that FLORIS's turbine grid samples, averaged
+  the same way (FLORIS's turbine grid without rotor cells);
+* ``3x3 cells``: FLORIS's ``turbine_grid`` with 3 x 3 points as shipped in ``inputs/``, every point
+  carrying its rotor cell's average (docs/coupling.md#rotor-average);
+* ``cubature N``: FLORIS's ``turbine_cubature_grid`` (point values, FLORIS's cubature mean).
+
+Error: power error (u / u_ref)^3 - 1. Cases (the issue list): the paper's actuator disk in CNBL,
+SBL-4 and SBL-6 (``inputs/cnbl.yaml``, ``sbl4.yaml``, ``sbl6.yaml``) and the NREL 5 MW farm
+input (``inputs/farm_sbl6.yaml``, 9 m/s at 90 m); veer on and off (M-1, M-2); upstream yaw 0 and
++-20 deg; downstream rotor 5, 7, 10, 15 D behind, laterally offset -1.5 D to +1.5 D in steps of
+0.25 D. Prints the largest |error| per input, veer and quadrature (the README's table) and the
+worst case. ``--quick`` uses steps of 0.5 D and 5 and 10 D only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+try:
+    import floris_ekman_veer  # noqa: F401
+except ImportError:
+    sys.path.insert(0, str(REPOSITORY))
+    import floris_ekman_veer  # noqa: F401
+
+from floris import FlorisModel  # noqa: E402
+from floris.utilities import load_yaml  # noqa: E402
+
+INPUTS = {"CNBL disk": "cnbl.yaml", "SBL-4 disk": "sbl4.yaml", "SBL-6 disk": "sbl6.yaml",
+          "NREL 5 MW, farm input": "farm_sbl6.yaml"}
+YAWS = (0.0, 20.0, -20.0)
+QUADRATURES = ("3x3 points", "3x3 cells", "cubature 3", "cubature 5")
+
+
+def disk_quadrature(n_radial: int, n_angle: int):
+    """Unit-disk nodes (y, z) and weights (summing to 1): Gauss-Legendre in r^2, uniform angle."""
+    x, w = np.polynomial.legendre.leggauss(n_radial)
+    r = np.sqrt(0.5 * (x + 1.0))
+    theta = (np.arange(n_angle) + 0.5) * 2.0 * np.pi / n_angle
+    rr, tt = np.meshgrid(r, theta, indexing="ij")
+    weight = np.outer(0.5 * w, np.full(n_angle, 1.0 / n_angle))
+    return (rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel(), weight.ravel()
+
+
+def mean(u, weight, moment):
+    """The operation model's rotor average of ``u`` (..., points) with ``weight``."""
+    return np.sum(weight * u, -1) if moment == 1 else np.cbrt(np.sum(weight * u**3, -1))
+
+
+def single_wake_errors(input_name, veer, distance, offset, reference, solver=None):
+    """Power errors of the downstream rotor for the upstream yaws YAWS: dict quadrature ->
+    (n_yaw,) array. ``solver`` restricts to one FLORIS quadrature (None: all)."""
+    config = load_yaml(REPOSITORY / "inputs" / input_name)
+    config["wake"]["wake_deflection_parameters"].setdefault("ekman_veer", {})["veer"] = veer
+    probe = FlorisModel(copy.deepcopy(config))
+    diameter = float(probe.core.farm.rotor_diameters[0])
+    hub = float(probe.core.farm.hub_heights[0])
+    plain = probe.core.farm.turbine_definitions[0].get("operation_model") == "actuator-disk"
+    moment = 1 if plain else 3
+    config["farm"]["layout_x"] = [0.0, distance * diameter]
+    config["farm"]["layout_y"] = [0.0, offset * diameter]
+    if len(config["farm"]["turbine_type"]) == 1:
+        config["farm"]["turbine_type"] = config["farm"]["turbine_type"] * 2
+    n = len(YAWS)
+    flow = config["flow_field"]
+    conditions = dict(
+        wind_directions=[270.0] * n, wind_speeds=[flow["wind_speeds"][0]] * n,
+        turbulence_intensities=[flow["turbulence_intensities"][0]] * n,
+    )
+    yaw = np.stack([np.array(YAWS), np.zeros(n)], axis=1)
+    y, z, weight = reference
+    radius = 0.5 * diameter
+
+    def sampled(ys, zs):
+        fmodel = FlorisModel(copy.deepcopy(config))
+        fmodel.set(**conditions, yaw_angles=yaw)
+        return fmodel.sample_flow_at_points(np.full(ys.size, distance * diameter),
+                                            offset * diameter + radius * ys, hub + radius * zs)
+
+    u_ref = mean(sampled(y, z), weight, moment)
+    errors = {}
+    for quadrature in QUADRATURES:
+        if solver is not None and quadrature != solver:
+            continue
+        if quadrature == "3x3 points":
+            g = np.linspace(-0.5, 0.5, 3)
+            gy, gz = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+            u = mean(sampled(gy, gz), np.full(9, 1.0 / 9.0), moment)
+        else:
+            fmodel = FlorisModel(copy.deepcopy(config))
+            if quadrature == "3x3 cells":
+                settings = {"type": "turbine_grid", "turbine_grid_points": 3}
+            else:
+                settings = {"type": "turbine_cubature_grid",
+                            "turbine_grid_points": int(quadrature.split()[1])}
+            fmodel.set(**conditions, yaw_angles=yaw, solver_settings=settings)
+            fmodel.run()
+            u = fmodel.turbine_average_velocities[:, 1]
+            if moment == 1:  # the actuator disk's plain mean of the rotor points (or cubature)
+                velocities = fmodel.core.flow_field.u[:, 1].reshape(n, -1)
+                w = fmodel.core.grid.cubature_weights
+                w = np.full(velocities.shape[1], 1.0 / velocities.shape[1]) if w is None \
+                    else w.ravel() / w.sum()
+                u = np.sum(velocities * w, axis=-1)
+        errors[quadrature] = (u / u_ref) ** 3 - 1.0
+    return errors
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--reference", default="48x192")
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args(argv)
+    reference = disk_quadrature(*(int(v) for v in args.reference.split("x")))
+    distances = (5.0, 10.0) if args.quick else (5.0, 7.0, 10.0, 15.0)
+    offsets = np.arange(-1.5, 1.51, 0.5 if args.quick else 0.25)
+    warnings.simplefilter("ignore", RuntimeWarning)
+    print(f"Single-wake rotor averages against a {args.reference} polar disk integral; power "
+          f"error (u/u_ref)^3 - 1, largest |error| over yaw {YAWS} deg, downstream "
+          f"{distances} D and lateral offsets {offsets[0]:+.2f}..{offsets[-1]:+.2f} D\n")
+    print("| case | veer | " + " | ".join(QUADRATURES) + " |")
+    print("|---|---|" + "---:|" * len(QUADRATURES))
+    worst = (0.0, None)
+    for label, input_name in INPUTS.items():
+        for veer in (True, False):
+            largest = dict.fromkeys(QUADRATURES, 0.0)
+            for distance in distances:
+                for offset in offsets:
+                    errors = single_wake_errors(input_name, veer, distance, offset, reference)
+                    for quadrature, error in errors.items():
+                        largest[quadrature] = max(largest[quadrature], np.max(np.abs(error)))
+                    cells = np.max(np.abs(errors["3x3 cells"]))
+                    if cells > worst[0]:
+                        worst = (cells, (label, veer, distance, offset))
+            print(f"| {label} | {'on' if veer else 'off'} | "
+                  + " | ".join(f"{100 * largest[q]:.1f} %" for q in QUADRATURES) + " |")
+    print(f"\nworst 3x3 cells case: {100 * worst[0]:.2f} % at {worst[1]}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,325 @@
+"""Rotor cells: the area of the rotor disk that each point of FLORIS's turbine grid stands for.
+
+FLORIS's ``turbine_grid`` puts n x n points at +-R/2 around each hub and takes the cubic mean of
+the n^2 point velocities with equal weights for power and thrust. On the narrow, veer-sheared
+wakes of stable nights a point value is not a rotor average (a sheared band a tenth of a rotor
+thick falls between the points) and the +-R/2 points miss the strongly curved stable profile
+(docs/coupling.md#rotor-average). This module divides the disk into n^2 cells of equal area,
+one per point, each with a fine sub-quadrature, so that
+
+* the inflow hook sets ``u_initial`` at a point to the cubic mean of the ambient U over its cell,
+  ``U_k = <U^3>_k^(1/3)`` (:func:`cell_mean`), and
+* the ``ekman_veer`` velocity models return at a point the deficit ``d_k`` whose cube removes
+  the wake's exact power deficit of the cell, ``U_k^3 (1 - (1 - d_k)^3) = n^2 sum_s w_s
+  (U_s^3 - (U_s - Delta u_s)^3)`` over the cell's sub-points s (:func:`cell_deficit`).
+
+FLORIS's equal-weight cubic mean of ``U_k (1 - d_k)`` is then the sub-quadrature of the disk
+integral of u^3 (ambient and wake), for one wake exactly, and its thrust and power follow. For
+a turbine whose operation model takes the plain mean of u (the actuator disk) the same holds
+with the first moment in place of the third (:data:`TURBINE_MOMENTS`). Pure geometry and numpy:
+no FLORIS import.
+
+The cells: the points are grouped into rings of equal distance from the hub (the centre point of
+odd n alone); ring after ring (inwards out) takes an annulus whose area is its share of points
+(a ring whose annulus would miss its own points joins the ring inside), and each annulus is
+cut into equal sectors centred on its points. For n = 3: a central disk of radius R/3 and eight
+45-degree sectors of the annulus R/3 < r < R, all of area pi R^2 / 9.
+The sub-quadrature: ``rows`` horizontal strips of equal height (each weighted by its exact area
+of the disk) times ``columns`` Gauss-Legendre points across the chord; a sub-point belongs to the
+cell it lies in, and the weights of each cell are scaled to its exact area. Uniform strips
+integrate a band crossing them spectrally (error ~ exp(-2 pi^2 s^2 / h^2) for a Gaussian of width
+s in z sampled at spacing h), which is what the sheared wakes need.
+"""
+
+from __future__ import annotations
+
+import contextvars
+import functools
+
+import attrs
+import numpy as np
+
+#: The moment m of the rotor average that each turbine's power and thrust take: FLORIS's power
+#: curves take the cubic mean (m = 3) of the turbine grid; the actuator disk takes the plain
+#: mean of u (m = 1, Eq. Ud, coupling/turbine.py). The cells then carry <U^m>_k^(1/m) and
+#: deficits that remove the wake's exact share of <u^m> (docs/coupling.md#rotor-average).
+PLAIN_MEAN_OPERATION_MODELS = frozenset({"actuator-disk"})
+
+#: Per unsorted turbine, the moment of the farm being solved (set by the inflow hook's Core
+#: wrappers, as the atmosphere is); None: m = 3 for every turbine.
+TURBINE_MOMENTS: contextvars.ContextVar = contextvars.ContextVar(
+    "rotor_average_moments", default=None
+)
+
+
+def turbine_moments(turbine_definitions) -> np.ndarray:
+    """m per turbine of a FLORIS farm's ``turbine_definitions`` (1 for plain-mean operation
+    models, else 3)."""
+    return np.array([
+        1.0 if definition.get("operation_model") in PLAIN_MEAN_OPERATION_MODELS else 3.0
+        for definition in turbine_definitions
+    ])
+
+
+def sorted_moments(grid) -> np.ndarray:
+    """m per sorted turbine of a turbine grid, (n_findex, n_turbines)."""
+    order = grid.sorted_indices[:, :, 0, 0]
+    moments = TURBINE_MOMENTS.get()
+    if moments is None or len(moments) != order.shape[1]:
+        return np.full(order.shape, 3.0)
+    return np.asarray(moments)[order]
+
+#: Sub-quadrature of the inflow cell averages: the ambient profile is smooth apart from the kink
+#: at the ABL top, and is evaluated once per run, so it is resolved finely.
+AMBIENT_ROWS, AMBIENT_NODES = 256, 4
+
+
+@attrs.define(eq=False)
+class RotorCells:
+    """Cells of the unit disk for an n x n FLORIS turbine grid and their sub-quadrature.
+
+    Attributes (lengths in rotor radii, positions relative to the hub, y lateral, z up):
+        n: points per side of FLORIS's grid (point (iy, iz) is cell iy * n + iz).
+        row_z: (rows,) heights of the sub-point rows.
+        sub_y: (rows, columns) lateral positions of the sub-points.
+        weight: (rows, columns) area weights over the disk area, summing to 1.
+        area: (n^2,) the cells' areas in this quadrature (exact: 1/n^2 each).
+        cell: (rows * columns,) cell index of each sub-point.
+        membership: (rows * columns, n^2) weight of sub-point s in cell k (0 elsewhere).
+        indicator: (rows * columns, n^2) 1 where sub-point s is in cell k.
+        row_chord: (rows,) half-chord of the disk at each row height.
+    """
+
+    n: int
+    row_z: np.ndarray
+    sub_y: np.ndarray
+    weight: np.ndarray
+    cell: np.ndarray
+    membership: np.ndarray
+    indicator: np.ndarray
+    row_chord: np.ndarray
+    area: np.ndarray
+
+    @property
+    def rows(self) -> int:
+        return self.row_z.size
+
+    @functools.cached_property
+    def cell_segments(self):
+        """(sub-points with weight, sorted by cell; start of each cell's segment)."""
+        used = np.flatnonzero(self.weight.ravel() > 0.0)
+        order = used[np.argsort(self.cell[used], kind="stable")]
+        starts = np.searchsorted(self.cell[order], np.arange(self.n**2))
+        return order, starts
+
+
+def grid_offsets(n: int) -> np.ndarray:
+    """FLORIS's turbine-grid offsets in rotor radii: linspace(-1/2, 1/2, n) (0 for n = 1)."""
+    return np.zeros(1) if n == 1 else np.linspace(-0.5, 0.5, n)
+
+
+def _strip_area(a, b):
+    """Area of the unit disk between heights a < b."""
+    primitive = lambda z: z * np.sqrt(1.0 - z * z) + np.arcsin(z)  # noqa: E731
+    return primitive(b) - primitive(a)
+
+
+def _cell_of(n: int, r: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """Cell index (iy * n + iz) of the points at polar (r, phi) of the unit disk."""
+    g = grid_offsets(n)
+    py, pz = np.meshgrid(g, g, indexing="ij")
+    radius = np.round(np.hypot(py, pz).ravel(), 12)
+    angle = np.arctan2(pz, py).ravel()
+    cell = np.empty(r.shape, dtype=int)
+    # Rings inwards out; a ring whose annulus (its share of the area) would not contain its own
+    # points' radius joins the ring inside it (n = 3: the edge and corner points form one ring).
+    rings = []
+    for value in np.unique(radius):
+        rings.append([value])
+        while len(rings) > 1:
+            counts = np.cumsum([np.count_nonzero(np.isin(radius, ring)) for ring in rings])
+            inner = np.sqrt(counts[-2] / n**2)
+            if min(rings[-1]) >= inner:
+                break
+            rings[-2:] = [rings[-2] + rings[-1]]
+    counts = [np.count_nonzero(np.isin(radius, ring)) for ring in rings]
+    bounds = np.sqrt(np.cumsum(counts) / n**2)
+    ring_of = np.minimum(np.searchsorted(bounds, r, side="right"), len(rings) - 1)
+    for k, ring in enumerate(rings):
+        members = np.flatnonzero(np.isin(radius, ring))
+        members = members[np.argsort(angle[members])]
+        m = members.size
+        width = 2.0 * np.pi / m
+        # Sector centres at phi0 + j width, phi0 the mean offset of the sorted points (exact
+        # for the symmetric rings of a square grid).
+        phi0 = np.mean(np.mod(angle[members] - np.arange(m) * width + np.pi, 2 * np.pi) - np.pi)
+        inside = ring_of == k
+        sector = np.floor(np.mod(phi[inside] - phi0 + 0.5 * width, 2 * np.pi) / width)
+        cell[inside] = members[np.minimum(sector.astype(int), m - 1)]
+    return cell
+
+
+#: Resolution of the row sampling that locates the cells' edges along each row (in chords).
+_EDGE_SAMPLES = 4096
+
+
+def _row_intervals(n: int, z: float):
+    """The cells crossed by the chord at height ``z``, as (cell, y_start, y_end) in order."""
+    chord = np.sqrt(1.0 - z * z)
+    edges = np.linspace(-chord, chord, _EDGE_SAMPLES + 1)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    label = _cell_of(n, np.hypot(centres, z), np.arctan2(np.full_like(centres, z), centres))
+    change = np.flatnonzero(np.diff(label)) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [label.size]])
+    return [(label[a], edges[a], edges[b]) for a, b in zip(starts, ends)]
+
+
+@functools.lru_cache(maxsize=32)
+def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
+    """The cells of an n x n turbine grid and their sub-quadrature (cached).
+
+    ``rows`` strips of equal height, each weighted by its exact area of the disk; along the
+    chord at the strip's centre, the stretch of each cell it crosses gets ``nodes_per_interval``
+    Gauss-Legendre points. Every cell's area is thereby exact to the strips' resolution (it must
+    be 1/n^2 of the disk: FLORIS weights the points equally). Rows crossing fewer cells are
+    padded with zero-weight points, so that the sub-points form a (rows, columns) array.
+    """
+    if n < 1 or rows < 1 or nodes_per_interval < 1:
+        raise ValueError(
+            f"rotor cells need n, rows, nodes_per_interval >= 1; got {n}, {rows}, "
+            f"{nodes_per_interval}"
+        )
+    edges = np.linspace(-1.0, 1.0, rows + 1)
+    row_z = 0.5 * (edges[1:] + edges[:-1])
+    chord = np.sqrt(1.0 - row_z**2)
+    strip = _strip_area(edges[:-1], edges[1:]) / np.pi
+    nodes, gl = np.polynomial.legendre.leggauss(nodes_per_interval)
+    intervals = [_row_intervals(n, z) for z in row_z]
+    columns = nodes_per_interval * max(len(row) for row in intervals)
+    sub_y = np.zeros((rows, columns))
+    weight = np.zeros((rows, columns))
+    cell = np.zeros((rows, columns), dtype=int)
+    for r, row in enumerate(intervals):
+        for k, (label, a, b) in enumerate(row):
+            block = slice(k * nodes_per_interval, (k + 1) * nodes_per_interval)
+            sub_y[r, block] = 0.5 * (a + b) + 0.5 * (b - a) * nodes
+            weight[r, block] = strip[r] * (b - a) / (2.0 * chord[r]) * 0.5 * gl
+            cell[r, block] = label
+    cell, weight = cell.ravel(), weight.ravel()
+    totals = np.bincount(cell, weights=weight, minlength=n * n)
+    if np.any(totals == 0.0):
+        raise ValueError(
+            f"{rows} sub-quadrature rows leave cells of the {n} x {n} turbine grid empty: use "
+            "more rows"
+        )
+    membership = np.zeros((weight.size, n * n))
+    membership[np.arange(weight.size), cell] = weight
+    indicator = (membership > 0.0).astype(float)
+    return RotorCells(
+        n, row_z, sub_y, weight.reshape(sub_y.shape), cell, membership, indicator, chord, totals
+    )
+
+
+def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.ndarray:
+    """<U^m>_k^(1/m) of each cell from U at the sub-point rows (U depends on height only).
+
+    ``u_rows``: (..., rows); ``moment`` m (1 or 3) broadcasting against ``u_rows[..., 0]``.
+    Returns (..., n, n) in FLORIS's point order.
+    """
+    row_membership = cells.membership.reshape(cells.rows, -1, cells.n**2).sum(axis=1)
+    moment = np.asarray(moment)[..., None]
+    powers = np.where(moment == 1.0, u_rows, u_rows**3)
+    mean = powers @ row_membership / cells.area
+    mean = np.where(moment == 1.0, mean, np.cbrt(mean))
+    return mean.reshape(*u_rows.shape[:-1], cells.n, cells.n)
+
+
+def cell_deficit(power_deficit, u_cell, moment, cells: RotorCells) -> np.ndarray:
+    """d_k of each cell from the sub-points' weighted deficits of the moment m of u:
+    w_s (U_s^m - u_s^m) (m = 3: power; m = 1: the velocity deficit itself).
+
+    ``power_deficit``: (..., rows, columns), weights included; ``u_cell``: (..., n^2) the cells'
+    U_k; ``moment`` (..., 1). Returns (..., n^2): U_k^m (1 - (1 - d_k)^m) = n^2 sum_{s in k}
+    w_s (U_s^m - u_s^m). A cell without inflow (U_k = 0) has no wake.
+    """
+    shape = power_deficit.shape[:-2]
+    # Sum per cell: the sub-points sorted by cell, summed by segments (faster than a matmul with
+    # the 0/1 membership on this tall, thin shape); padding points are left out.
+    order, starts = cells.cell_segments
+    removed = np.add.reduceat(power_deficit.reshape(*shape, -1)[..., order], starts, axis=-1)
+    removed *= cells.n**2
+    cubic = moment == 3.0
+    ambient = np.where(cubic, u_cell**3, u_cell)
+    flowing = ambient > 0.0
+    fraction = np.where(flowing, removed / np.where(flowing, ambient, 1.0), 0.0)
+    # The cells' quadrature areas are exact to the strips' resolution (a few per cent for the
+    # wake cells): a wake that stops nearly all flow through a cell could exceed it by as much.
+    # The cell then has no flow (d = 1) rather than a negative one.
+    fraction = np.minimum(fraction, 1.0)
+    return np.where(cubic, 1.0 - np.cbrt(1.0 - fraction), fraction)
+
+
+#: Sub-quadrature of the wake cells per point of FLORIS's n x n grid: ROWS_PER_POINT n strips
+#: and NODES_PER_INTERVAL points on each cell's stretch of every strip, so that a finer turbine
+#: grid (``solver.turbine_grid_points``) also refines the cells' quadrature.
+ROWS_PER_POINT, NODES_PER_INTERVAL = 6, 2
+
+
+def sub_quadrature(n: int) -> tuple[int, int]:
+    """(rows, nodes per interval) of the wake cells' sub-quadrature for an n x n turbine grid."""
+    return ROWS_PER_POINT * n, NODES_PER_INTERVAL
+
+
+def rotor_geometry(grid):
+    """Rotor centres, radii and turbine order of a FLORIS turbine grid, per sorted turbine.
+
+    Returns x, y, z (hub height), radius, each (n_findex, n_turbines), and ``order``, the
+    unsorted turbine index of each sorted turbine (FLORIS's ``sorted_indices``).
+    """
+    order = grid.sorted_indices[:, :, 0, 0]
+    x = grid.x_sorted[:, :, 0, 0]
+    y = np.mean(grid.y_sorted, axis=(2, 3))
+    z = np.mean(grid.z_sorted, axis=(2, 3))
+    radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)[order]
+    return x, y, z, radius, order
+
+
+def rows_profile(profile, grid, cells: RotorCells):
+    """A height profile at the sub-point rows of every rotor: (n_findex, n_turbines, rows) per
+    output of ``profile(z)``, ``z`` shaped (1, 1, 1, heights); evaluated once per distinct row
+    height of the farm (one hub height and diameter: ``rows`` heights, whatever n_findex)."""
+    _, _, _, _, order = rotor_geometry(grid)
+    coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
+    radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)
+    heights = coordinates[:, 2, None] + radius[:, None] * cells.row_z  # (n_turbines, rows)
+    distinct, inverse = np.unique(heights, return_inverse=True)
+    inverse = inverse.reshape(heights.shape)
+    n_findex = order.shape[0]
+    out = []
+    for values in profile(distinct.reshape(1, 1, 1, -1)):
+        values = np.broadcast_to(values, (n_findex, 1, 1, distinct.size)).reshape(n_findex, -1)
+        out.append(values[:, inverse][np.arange(n_findex)[:, None], order])
+    return out
+
+
+def row_interpolation(n: int, row_z: np.ndarray) -> np.ndarray:
+    """(n, rows) matrix interpolating values at the grid's point heights linearly to the rows
+    (constant beyond the outer points): the wake centre of a deflection model that gives it at
+    FLORIS's points only."""
+    g = grid_offsets(n)
+    if n == 1:
+        return np.ones((1, row_z.size))
+    return np.stack([np.interp(row_z, g, np.eye(n)[k]) for k in range(n)])
+
+
+def turbine_grid_inflow(profile, grid) -> np.ndarray:
+    """u_initial of a FLORIS turbine grid: U_k = <U^m>_k^(1/m) over each rotor cell (m of
+    :func:`sorted_moments`).
+
+    ``profile(z)`` returns the inflow U (one output) at heights ``z`` (1, 1, 1, heights).
+    Returns (n_findex, n_turbines, n, n).
+    """
+    cells = rotor_cells(grid.grid_resolution, AMBIENT_ROWS, AMBIENT_NODES)
+    (u_rows,) = rows_profile(lambda z: (profile(z),), grid, cells)
+    return cell_mean(u_rows, sorted_moments(grid), cells)

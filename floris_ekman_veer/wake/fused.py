@@ -1,0 +1,93 @@
+"""Eq. (du_model) fused into one pass over many points, for rotor-cell averages.
+
+The readable form of the deficit is :func:`floris_ekman_veer.wake.deficit.normalised_deficit`;
+this module evaluates the same formula where most factors are shared: per wake (C(x), k_w x,
+the stream-tube radius, beta) and per height (t_hat and the three tanh of Eq. xi_emp depend on
+z only, through U(z)), leaving per point only the polar harmonics, the width and the Gaussian.
+numexpr (a FLORIS dependency) runs that per-point part in a single pass without temporaries.
+tests/test_fused.py checks it against ``normalised_deficit`` to round-off.
+"""
+
+from __future__ import annotations
+
+import numexpr as ne
+import numpy as np
+
+from .deficit import (
+    CURL_ALPHA,
+    WIDTH_FACTOR,
+    _initial_radius,
+    max_deficit,
+    time_like_variable,
+)
+
+
+def curl_coefficients(t_hat, alpha=CURL_ALPHA):
+    """(a2, a3, a4) with xi_hat = 1 - (a2 cos 2theta + a3 cos 3theta + a4 cos 4theta), Eq. (xi_emp):
+
+    a2 = alpha (tanh(t^2/4alpha)/2 - 5/48 tanh(t^4/16alpha)), a3 = -alpha/4 tanh(t^3/8alpha),
+    a4 = 7 alpha/48 tanh(t^4/16alpha).
+    """
+    t_hat = np.asarray(t_hat, dtype=float)
+    tanh2 = np.tanh(t_hat**2 / (4.0 * alpha))
+    tanh3 = np.tanh(t_hat**3 / (8.0 * alpha))
+    tanh4 = np.tanh(t_hat**4 / (16.0 * alpha))
+    return (
+        alpha * (0.5 * tanh2 - 5.0 / 48.0 * tanh4),
+        -0.25 * alpha * tanh3,
+        7.0 / 48.0 * alpha * tanh4,
+    )
+
+
+# Per point, with c = cos(theta) (theta := 0 at the centre, where the Gaussian is 1 whatever the
+# width) and sin^2(theta) = 1 - c^2: xi_hat of Eq. (xi_emp) as the quartic in c of
+# :func:`rows_deficit_parameters` (Chebyshev: cos 2t = 2c^2 - 1, cos 3t = 4c^3 - 3c,
+# cos 4t = 8c^4 - 8c^2 + 1), the width of Eqs. (sigma_width), (xi0_theta) and the Gaussian.
+_COSINE = "where(dy**2 + dz**2 > 0, dy / sqrt(where(dy**2 + dz**2 > 0, dy**2 + dz**2, 1)), 1)"
+_CURL = "(q0 + c * (q1 + c * (q2 + c * (q3 + c * q4))))"
+_SIGMA = f"(kx + xi0 / sqrt(1 - sin2b * (1 - c**2)) * {_CURL})"
+_DEFICIT = f"amplitude * exp(-(dy**2 + dz**2) / (2 * {_SIGMA}**2))"
+
+
+def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, local_speed,
+                            curl=True):
+    """The per-wake and per-height factors of Eq. (du_model) (see :func:`deficit_on_rows`).
+
+    ``x`` (> 0), ``k_w``, ``radius``, ``ct``, ``yaw``, ``friction_velocity``, ``hub_speed``
+    broadcast per wake; ``local_speed`` U(z) per height (> 0). Returns a dict of arrays.
+    """
+    r_tube = _initial_radius(radius, ct, yaw)
+    if curl:
+        t_hat = time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct, yaw)
+        a2, a3, a4 = curl_coefficients(t_hat)
+    else:
+        a2 = a3 = a4 = np.zeros(1)
+    # xi_hat = 1 - (a2 (2c^2 - 1) + a3 (4c^3 - 3c) + a4 (8c^4 - 8c^2 + 1)) = sum_k q_k c^k.
+    return {
+        "amplitude": max_deficit(x, k_w, radius, ct, yaw),
+        "kx": np.asarray(k_w) * np.asarray(x),
+        "xi0": WIDTH_FACTOR * r_tube * np.abs(np.cos(yaw)),
+        "sin2b": np.sin(yaw) ** 2,
+        "q0": 1.0 + a2 - a4, "q1": 3.0 * a3, "q2": 8.0 * a4 - 2.0 * a2, "q3": -4.0 * a3,
+        "q4": -8.0 * a4,
+    }
+
+
+def deficit_on_rows(dy, dz, parameters):
+    """Delta u / U_h of Eq. (du_model) at points (dy, dz) from the factors of
+    :func:`rows_deficit_parameters` (two numexpr passes: cos(theta), then the deficit)."""
+    c = ne.evaluate(_COSINE, local_dict={"dy": dy, "dz": dz})
+    return ne.evaluate(_DEFICIT, local_dict={"dy": dy, "dz": dz, "c": c, **parameters})
+
+
+def power_deficit_on_rows(dy, dz, parameters, hub_speed, ambient, weight, moment=3.0):
+    """weight (U^m - (U - Delta u)^m) at points (dy, dz), m = ``moment`` (3: the power-deficit
+    density of the wake; 1: Delta u itself), on the inflow U (``ambient``, per height; 0 where
+    there is no flow), times the quadrature weights. Two numexpr passes over the points."""
+    du = deficit_on_rows(dy, dz, parameters)
+    return ne.evaluate(
+        "where(U > 0, weight * hub_speed * du * where(m > 2, 3 * U**2 - 3 * U * hub_speed * du"
+        " + (hub_speed * du)**2, 1), 0)",
+        local_dict={"du": du, "U": ambient, "weight": weight, "hub_speed": hub_speed,
+                    "m": np.asarray(moment, dtype=float)},
+    )
