@@ -41,8 +41,8 @@ def expected_profile(fmodel, z):
 
 
 def _cells_3x3_quadrature(n_radial=96, n_angle=256):
-    """An independent quadrature of the 3 x 3 turbine grid's rotor cells (docs/coupling.md#rotor-
-    average): the centre disk r < R/3 (point (1, 1)); the annulus R/3 < r < R sqrt(5/9) in four
+    """An independent quadrature of the 3 x 3 turbine grid's rotor cells
+    (docs/coupling.md#rotor-average): the centre disk r < R/3 (point (1, 1)); the annulus R/3 < r < R sqrt(5/9) in four
     90-degree sectors centred on the edge points (0, 90, 180, 270 deg); the annulus beyond in
     four quadrants, one per corner point. Gauss-Legendre in r^2 on each annulus times uniform
     angles whose cells' edges fall between nodes. Returns (y, z, weight, cell index iy*3+iz)."""
@@ -114,8 +114,8 @@ def test_u_initial_equals_profile_at_rotor_points(solver):
     if solver == "turbine_cubature_grid":
         np.testing.assert_allclose(flow_field.u_initial_sorted, points, rtol=0, atol=1e-12)
     else:
-        # Each turbine-grid point carries its rotor cell's cubic mean (docs/coupling.md#rotor-
-        # average); the quadratures differ (rows of the disk there, polar rings here).
+        # Each turbine-grid point carries its rotor cell's cubic mean
+        # (docs/coupling.md#rotor-average); the quadratures differ (strips there, rings here).
         np.testing.assert_allclose(flow_field.u_initial_sorted,
                                    expected_turbine_grid_inflow(fmodel), rtol=2e-4)
         # ...which is not the point value where the profile curves (strongly, in this SBL)
