@@ -42,28 +42,25 @@ def expected_profile(fmodel, z):
 
 def _cells_3x3_quadrature(n_radial=96, n_angle=256):
     """An independent quadrature of the 3 x 3 turbine grid's rotor cells
-    (docs/coupling.md#rotor-average): the centre disk r < R/3 (point (1, 1)); the annulus R/3 < r < R sqrt(5/9) in four
-    90-degree sectors centred on the edge points (0, 90, 180, 270 deg); the annulus beyond in
-    four quadrants, one per corner point. Gauss-Legendre in r^2 on each annulus times uniform
-    angles whose cells' edges fall between nodes. Returns (y, z, weight, cell index iy*3+iz)."""
+    (docs/coupling.md#rotor-average): the centre disk r < R/3 (point (1, 1)) and eight
+    45-degree sectors of the annulus R/3 < r < R, centred on the outer points (point (iy, iz) at
+    the angle atan2(iz - 1, iy - 1)). Gauss-Legendre in r^2 on each annulus times uniform angles
+    whose cells' edges fall between nodes. Returns (y, z, weight, cell index iy*3+iz)."""
     x, w = np.polynomial.legendre.leggauss(n_radial)
     ys, zs, ws, cells = [], [], [], []
     theta = (np.arange(n_angle) + 0.5) * 2 * np.pi / n_angle
-    for lower, upper, ring in ((0.0, 1 / 9, "centre"), (1 / 9, 5 / 9, "edge"), (5 / 9, 1.0, "corner")):
+    for lower, upper in ((0.0, 1 / 9), (1 / 9, 1.0)):
         s = lower + (upper - lower) * 0.5 * (x + 1)
         r, t = np.meshgrid(np.sqrt(s), theta, indexing="ij")
         weight = np.outer((upper - lower) * 0.5 * w, np.full(n_angle, 1.0 / n_angle))
-        y, z = r * np.cos(t), r * np.sin(t)
-        if ring == "centre":
-            iy = iz = np.ones_like(y, dtype=int)
-        elif ring == "edge":
-            sector = np.floor(np.mod(t + np.pi / 4, 2 * np.pi) / (np.pi / 2)).astype(int)
-            iy = np.choose(sector, [2, 1, 0, 1])
-            iz = np.choose(sector, [1, 2, 1, 0])
+        if lower == 0.0:
+            iy = iz = np.ones_like(r, dtype=int)
         else:
-            iy, iz = np.where(y > 0, 2, 0), np.where(z > 0, 2, 0)
-        ys.append(y.ravel()), zs.append(z.ravel()), ws.append(weight.ravel())
-        cells.append((3 * iy + iz).ravel())
+            sector = np.floor(np.mod(t + np.pi / 8, 2 * np.pi) / (np.pi / 4)).astype(int)
+            iy = np.choose(sector, [2, 2, 1, 0, 0, 0, 1, 2])  # 0, 45, ..., 315 deg
+            iz = np.choose(sector, [1, 2, 2, 2, 1, 0, 0, 0])
+        ys.append((r * np.cos(t)).ravel()), zs.append((r * np.sin(t)).ravel())
+        ws.append(weight.ravel()), cells.append((3 * iy + iz).ravel())
     return (np.concatenate(a) for a in (ys, zs, ws, cells))
 
 
