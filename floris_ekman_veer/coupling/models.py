@@ -452,7 +452,10 @@ class _EkmanWakeModel(BaseModel):
             return result.reshape(u_initial.shape)
         abl = ambient.abl
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
-        k_w = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i,
+        # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added turbulence
+        # is counted per point); its wake takes one expansion rate, from the rotor's mean.
+        turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
+        k_w = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                                   ambient.floris_turbulence)
         rows = getattr(deflection_field_i, "rows", None)
         if rows is None:
