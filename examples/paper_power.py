@@ -16,7 +16,8 @@ all cases and yaws as conditions of one model (per-condition atmospheres) and th
 a few rows of downstream turbines at least ``ROW_SPACING`` apart, which do not interact (no wake
 reaches a turbine in the same rotor plane; tests/test_examples.py checks a row against two-turbine
 farms). The rotor average is
-FLORIS's, on the quadrature ``ROTOR_SOLVER``; it is checked against a direct disk integration of
+FLORIS's, on the quadrature ``ROTOR_SOLVERS`` (the inputs' turbine grid, whose rotor cells
+integrate the disk, for M-1, M-2 and M-3; FLORIS's finest cubature for GCH and cc); it is checked against a direct disk integration of
 Eq. (P_ratio): a polar Gauss rule (16 x 48 points) over the disk of the flow FLORIS samples behind
 the upstream turbine alone. For GCH and cc behind a yawed turbine the two differ by more than the
 quadrature: FLORIS computes their yaw-added recovery and secondary steering differently in its
@@ -59,8 +60,12 @@ from floris import FlorisModel  # noqa: E402
 
 from floris_ekman_veer.coupling.turbine import induction_factor  # noqa: E402
 
-#: FLORIS's rotor quadrature for the downstream disk.
-ROTOR_SOLVER = {"type": "turbine_cubature_grid", "turbine_grid_points": 10}
+#: FLORIS's rotor quadrature for the downstream disk, per model: the inputs' own 3 x 3 turbine
+#: grid for this package's models, whose rotor cells integrate the disk
+#: (docs/coupling.md#rotor-average); FLORIS's finest cubature for its own models, which take
+#: point values.
+CUBATURE = {"type": "turbine_cubature_grid", "turbine_grid_points": 10}
+ROTOR_SOLVERS = {"M-1": None, "M-2": None, "M-3": None, "GCH": CUBATURE, "cc": CUBATURE}
 X_T_OVER_D = (4.0, 6.0, 8.0, 10.0)
 Y_T_OVER_D = np.linspace(-4.0, 4.0, 81)
 #: Least lateral distance [D] of two downstream disks in one FLORIS run (rotors must not
@@ -71,11 +76,12 @@ DISK_RADIAL, DISK_ANGULAR = 16, 48
 
 
 # ----------------------------------------------------------------------------------- set-up
-def conditions_model(cases: list[Case], name: str, betas=BETAS, solver=ROTOR_SOLVER
+def conditions_model(cases: list[Case], name: str, betas=BETAS, solver="model"
                      ) -> tuple[FlorisModel, np.ndarray]:
     """One FLORIS model of ``name`` whose conditions are every (case, beta), case-major; the
     atmosphere inputs that differ between cases become per-condition lists. Returns the model
-    (one turbine at the origin) and the upstream yaw of each condition."""
+    (one turbine at the origin) and the upstream yaw of each condition. ``solver``: a FLORIS
+    solver block, None for the input's, "model" for ROTOR_SOLVERS[name]."""
     config = model_config(cases[0].config, name)
     atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
     for key in atmosphere:
@@ -87,6 +93,8 @@ def conditions_model(cases: list[Case], name: str, betas=BETAS, solver=ROTOR_SOL
         turbulence_intensities=[case.turbulence for case in cases for _ in betas],
         wind_directions=[270.0] * n,
     )
+    if solver == "model":
+        solver = ROTOR_SOLVERS[name]
     if solver is not None:
         config["solver"] = dict(solver)
     return FlorisModel(config), np.tile(np.asarray(betas, float), len(cases))
@@ -114,7 +122,7 @@ def separated_rows(y_t, spacing=ROW_SPACING) -> list[np.ndarray]:
 
 
 def floris_power_ratios(cases: list[Case], name: str, betas=BETAS, x_t=X_T_OVER_D,
-                        y_t=Y_T_OVER_D, solver=ROTOR_SOLVER) -> np.ndarray:
+                        y_t=Y_T_OVER_D, solver="model") -> np.ndarray:
     """P/P0 from FLORIS's power of the downstream disk, shape (cases, betas, x_t, y_t)."""
     fmodel, yaw = conditions_model(cases, name, betas, solver)
     D = cases[0].diameter
@@ -199,7 +207,7 @@ def print_tables(results: dict, disks: dict) -> None:
                     at_min = minima(results[name][i, j, k])[1] - minima(results["M-1"][i, j, k])[1]
                     cells.append(f"{at_0:+.3f}/{at_min:+.3f}")
             print(f"  {case:<6}{name:>5}  " + "  ".join(cells))
-    print(f"\nFLORIS rotor average ({ROTOR_SOLVER}) against the direct disk integration "
+    print("\nFLORIS rotor average (ROTOR_SOLVERS) against the direct disk integration "
           f"({DISK_RADIAL} x {DISK_ANGULAR}): largest |Delta P/P0| over x_T and y_T, "
           "beta = 0 | beta = +-20 deg")
     print(f"  {'model':<6}" + "".join(f"{case:>16}" for case in WAKE_CASES))
