@@ -318,8 +318,23 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
     :func:`sorted_moments`).
 
     ``profile(z)`` returns the inflow U (one output) at heights ``z`` (1, 1, 1, heights).
-    Returns (n_findex, n_turbines, n, n).
+    Returns (n_findex, n_turbines, n, n). The cells are averaged once per distinct (hub height,
+    radius, m) of the farm and gathered to the turbines, so the work and memory do not grow
+    with the number of turbines.
     """
     cells = rotor_cells(grid.grid_resolution, AMBIENT_ROWS, AMBIENT_NODES)
-    (u_rows,) = rows_profile(lambda z: (profile(z),), grid, cells)
-    return cell_mean(u_rows, sorted_moments(grid), cells)
+    order = grid.sorted_indices[:, :, 0, 0]
+    coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
+    radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)
+    moments = TURBINE_MOMENTS.get()
+    if moments is None or len(moments) != radius.size:
+        moments = np.full(radius.size, 3.0)
+    kinds, kind_of = np.unique(np.stack([coordinates[:, 2], radius, moments], axis=1), axis=0,
+                               return_inverse=True)
+    heights = kinds[:, :1] + kinds[:, 1:2] * cells.row_z  # (kinds, rows)
+    distinct, inverse = np.unique(heights, return_inverse=True)
+    n_findex = order.shape[0]
+    u = np.broadcast_to(profile(distinct.reshape(1, 1, 1, -1)), (n_findex, 1, 1, distinct.size))
+    u_rows = u.reshape(n_findex, -1)[:, inverse.reshape(heights.shape)]  # (n_findex, kinds, rows)
+    means = cell_mean(u_rows, kinds[:, 2], cells)  # (n_findex, kinds, n, n)
+    return means[np.arange(n_findex)[:, None], kind_of.ravel()[order]]
