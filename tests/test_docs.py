@@ -305,3 +305,14 @@ def test_cited_equations_and_sections_are_the_papers():
                   if number not in PAPER_SECTIONS]
     assert cited > 100  # the code cites the paper's equations throughout
     assert not wrong, "\n".join(wrong)
+
+
+def test_docs_index_lists_every_model_equation():
+    """docs/README.md's equation table has a row for each equation of the paper's model (the
+    error measures against the LES, eps_*, are named in the text below it)."""
+    index = (DOCS / "README.md").read_text()
+    rows = {re.match(r"\|\s*([\w:]+)", line)[1] for line in index.splitlines()
+            if re.match(r"\|\s*[\w:]+\s*(\([\w:]+\)\s*)?\|\s*\d", line)}
+    model = {label for label in PAPER_EQUATIONS
+             if not label.startswith(("eps_", "eqn:avoidnumbers1a", "eqn:avoidnumbers1b", "eqn:GDL"))}
+    assert model <= rows, sorted(model - rows)
