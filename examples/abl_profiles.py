@@ -63,15 +63,20 @@ def print_table(table: dict[str, dict[str, float]]) -> None:
               f"{row['k_w']:8.4f}")
 
 
+def profiles(case: Case, z) -> tuple[np.ndarray, ...]:
+    """U, V (frame of the hub-height wind), speed and direction relative to hub height [deg,
+    + = veered, clockwise] at heights z."""
+    u, v = case.abl.hub_aligned_velocity(np.asarray(z, float), case.hub_height)
+    return u, v, np.hypot(u, v), -np.rad2deg(np.arctan2(v, u))
+
+
 def profiles_figure(cases: dict[str, Case], output: Path) -> Path:
     z = np.linspace(0.5, 1300.0, 1300)
     fig, axes = plt.subplots(1, 4, figsize=(15, 5.5), sharey=True, constrained_layout=True)
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, len(cases)))
     for (name, case), colour in zip(cases.items(), colours):
-        u, v = case.abl.hub_aligned_velocity(z, case.hub_height, below_roughness="zero")
         h = float(case.abl.boundary_layer_height)
-        direction = -np.rad2deg(np.arctan2(v, u))  # + = veered (clockwise) from the hub wind
-        for ax, values in zip(axes, (u, v, np.hypot(u, v), direction)):
+        for ax, values in zip(axes, profiles(case, z)):
             ax.plot(values, z, color=colour, label=f"{name} (h = {h:.0f} m)")
             ax.plot(np.interp(h, z, values), h, "o", color=colour, ms=5)
     for ax in axes:

@@ -44,6 +44,22 @@ def test_abl_table_trends(cases):
         assert case.abl.geostrophic_wind == pytest.approx(15.0, rel=1e-9), name
 
 
+def test_profiles_are_in_the_hub_height_frame(cases):
+    """The profile figure's curves: V = 0 and no direction change at z_h, the speed |(U, V)|;
+    above h the geostrophic wind G = 15 m/s, turned by the veer from z_h to h (more in SBL-6)."""
+    turn = {}
+    for name in ("CNBL", "SBL-6"):
+        case = cases[name]
+        h = float(case.abl.boundary_layer_height)
+        u, v, speed, direction = abl_profiles.profiles(case, [case.hub_height, 1.05 * h])
+        assert abs(v[0]) < 1e-12 and abs(direction[0]) < 1e-9
+        assert speed[0] == pytest.approx(case.hub_speed, rel=1e-12)
+        assert speed[1] == pytest.approx(15.0, rel=1e-9)
+        np.testing.assert_allclose(speed, np.hypot(u, v))
+        turn[name] = direction[1]
+    assert 0.0 < turn["CNBL"] < turn["SBL-6"]
+
+
 def test_potential_core_grows_with_stability_and_c_matches_floris(cases):
     """x0 (Eq. x0_transition) orders CNBL < SBL-4 < SBL-5 < SBL-6 (the paper: about 3 D to 5 D),
     and the largest deficit sampled through FLORIS is C(x) of Eq. (Cx)."""
