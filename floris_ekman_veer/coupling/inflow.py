@@ -528,16 +528,19 @@ def _with_core_atmosphere(method):
 
 
 def _without_reversed_flow(flow_field: FlowField, result):
-    """Superposed wakes at most stop the flow: u = max(u, 0) on a full-flow grid (points, planes)
-    of the package's wake models.
+    """Superposed wakes at most stop the flow: u >= min(U(z), 0) on a full-flow grid (points,
+    planes) of the package's wake models.
 
     Each wake's deficit is limited to the local inflow U(z) (the U_h-scaled Gaussian tail exceeds
     it next to the ground, docs/wake_model.md#which-velocity-goes-where), but FLORIS's
-    sum-of-squares superposition of two such stopped wakes would give (1 - sqrt(2)) U(z). Rotor
-    points lie far above that layer, so turbine grids need no bound.
+    sum-of-squares superposition of two such stopped wakes would give (1 - sqrt(2)) U(z). Where
+    the inflow itself runs against the reference direction (collapsed layers a few metres deep,
+    docs/atmosphere.md) the wake models add no deficit and u stays U(z). Rotor points lie far
+    above that layer, so turbine grids need no bound.
     """
-    flow_field.u_sorted = np.maximum(flow_field.u_sorted, 0.0)
-    return None if result is None else np.maximum(result, 0.0)
+    floor = np.minimum(flow_field.u_initial_sorted, 0.0)
+    flow_field.u_sorted = np.maximum(flow_field.u_sorted, floor)
+    return None if result is None else np.maximum(result, floor[:, :, 0, 0])
 
 
 def _validating_post_init(method):
