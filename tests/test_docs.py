@@ -316,3 +316,26 @@ def test_docs_index_lists_every_model_equation():
     model = {label for label in PAPER_EQUATIONS
              if not label.startswith(("eps_", "eqn:avoidnumbers1a", "eqn:avoidnumbers1b", "eqn:GDL"))}
     assert model <= rows, sorted(model - rows)
+
+
+def test_readme_table1_is_what_the_model_gives():
+    """The README's copy of Table 1 (h, u*, alpha_0 as "mu closure / cooling-rate closure")."""
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+    lines = (REPO / "README.md").read_text().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("## Validation"))
+    rows = []
+    for line in lines[start:]:
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and cells[0] in TABLE1_INPUTS:
+            rows.append(cells)
+        elif rows:
+            break
+    assert [r[0] for r in rows] == list(TABLE1_INPUTS)
+    for case, h, _, u_star, _, alpha, _ in rows:
+        mu, c_r = TABLE1_INPUTS[case]
+        for i, value in enumerate((dict(stability_parameter=mu), dict(cooling_rate=c_r))):
+            abl = EkmanABL(**PAPER, **value)
+            assert_printed(h.split("/")[i].strip(), float(abl.boundary_layer_height), (case, "h"))
+            assert_printed(u_star.split("/")[i].strip(), float(abl.friction_velocity), (case, "u*"))
+            assert_printed(alpha.split("/")[i].strip(), float(abl.cross_isobaric_angle), (case, "alpha_0"))
