@@ -20,8 +20,8 @@ Error: power error (u / u_ref)^3 - 1. Cases (the issue list): the paper's actuat
 SBL-4 and SBL-6 (``inputs/cnbl.yaml``, ``sbl4.yaml``, ``sbl6.yaml``) and the NREL 5 MW farm
 input (``inputs/farm_sbl6.yaml``, 9 m/s at 90 m); veer on and off (M-1, M-2); upstream yaw 0 and
 +-20 deg; downstream rotor 5, 7, 10, 15 D behind, laterally offset -1.5 D to +1.5 D in steps of
-0.25 D. Prints the largest |error| per input, veer and quadrature (the README's table) and the
-worst case. ``--quick`` uses steps of 0.5 D and 5 and 10 D only.
+0.25 D. Prints the largest |error| per input, veer and quadrature (the README's table), the
+worst case, and the errors of an unwaked rotor (the ambient profile alone). ``--quick`` uses steps of 0.5 D and 5 and 10 D only.
 """
 
 from __future__ import annotations
@@ -153,6 +153,10 @@ def main(argv=None) -> None:
             print(f"| {label} | {'on' if veer else 'off'} | "
                   + " | ".join(f"{100 * largest[q]:.1f} %" for q in QUADRATURES) + " |")
     print(f"\nworst 3x3 cells case: {100 * worst[0]:.2f} % at {worst[1]}")
+    # The ambient part alone: a rotor 8 D aside of the wake (no wake on it).
+    unwaked = single_wake_errors(INPUTS["NREL 5 MW, farm input"], True, 7.0, 8.0, reference)
+    print("unwaked NREL 5 MW in the farm input (9 m/s): "
+          + ", ".join(f"{q} {100 * unwaked[q][0]:+.1f} %" for q in QUADRATURES))
 
 
 if __name__ == "__main__":

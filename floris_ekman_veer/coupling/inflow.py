@@ -56,9 +56,9 @@ What the hook sets
   steering) and feeds ``v``/``w`` into yaw-added recovery, so ambient veer in ``v_initial`` would
   be mistaken for the sidewash of a yawed rotor. Measured (GCH, NREL 5 MW row at 7 D, 8 m/s at
   90 m, f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s; powers with V(z) in ``v_initial`` vs without):
-  cooling rate -1 K/h (h = 71 m, 36 deg of veer across the rotor): downstream turbines +97 % and
-  +64 % at zero yaw; -0.25 K/h (h = 197 m, 25 deg): +2.7 %, and +7.6 % with the first turbine
-  yawed 20 deg; neutral (0 K/h, 0.5 deg of backing): +0.03 to +1.1 %. Unwaked turbines do not
+  cooling rate -1 K/h (h = 71 m, 36 deg of veer across the rotor): downstream turbines +96 % and
+  +67 % at zero yaw; -0.25 K/h (h = 197 m, 25 deg): +2.7 %, and +7.8 % with the first turbine
+  yawed 20 deg; neutral (0 K/h, 0.5 deg of backing): +0.1 to +1.1 %. Unwaked turbines do not
   change (wind direction 300 deg: 0 %), i.e. the effect is purely a spurious wake steering. See
   ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The veer reaches this package's own
   deflection model through :func:`solved_atmosphere` instead.
