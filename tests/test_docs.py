@@ -132,7 +132,8 @@ def test_project_paths_named_in_the_text_exist():
 
 
 # Documents of the project's development that are not part of it, and paths of one machine.
-OUTSIDE = re.compile("|".join(["MODEL_NOTES", r"ARCHITECTURE\.md", "/work/", "/home/", "/Users/"]))
+# (the first name is spelt in two pieces so that this line does not cite it itself)
+OUTSIDE = re.compile("|".join(["MODEL" "_NOTES", r"ARCHITECTURE\.md", "/work/", "/home/", "/Users/"]))
 
 
 def test_nothing_cites_a_document_outside_the_project():
