@@ -31,6 +31,7 @@ import argparse
 import copy
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import matplotlib
@@ -53,6 +54,7 @@ from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
+from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
@@ -173,6 +175,14 @@ def print_abl(farm: Farm, speeds) -> dict:
           "shear: rotor-equivalent power-law exponent, for reference only: FLORIS's inflow is "
           "the Ekman U(z); k_w: paper Eq. kw_CNBL_SBL_model, used by M-1/M-2; I_u(z_h) is every "
           f"model's TI; gauss wind_veer = {'the rotor veer' if farm.gauss_wind_veer else '0'})")
+    shallow = [speed for i, speed in enumerate(speeds)
+               if abl.boundary_layer_height[i] < z_h + radius]
+    if shallow:
+        print(f"  note: at U(90 m) = {', '.join(f'{s:g}' for s in shallow)} m/s h is below the "
+              f"rotor top ({z_h + radius:.0f} m), outside the paper's validated range: above h the "
+              "inflow is the geostrophic wind and k_w falls continuously to its floor "
+              "(docs/atmosphere.md#shallow-boundary-layer); the ShallowBoundaryLayerWarning of "
+              "each model build is silenced in this example")
 
 
 def ratio(a: float, b: float) -> str:
@@ -343,6 +353,8 @@ def main(argv=None) -> None:
     start = time.perf_counter()
     np.set_printoptions(precision=3, suppress=True)
 
+    # Every model build of this night would repeat the warning; print_abl says it once.
+    warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
     farm = Farm(load_yaml(FARM_INPUT), gauss_wind_veer=args.gauss_wind_veer)
     if args.gauss_wind_veer:
         LABELS["gauss"] += " + wind_veer"
