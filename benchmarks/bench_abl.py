@@ -1,4 +1,4 @@
-"""Time the EkmanABL solver (issue 2). Hand-run script, not a test:
+"""Time the EkmanABL solver. Hand-run script, not a test:
 
     PYTHONPATH=. python benchmarks/bench_abl.py
 
