@@ -665,6 +665,17 @@ class EkmanABL:
         abl._set_solution(log_u_star[inverse.ravel()].reshape(shape), abl._params)
         return abl
 
+    @classmethod
+    def fit_profile(cls, heights, speeds, directions=None, **options_and_fixed_inputs):
+        """The atmosphere whose profile best fits measured wind speeds [m/s] and meteorological
+        directions [deg] at ``heights`` [m], per record (arrays (n_records, n_heights)): least
+        squares in u* (hence G), the Obukhov length and optionally z0, the direction a free
+        rotation; refuses records no atmosphere of the model fits. Options and fixed inputs:
+        :func:`floris_ekman_veer.atmosphere.fit.fit_profile` (docs/measurements.md)."""
+        from floris_ekman_veer.atmosphere import fit
+
+        return fit.fit_profile(cls, heights, speeds, directions, **options_and_fixed_inputs)
+
     def __repr__(self):
         return (
             f"EkmanABL(G={self.geostrophic_wind!r}, u*={self.friction_velocity!r}, "

@@ -1,0 +1,591 @@
+"""The atmosphere from measured wind profiles: a least-squares fit of the Ekman-surface-layer
+model to mast or lidar records (docs/measurements.md).
+
+Data: per record (10-minute mean, say) wind speeds [m/s] and meteorological wind directions [deg,
+where the wind comes from, clockwise from north] at a few heights. Unknowns (docs/measurements.md#unknowns):
+
+* the friction velocity u*, equivalently the geostrophic wind G, which the drag law (Eq. GDL)
+  makes explicit in u* for a given stability;
+* one stability input, the inverse Obukhov length 1/L >= 0 (mu = u*/(kappa f L), 0 neutral):
+  L rather than mu because the surface-layer shape U/u* = (ln(z/z0) + 5 z/L)/kappa depends on
+  1/L alone, which keeps the two unknowns nearly independent;
+* optionally (``fit_roughness=True``) the roughness length z0; otherwise z0 is a site input;
+* the wind direction is a free rotation (the direction of the surface stress): only the
+  direction *change* between heights constrains the physics. It is eliminated in closed form
+  (the weighted mean of the measured-minus-model directions) at every evaluation.
+
+Latitude (or f_c), the free-atmosphere stratification and the model constants are site inputs,
+fixed. The residuals are the speed and direction misfits divided by the measurement noise
+(``speed_noise``, ``direction_noise``); their root-mean-square per degree of freedom is the
+record's ``misfit``, about 1 when the data are the model plus that noise.
+
+Solver: a Levenberg-Marquardt iteration over all records at once (forward-difference Jacobians
+from the model's own vectorised profile, a 2x2 or 3x3 normal system per record solved as one
+stacked array; 1/L kept >= 0 by an active bound), from the best of a few starting stabilities
+(L = inf, 400, 200, 100, 50, 25 m); records that have converged are frozen. No Python loop runs
+over records.
+
+Refusal: a record whose best fit misses the data by more than the model plus the stated noise
+would with probability ``refusal_probability`` (1e-6; a chi-square test) fits no atmosphere of
+the model (directions backing with height in the northern
+hemisphere, speeds falling from the lowest height, a profile kinked beyond the model's...):
+ValueError naming the record and what in its data the model cannot follow, unless
+``on_misfit="flag"``, which keeps the fits and marks them in ``ProfileFit.fits``.
+
+This module imports no FLORIS and not the ABL module either: ``EkmanABL.fit_profile`` passes its
+class in (imports point one way, docs/coupling.md#registry).
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+
+from floris_ekman_veer._validation import real_array, require_at
+
+#: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
+FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
+               "on_misfit", "labels", "max_iterations")
+#: Stability inputs the fit determines (refused as fixed inputs).
+STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
+#: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
+DEFAULT_SPEED_NOISE = 0.2
+DEFAULT_DIRECTION_NOISE = 1.0
+#: A record is refused (or flagged) when the model plus the stated noise would give a misfit as
+#: large as its best fit's with a probability below this (chi-square test of its residuals).
+DEFAULT_REFUSAL_PROBABILITY = 1e-6
+#: Starting Obukhov lengths [m] of the multi-start (inf: neutral).
+STARTING_OBUKHOV_LENGTHS = (np.inf, 400.0, 200.0, 100.0, 50.0, 25.0)
+#: Default starting roughness length [m] when it is fitted and none is given.
+DEFAULT_ROUGHNESS_START = 0.05
+#: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
+_LENGTH_SCALE = 100.0
+_JACOBIAN_STEP = 1e-7
+_STEP_TOLERANCE = 1e-10
+
+
+@attrs.define(eq=False)
+class ProfileFit:
+    """What :func:`fit_profile` found, per record (arrays of shape ``(n_records,)``; scalars for
+    one record given as 1-D data).
+
+    Attributes:
+        abl: The fitted EkmanABL (the same object whose ``profile_fit`` this is).
+        heights, speeds, directions: The data as fitted, ``(n_records, n_heights)`` (NaN:
+            missing; directions None when not given).
+        fitted: Names of the unknowns: ``("friction_velocity", "obukhov_length")`` and
+            ``"roughness_length"`` when fitted.
+        friction_velocity [m/s], geostrophic_wind [m/s], obukhov_length [m] (inf: neutral),
+        stability_parameter mu, roughness_length [m], boundary_layer_height [m].
+        direction_offset: [deg] the free rotation: the model's meteorological direction is
+            ``direction_offset - abl.wind_angle(z)`` (see :meth:`direction`).
+        speed_residual: rms of model minus measured speed [m/s].
+        direction_residual: rms of the direction misfit [deg] (NaN without directions).
+        misfit: rms normalised residual per degree of freedom (about 1 for the model plus the
+            stated noise).
+        fits: the record passes the chi-square test of ``refusal_probability``.
+        iterations, converged: of the Levenberg-Marquardt iteration.
+        labels: Record names used in messages (index by default).
+        fixed_inputs: The fixed EkmanABL inputs as given.
+    """
+
+    abl: object
+    heights: np.ndarray
+    speeds: np.ndarray
+    directions: np.ndarray | None
+    fitted: tuple
+    friction_velocity: np.ndarray
+    geostrophic_wind: np.ndarray
+    obukhov_length: np.ndarray
+    stability_parameter: np.ndarray
+    roughness_length: np.ndarray
+    boundary_layer_height: np.ndarray
+    direction_offset: np.ndarray
+    speed_residual: np.ndarray
+    direction_residual: np.ndarray
+    misfit: np.ndarray
+    fits: np.ndarray
+    iterations: np.ndarray
+    converged: np.ndarray
+    labels: list
+    fixed_inputs: dict
+    speed_noise: float
+    direction_noise: float
+    single: bool
+
+    def speed(self, heights):
+        """Fitted speed [m/s] at ``heights`` ((n_heights,) or (n_records, n_heights)), shaped
+        (n_records, n_heights)."""
+        return self._per_record(self.abl.speed, heights)
+
+    def direction(self, heights):
+        """Fitted meteorological wind direction [deg, 0-360) at ``heights``, shaped as
+        :meth:`speed`."""
+        angle = self._per_record(self.abl.wind_angle, heights)
+        return np.mod(np.reshape(self.direction_offset, (-1, 1)) - angle, 360.0)
+
+    def _per_record(self, profile, heights):
+        z = np.asarray(heights, dtype=float)
+        if self.single:
+            return np.atleast_2d(profile(z))
+        # The fitted ABL has shape (n_records,): heights go on the leading axis.
+        return np.transpose(profile(np.transpose(np.atleast_2d(z))))
+
+    def atmosphere(self, stability_input: str = "stability_parameter",
+                   reference_height=None) -> dict:
+        """The fitted inputs as the ``ekman_veer.atmosphere`` block of a FLORIS input: the fixed
+        inputs, the roughness length and the stability as ``stability_input`` (one of
+        ``stability_parameter``, ``obukhov_length``, ``surface_heat_flux``, ``cooling_rate``);
+        lists with one entry per record, plain floats for one record (YAML-safe).
+
+        The block holds no wind: driven by the fitted speed at a reference height (FLORIS's
+        wind speed, :meth:`speed`), it gives back the fitted ABL: the four stability inputs are
+        the same state at that speed, but the reference-wind solve takes the deepest ABL with
+        that speed (docs/atmosphere.md#reference-wind-solve), and a closure may have a second,
+        deeper one (a surface heat flux does at strong stability,
+        docs/measurements.md#from-the-fit-to-floris). Given ``reference_height`` [m], the block
+        is solved from the fitted speed there and ValueError names the records it does not
+        give back (to 1e-6 in G).
+        """
+        mu = np.asarray(self.stability_parameter, float)
+        u_star = np.asarray(self.friction_velocity, float)
+        f = np.abs(np.asarray(self.abl.coriolis_parameter, float))
+        theta0 = np.asarray(self.abl.reference_potential_temperature, float)
+        gravity_ratio = 9.81 / theta0
+        with np.errstate(divide="ignore"):
+            values = {
+                "stability_parameter": mu,
+                "obukhov_length": np.where(mu > 0, u_star / (self.abl.von_karman * f
+                                                              * np.where(mu > 0, mu, 1.0)), np.inf),
+                "surface_heat_flux": -mu * f * u_star**2 / gravity_ratio,
+                "cooling_rate": -mu * f * u_star**2 / gravity_ratio
+                / np.asarray(self.boundary_layer_height, float) * 3600.0,
+            }
+        if stability_input not in values:
+            raise ValueError(f"stability_input must be one of {list(values)}; got "
+                             f"{stability_input!r}")
+        block = dict(self.fixed_inputs)
+        if "roughness_length" in self.fitted:
+            block["roughness_length"] = self.roughness_length
+        block[stability_input] = values[stability_input]
+        block = {k: _yaml_value(v, self.single) for k, v in block.items()}
+        if reference_height is not None:
+            self._check_block(block, stability_input, reference_height)
+        return block
+
+    def _check_block(self, block, stability_input, reference_height):
+        speed = self.speed(np.reshape(float(reference_height), (1,)))[:, 0]
+        again = type(self.abl).from_reference_wind(speed if not self.single else speed[0],
+                                                   float(reference_height), **block)
+        error = np.abs(np.asarray(again.geostrophic_wind) / self.geostrophic_wind - 1.0)
+        wrong = np.flatnonzero(np.reshape(~(error <= 1e-6), -1))
+        if wrong.size:
+            i = int(wrong[0])
+            raise ValueError(
+                f"the atmosphere block with {stability_input}, driven by the fitted speed "
+                f"{speed[i]:.4g} m/s at {reference_height:g} m, gives a different ABL than the "
+                f"fit of record {self.labels[i]} (G {np.reshape(again.geostrophic_wind, -1)[i]:.4g}"
+                f" instead of {np.reshape(self.geostrophic_wind, -1)[i]:.4g} m/s; "
+                f"{wrong.size} record(s)): that closure has two states with this speed there "
+                "and the reference-wind solve takes the deeper one; give the stability as "
+                "stability_parameter or obukhov_length"
+            )
+
+
+def _yaml_value(value, single):
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 0 or single:
+        return float(array.reshape(-1)[0]) if array.size == 1 else array.reshape(-1).tolist()
+    return [float(v) for v in array.reshape(-1)]
+
+
+def _wrap(angle):
+    """Angle difference in (-180, 180] degrees."""
+    return angle - 360.0 * np.round(angle / 360.0)
+
+
+class _ProfileModel:
+    """The model's speeds and direction changes at the data heights for unknowns
+    x = (ln u*, lam = 100 m/L, [ln z0]) per record, and the normalised residuals."""
+
+    def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
+                 speed_noise, direction_noise):
+        self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        self.z, self.s, self.d = heights, speeds, directions
+        self.sigma_s, self.sigma_d = speed_noise, direction_noise
+        self.ms = np.isfinite(speeds)
+        self.md = None if directions is None else np.isfinite(directions)
+        n = speeds.shape[0]
+        self.z0 = np.broadcast_to(z0, (n,)).astype(float)
+        # A template of the fixed inputs: the drag law's coefficients are explicit in u* for
+        # a given mu (the reference-wind solve's parametrisation, docs/atmosphere.md#reference-wind-solve).
+        self.template = abl_class.check_inputs(
+            stability_parameter=np.zeros(n), roughness_length=self.z0, **fixed
+        )
+        params, _ = self.template._parameters(np.nan, (n,))
+        self.params = params
+        self.f = params["f"]
+        self.kappa = self.template.von_karman
+
+    def fixed_at(self, index):
+        return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
+
+    def state(self, x, index):
+        """(G, mu, z0, valid) for unknowns x of records ``index``."""
+        log_u = x[:, 0]
+        u_star = np.exp(log_u)
+        z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
+        mu = u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        p = {k: v[index] for k, v in self.params.items()}
+        p["value"], p["z0"] = mu, z0
+        with np.errstate(all="ignore"):
+            _, _, h_hat, _, b, along = self.template._state(log_u, p)
+            g = u_star * np.hypot(along, b) / self.kappa
+            valid = (
+                (x[:, 1] >= 0) & (along > 0) & np.isfinite(g) & np.isfinite(mu)
+                # a surface layer above the roughness, with margin for the re-solve's round-off
+                & (self.template.matching_fraction * h_hat * u_star / p["f"] > 1.001 * z0)
+            )
+        return g, mu, z0, valid
+
+    def abl(self, g, mu, z0, index):
+        return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
+                        **self.fixed_at(index))
+
+    def residuals(self, x, index):
+        """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
+        g, mu, z0, valid = self.state(x, index)
+        # Invalid trial states are evaluated at a harmless stand-in and discarded.
+        g = np.where(valid, g, 10.0)
+        mu = np.where(valid, mu, 0.0)
+        z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
+        abl = self.abl(g, mu, z0, index)
+        z = self.z[index]
+        speed = np.transpose(abl.speed(np.transpose(z)))
+        ms = self.ms[index]
+        r_s = np.where(ms, (speed - np.where(ms, self.s[index], 0.0)) / self.sigma_s, 0.0)
+        if self.d is None:
+            return r_s, valid, np.zeros(len(index))
+        angle = np.transpose(abl.wind_angle(np.transpose(z)))
+        md = self.md[index]
+        # Measured direction plus the model's flow angle: the offset, constant for a perfect fit.
+        e = np.where(md, self.d[index], 0.0) + angle
+        first = np.argmax(md, axis=1)
+        e_ref = e[np.arange(len(index)), first]
+        relative = np.where(md, _wrap(e - e_ref[:, None]), 0.0)
+        count = np.maximum(np.sum(md, axis=1), 1)
+        mean = np.sum(relative, axis=1) / count
+        r_d = np.where(md, (relative - mean[:, None]) / self.sigma_d, 0.0)
+        return np.concatenate([r_s, r_d], axis=1), valid, e_ref + mean
+
+
+def _solve_normal(jtj, jtr, damping, x_lam, bounded):
+    """LM step of stacked systems (k, p, p); where ``bounded`` the stability unknown (index 1)
+    is held at its bound 0 (step -x_lam) and the others solved with it fixed."""
+    p = jtj.shape[-1]
+    diag = np.einsum("kii->ki", jtj)
+    a = jtj + (damping[:, None] * diag + 1e-30)[:, :, None] * np.eye(p)
+    rhs = -jtr
+    if np.any(bounded):
+        fixed_step = -x_lam
+        column = a[:, :, 1].copy()
+        rhs = np.where(bounded[:, None], rhs - column * fixed_step[:, None], rhs)
+        a = a.copy()
+        a[bounded, :, 1] = 0.0
+        a[bounded, 1, :] = 0.0
+        a[bounded, 1, 1] = 1.0
+        rhs[bounded, 1] = fixed_step[bounded]
+    return np.linalg.solve(a, rhs[..., None])[..., 0]
+
+
+def _levenberg_marquardt(model, x, max_iterations, records):
+    """LM iterations for unknowns x (k, p) of ``records`` (k,) (a record may appear with
+    several starting points); converged rows are frozen."""
+    n, p = x.shape
+    r, valid, _ = model.residuals(x, records)
+    cost = np.where(valid, np.sum(r**2, axis=1), np.inf)
+    damping = np.full(n, 1e-3)
+    active = valid.copy()
+    converged = np.zeros(n, bool)
+    iterations = np.zeros(n, int)
+    for _ in range(max_iterations):
+        index = np.flatnonzero(active)
+        if index.size == 0:
+            break
+        xa, ra = x[index], r[index]
+        # Forward differences, all unknowns and records in one evaluation.
+        steps = _JACOBIAN_STEP * np.eye(p)
+        trial = (xa[:, None, :] + steps[None]).reshape(-1, p)
+        rt, vt, _ = model.residuals(trial, np.repeat(records[index], p))
+        jac = (rt.reshape(index.size, p, -1) - ra[:, None, :]) / _JACOBIAN_STEP
+        jac = np.where(vt.reshape(index.size, p)[:, :, None], jac, 0.0)
+        jtj = np.einsum("kpm,kqm->kpq", jac, jac)
+        jtr = np.einsum("kpm,km->kp", jac, ra)
+        step = _solve_normal(jtj, jtr, damping[index], xa[:, 1], np.zeros(index.size, bool))
+        # The stability bound: a step below 1/L = 0 is replaced by one held on the bound.
+        bounded = xa[:, 1] + step[:, 1] < 0
+        if np.any(bounded):
+            held = _solve_normal(jtj, jtr, damping[index], xa[:, 1], bounded)
+            step = np.where(bounded[:, None], held, step)
+        x_new = xa + step
+        x_new[:, 1] = np.maximum(x_new[:, 1], 0.0)
+        r_new, v_new, _ = model.residuals(x_new, records[index])
+        cost_new = np.where(v_new, np.sum(r_new**2, axis=1), np.inf)
+        accept = cost_new <= cost[index]
+        iterations[index] += 1
+        small = np.max(np.abs(step), axis=1) < _STEP_TOLERANCE
+        flat = accept & (cost[index] - cost_new <= 1e-14 * np.maximum(cost[index], 1e-300))
+        x[index] = np.where(accept[:, None], x_new, xa)
+        r[index] = np.where(accept[:, None], r_new, ra)
+        cost[index] = np.where(accept, cost_new, cost[index])
+        damping[index] = np.where(accept, damping[index] / 3.0, damping[index] * 4.0)
+        done = (accept & (small | flat)) | (damping[index] > 1e12)
+        converged[index] |= accept & (small | flat)
+        active[index] = ~done
+    return x, cost, converged, iterations
+
+
+def _checked_data(name, value, shape=None):
+    array = real_array(name, value, "real numbers (NaN: missing)")
+    if shape is not None and array.shape != shape:
+        raise ValueError(f"fit_profile: {name} must have the shape of speeds {shape}; got "
+                         f"{array.shape}")
+    require_at(~np.isinf(array), name, "finite (NaN: missing)", array)
+    return array
+
+
+def fit_profile(abl_class, heights, speeds, directions=None, *,
+                speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
+                fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
+                on_misfit="raise", labels=None, max_iterations=100, **fixed_inputs):
+    """The atmosphere whose profile best fits measured speeds and directions (module docstring);
+    ``EkmanABL.fit_profile`` is this with its class.
+
+    Args:
+        heights: [m] (n_heights,) shared by all records, or (n_records, n_heights); > z0.
+        speeds: [m/s] (n_records, n_heights), or (n_heights,) for one record; > 0, NaN missing.
+        directions: [deg] meteorological, same shape (NaN missing), or None (speeds only).
+        speed_noise, direction_noise: measurement noise [m/s], [deg] weighting the residuals.
+        fit_roughness: fit z0 too (``roughness_length`` is then the starting value).
+        refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
+            the chi-square quantile of this upper-tail probability (degrees of freedom: data
+            minus unknowns) fits no atmosphere of the model: with dof = 11 (7 heights, speeds
+            and directions) that is a ``misfit`` above 2.07, with dof = 1 above 4.9.
+        on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
+        labels: a name per record for messages (e.g. time stamps); default its index.
+        max_iterations: of the Levenberg-Marquardt iteration.
+        **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
+            ``coriolis_parameter`` (required), ``roughness_length`` (required unless fitted),
+            ``brunt_vaisala_frequency`` or ``lapse_rate``, ``reference_potential_temperature``,
+            model constants; numbers or arrays of one per record.
+
+    Returns:
+        The fitted EkmanABL, shape (n_records,) (scalar for 1-D data), with ``profile_fit``: the
+        :class:`ProfileFit` (unknowns, direction offset, residuals per record).
+    """
+    speeds = _checked_data("speeds", speeds)
+    single = speeds.ndim == 1
+    speeds = np.atleast_2d(speeds)
+    if speeds.ndim != 2:
+        raise ValueError(f"fit_profile: speeds must be (n_records, n_heights) or (n_heights,); "
+                         f"got shape {speeds.shape}")
+    n, m = speeds.shape
+    heights = real_array("heights", heights, "> 0 m")
+    require_at(np.isfinite(heights) & (heights > 0), "heights", "finite and > 0 m", heights)
+    if heights.shape not in ((m,), (n, m)):
+        raise ValueError(f"fit_profile: heights must be (n_heights,) = ({m},) or (n_records, "
+                         f"n_heights) = ({n}, {m}); got shape {heights.shape}")
+    heights = np.broadcast_to(heights, (n, m)).astype(float)
+    if directions is not None:
+        directions = np.atleast_2d(_checked_data("directions", directions,
+                                                 np.shape(speeds[0] if single else speeds)))
+    require_at(np.isnan(speeds) | (speeds > 0), "speeds", "> 0 m/s (NaN: missing)", speeds)
+    for name, value in (("speed_noise", speed_noise), ("direction_noise", direction_noise),
+                        ("refusal_probability", refusal_probability)):
+        upper = 1.0 if name == "refusal_probability" else np.inf
+        if (isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value)
+                or not 0 < value < upper):
+            valid = "in (0, 1)" if name == "refusal_probability" else "> 0"
+            raise ValueError(f"fit_profile: {name} must be a number {valid}; got {value!r}")
+    if on_misfit not in ("raise", "flag"):
+        raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
+    if not isinstance(fit_roughness, bool):
+        raise ValueError(f"fit_profile: fit_roughness must be True or False; got {fit_roughness!r}")
+    labels = list(range(n)) if labels is None else list(labels)
+    if len(labels) != n:
+        raise ValueError(f"fit_profile: labels must name the {n} records; got {len(labels)}")
+
+    given = sorted(k for k in fixed_inputs if k in STABILITY_INPUTS or k == "geostrophic_wind")
+    if given:
+        raise ValueError(
+            f"fit_profile fits the wind and the stability; {given} cannot be fixed inputs (an "
+            "atmosphere from a known wind and stability is EkmanABL.from_reference_wind(speed, "
+            "height, obukhov_length=..., ...), docs/measurements.md#simpler-site-inputs)"
+        )
+    if "latitude" not in fixed_inputs and "coriolis_parameter" not in fixed_inputs:
+        raise ValueError("fit_profile needs the site's latitude [deg] or coriolis_parameter "
+                         "[1/s] as a fixed input")
+    z0 = fixed_inputs.pop("roughness_length", DEFAULT_ROUGHNESS_START if fit_roughness else None)
+    if z0 is None:
+        raise ValueError("fit_profile needs roughness_length [m] as a fixed input (or "
+                         "fit_roughness=True, where it is the starting value)")
+    fixed = {}
+    for k, v in fixed_inputs.items():
+        array = real_array(k, v)
+        if array.ndim > 1 or (array.ndim == 1 and array.size != n):
+            raise ValueError(f"fit_profile: fixed input {k} must be a number or one per record "
+                             f"({n}); got shape {array.shape}")
+        fixed[k] = float(array) if array.ndim == 0 else array
+    z0_array = real_array("roughness_length", z0, "> 0 m")
+    if z0_array.ndim > 1 or (z0_array.ndim == 1 and z0_array.size != n):
+        raise ValueError(f"fit_profile: roughness_length must be a number or one per record "
+                         f"({n}); got shape {z0_array.shape}")
+    abl_class.check_inputs(roughness_length=z0_array, **fixed)  # ranges, named as EkmanABL names them
+    if not fit_roughness:
+        low = heights <= np.reshape(z0_array, (-1, 1))
+        require_at(~low, "heights", "> roughness_length z0", heights)
+
+    valid_speeds = np.sum(np.isfinite(speeds), axis=1)
+    n_unknowns = 3 if fit_roughness else 2
+    observations = valid_speeds + (0 if directions is None
+                                   else np.maximum(np.sum(np.isfinite(directions), axis=1) - 1, 0))
+    short = (valid_speeds < 2) | (observations < n_unknowns)
+    if np.any(short):
+        i = int(np.argmax(short))
+        raise ValueError(
+            f"fit_profile: record {labels[i]} has {valid_speeds[i]} speeds and "
+            f"{observations[i] - valid_speeds[i]} direction changes; the fit needs at least 2 "
+            f"speeds and {n_unknowns} data in all ({n_unknowns} unknowns)"
+        )
+
+    model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
+                          float(speed_noise), float(direction_noise))
+    x, cost, converged, iterations = _multistart(model, n, max_iterations)
+    index = np.arange(n)
+    g, mu, z0_fit, valid = model.state(x, index)
+    r, _, offset = model.residuals(x, index)
+    dof = np.maximum(observations - n_unknowns, 1)
+    misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
+    speed_rms = np.sqrt(np.sum(r[:, :m] ** 2, axis=1) / valid_speeds) * speed_noise
+    if directions is None:
+        direction_rms = np.full(n, np.nan)
+    else:
+        count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
+        direction_rms = np.sqrt(np.sum(r[:, m:] ** 2, axis=1) / count) * direction_noise
+    from scipy.stats import chi2
+
+    misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
+    fits = misfit <= misfit_tolerance
+    if on_misfit == "raise" and not np.all(fits):
+        raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
+                            speed_rms, direction_rms, misfit, model, misfit_tolerance,
+                            float(refusal_probability))
+
+    g = np.where(valid, g, np.nan)
+    safe = valid | (on_misfit == "raise")
+    shape = (lambda a: a[0]) if single else (lambda a: a)
+    abl = abl_class(
+        geostrophic_wind=shape(np.where(safe, g, 10.0)),
+        stability_parameter=shape(np.where(safe, mu, 0.0)),
+        roughness_length=shape(z0_fit) if fit_roughness or z0_array.ndim else float(z0_array),
+        **({k: shape(v) if np.ndim(v) else v for k, v in fixed.items()}),
+    )
+    u_star = np.exp(x[:, 0])
+    kappa_f = model.kappa * model.f
+    with np.errstate(divide="ignore"):
+        obukhov = np.where(mu > 0, u_star / (kappa_f * np.where(mu > 0, mu, 1.0)), np.inf)
+    fit = ProfileFit(
+        abl=abl, heights=heights, speeds=speeds, directions=directions,
+        fitted=("friction_velocity", "obukhov_length") + (("roughness_length",) if fit_roughness else ()),
+        friction_velocity=shape(u_star), geostrophic_wind=shape(g), obukhov_length=shape(obukhov),
+        stability_parameter=shape(mu), roughness_length=shape(np.broadcast_to(z0_fit, (n,))),
+        boundary_layer_height=np.asarray(abl.boundary_layer_height),
+        direction_offset=shape(np.mod(offset, 360.0)), speed_residual=shape(speed_rms),
+        direction_residual=shape(direction_rms), misfit=shape(misfit), fits=shape(fits),
+        iterations=shape(iterations), converged=shape(converged), labels=labels,
+        fixed_inputs={k: (v if np.ndim(v) == 0 else shape(v)) for k, v in fixed.items()}
+        | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
+        speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
+    )
+    abl.profile_fit = fit
+    return abl
+
+
+def _multistart(model, n, max_iterations):
+    """Levenberg-Marquardt from each starting stability (u* from the lowest speed by the
+    log-linear law), all records and starts in one batch; the best end point per record.
+
+    Several starts because the objective has kinks: where the ABL top h (or the matching height
+    0.2 h) crosses a measurement height the profile's slope jumps, and an iteration can stop on
+    the kink, a local minimum, while another start reaches the fit.
+    """
+    lowest = np.argmin(np.where(model.ms, model.z, np.inf), axis=1)
+    rows = np.arange(n)
+    z1, s1 = model.z[rows, lowest], model.s[rows, lowest]
+    lams = _LENGTH_SCALE / np.asarray(STARTING_OBUKHOV_LENGTHS)
+    u_star = model.kappa * s1[:, None] / (np.log(z1 / model.z0)[:, None] + 5.0 * z1[:, None]
+                                           * lams[None, :] / _LENGTH_SCALE)
+    columns = [np.log(u_star), np.broadcast_to(lams, (n, lams.size))]
+    if model.fit_roughness:
+        columns.append(np.broadcast_to(np.log(model.z0)[:, None], (n, lams.size)))
+    x = np.stack([np.asarray(c, float) for c in columns], axis=-1).reshape(-1, len(columns))
+    x, cost, converged, iterations = _levenberg_marquardt(
+        model, x, max_iterations, np.repeat(rows, lams.size)
+    )
+    best = np.argmin(cost.reshape(n, lams.size), axis=1)
+    pick = rows * lams.size + best
+    return x[pick], cost[pick], converged[pick], iterations[pick]
+
+
+def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
+                  model, tolerance, probability):
+    i = int(failing[0])
+    order = np.argsort(heights[i])
+    z, s = heights[i][order], speeds[i][order]
+    reasons = []
+    ok = np.isfinite(s)
+    zs, ss = z[ok], s[ok]
+    if zs.size >= 2:
+        drops = ss[1:] - ss[:-1]
+        j = int(np.argmin(drops))
+        if ss[-1] < ss[0] - 2.0 * model.sigma_s:
+            reasons.append(f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to "
+                           f"{ss[-1]:.3g} m/s at {zs[-1]:.4g} m (the model's wind grows with "
+                           "height from the ground up to its low-level jet)")
+        elif drops[j] < -2.0 * model.sigma_s and j == 0:
+            reasons.append(f"the speed falls with height from {zs[0]:.4g} m to {zs[1]:.4g} m by "
+                           f"{-drops[0]:.3g} m/s")
+    if directions is not None:
+        d = directions[i][order]
+        okd = np.isfinite(d)
+        zd, dd = z[okd], d[okd]
+        if zd.size >= 2:
+            change = _wrap(dd[-1] - dd[0])
+            hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
+            north = hemisphere > 0
+            if hemisphere * change < -2.0 * model.sigma_d:
+                reasons.append(
+                    f"the direction {'backs' if north else 'veers'} with height by "
+                    f"{abs(change):.3g} deg from {zd[0]:.4g} m to {zd[-1]:.4g} m (an Ekman layer "
+                    f"in the {'northern' if north else 'southern'} hemisphere "
+                    f"{'veers' if north else 'backs'}: the direction turns "
+                    f"{'clockwise' if north else 'anticlockwise'} with height)"
+                )
+    if not reasons:
+        reasons.append("the shape of its profile is outside the model's (speed and direction "
+                       "change together set u*, L and z0; a profile kinked beyond the model's, "
+                       "or directions turning more than its stability allows with that shear)")
+    more = ""
+    if failing.size > 1:
+        shown = ", ".join(str(labels[k]) for k in failing[1:6])
+        more = (f"; {failing.size - 1} more record(s) fail ({shown}"
+                f"{', ...' if failing.size > 6 else ''})")
+    direction = "" if directions is None else f" and the directions by {direction_rms[i]:.3g} deg"
+    return ValueError(
+        f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
+        f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
+        f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg; refused "
+        f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
+        f"{'; '.join(reasons)}{more}. Give "
+        "on_misfit='flag' to keep the fits and read profile_fit.fits"
+    )
