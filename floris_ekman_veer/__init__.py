@@ -20,8 +20,9 @@ from floris_ekman_veer.coupling.distributed import ParFlorisModel
 from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
+from floris_ekman_veer.coupling.site import fit_site
 
-__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "annual_energy", "optimize_yaw",
-           "register"]
+__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "annual_energy", "fit_site",
+           "optimize_yaw", "register"]
 
 register()

@@ -1,0 +1,203 @@
+"""A site's measured wind profiles as a FLORIS run: fitted atmosphere per record, a FLORIS
+``TimeSeries``, annual energy and yaw optimisation (docs/measurements.md#from-the-fit-to-floris).
+
+Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with columns
+``speed_<height>m`` [m/s] and ``direction_<height>m`` [deg, meteorological] (e.g. ``speed_90m``,
+``direction_90m``; NaN for a missing value) and optionally a ``time`` column naming the records.
+:func:`fit_site` fits every record (``EkmanABL.fit_profile``, one vectorised call) and gives, per
+record, FLORIS's inputs at the reference height: the wind speed and direction of the fitted
+profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and the atmosphere
+block with one entry per record. Driven by those wind speeds, the block gives back the fitted
+ABLs (checked when it is made).
+"""
+
+from __future__ import annotations
+
+import re
+
+import attrs
+import numpy as np
+import pandas as pd
+from floris.wind_data import TimeSeries
+
+from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.coupling.energy import annual_energy
+from floris_ekman_veer.coupling.inflow import set_atmosphere
+
+#: Column names of the measured speeds and directions: the height in metres is in the name.
+SPEED_COLUMN = re.compile(r"^speed_(\d+(?:\.\d+)?)m$")
+DIRECTION_COLUMN = re.compile(r"^direction_(\d+(?:\.\d+)?)m$")
+#: What :func:`fit_site` does with records that fit no atmosphere of the model.
+MISFIT_POLICIES = ("raise", "drop")
+
+
+def mast_profiles(records: pd.DataFrame):
+    """(heights [m], speeds (n_records, n_heights), directions or None) from the
+    ``speed_<h>m`` and ``direction_<h>m`` columns of ``records`` (heights sorted)."""
+    if not isinstance(records, pd.DataFrame):
+        raise ValueError(f"records must be a pandas DataFrame; got {type(records).__name__}")
+    speeds = {float(m[1]): c for c in records.columns if (m := SPEED_COLUMN.match(str(c)))}
+    directions = {float(m[1]): c for c in records.columns
+                  if (m := DIRECTION_COLUMN.match(str(c)))}
+    if len(speeds) < 2:
+        raise ValueError(
+            "records need speed columns at two heights or more, named speed_<height>m (e.g. "
+            f"speed_90m); got columns {list(records.columns)}"
+        )
+    if directions and set(directions) != set(speeds):
+        raise ValueError(
+            f"records: direction columns at heights {sorted(directions)} m do not match the "
+            f"speed columns at {sorted(speeds)} m (give both at every height; NaN: missing)"
+        )
+    heights = np.array(sorted(speeds))
+
+    def table(columns):
+        frame = records[[columns[h] for h in heights]]
+        bad = [c for c in frame.columns if not pd.api.types.is_numeric_dtype(frame[c])]
+        if bad:
+            raise ValueError(f"records: columns {bad} must be numbers (NaN: missing)")
+        return frame.to_numpy(dtype=float)
+
+    return heights, table(speeds), table(directions) if directions else None
+
+
+@attrs.frozen(eq=False)
+class SiteAtmosphere:
+    """The fitted atmosphere of a site's records (see :func:`fit_site`).
+
+    Attributes:
+        labels: the record names (the ``time`` column, else the DataFrame index).
+        abl: the fitted EkmanABL, shape (n_records,); ``abl.profile_fit`` the fit.
+        reference_height: FLORIS's ``reference_wind_height`` [m].
+        wind_speeds, wind_directions, turbulence_intensities: per record, FLORIS's inputs at
+            the reference height (the fitted profile's speed and meteorological direction, the
+            fitted ABL's I_u).
+        atmosphere: the ``ekman_veer.atmosphere`` block, one entry per record.
+        dropped: labels of the records left out as fitting no atmosphere (``on_misfit="drop"``).
+    """
+
+    labels: list
+    abl: EkmanABL
+    reference_height: float
+    wind_speeds: np.ndarray
+    wind_directions: np.ndarray
+    turbulence_intensities: np.ndarray
+    atmosphere: dict
+    dropped: list
+
+    @property
+    def profile_fit(self):
+        return self.abl.profile_fit
+
+    def time_series(self) -> TimeSeries:
+        """The records as a FLORIS TimeSeries (equal frequencies)."""
+        return TimeSeries(wind_directions=self.wind_directions, wind_speeds=self.wind_speeds,
+                          turbulence_intensities=self.turbulence_intensities)
+
+    def apply(self, fmodel) -> None:
+        """Set ``fmodel``'s conditions to the records and its atmosphere to the per-record block
+        (one vectorised FLORIS run for all records; ``optimize_yaw`` takes it as it is).
+        ``fmodel``'s reference wind height must be the fit's."""
+        height = float(fmodel.core.flow_field.reference_wind_height)
+        if abs(height - self.reference_height) > 1e-9 * max(1.0, self.reference_height):
+            raise ValueError(
+                f"fmodel's flow_field.reference_wind_height is {height} m but the site "
+                f"atmosphere was made for {self.reference_height} m (fit_site(..., "
+                "reference_height=...))"
+            )
+        set_atmosphere(fmodel, self.atmosphere, wind_directions=self.wind_directions,
+                       wind_speeds=self.wind_speeds,
+                       turbulence_intensities=self.turbulence_intensities)
+
+    def stability(self) -> tuple[dict, list]:
+        """(stability classes, record classes) for :func:`~floris_ekman_veer.annual_energy`:
+        one class per distinct fitted atmosphere (named by its first record's label), each
+        record of its own class."""
+        n = len(self.labels)
+        names = [k for k, v in self.atmosphere.items() if isinstance(v, list)]
+        rows = np.array([[self.atmosphere[k][i] for k in names] for i in range(n)]).reshape(n, -1)
+        _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        classes, records = {}, []
+        for i in range(n):
+            j = int(first[inverse[i]])
+            name = str(self.labels[j])
+            if name not in classes:
+                classes[name] = {"atmosphere": {
+                    k: (v[j] if isinstance(v, list) else v) for k, v in self.atmosphere.items()
+                }}
+            records.append(name)
+        return classes, records
+
+    def annual_energy(self, fmodel, optimizer_class=None, **options):
+        """:func:`~floris_ekman_veer.annual_energy` of ``fmodel`` for these records, each record
+        with its fitted atmosphere (``options``: annual_energy's and the optimiser's)."""
+        classes, records = self.stability()
+        return annual_energy(fmodel, self.time_series(), classes, optimizer_class,
+                             records=records, **options)
+
+
+def fit_site(records: pd.DataFrame, reference_height: float, *,
+             stability_input: str = "stability_parameter", on_misfit: str = "raise",
+             time_column: str = "time", **fit_options_and_inputs) -> SiteAtmosphere:
+    """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
+
+    Args:
+        records: DataFrame with ``speed_<h>m``, ``direction_<h>m`` and optionally ``time``.
+        reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually).
+        stability_input: the stability input of the atmosphere block (``stability_parameter``,
+            ``obukhov_length`` or ``cooling_rate``; the block is checked to give back the fit).
+        on_misfit: ``"raise"`` (ValueError naming the first record no atmosphere of the model
+            fits) or ``"drop"`` (leave such records out, listed in ``dropped``).
+        time_column: the column naming the records in messages and classes.
+        **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
+            (``latitude``, ``roughness_length``, ``speed_noise``...).
+    """
+    if on_misfit not in MISFIT_POLICIES:
+        raise ValueError(f"fit_site: on_misfit must be one of {list(MISFIT_POLICIES)}; got "
+                         f"{on_misfit!r}")
+    if "on_misfit" in fit_options_and_inputs or "labels" in fit_options_and_inputs:
+        raise ValueError("fit_site sets fit_profile's on_misfit and labels itself (from its "
+                         "own on_misfit and the time column)")
+    if (isinstance(reference_height, bool) or not np.isscalar(reference_height)
+            or not np.isfinite(reference_height) or reference_height <= 0):
+        raise ValueError(f"fit_site: reference_height must be a number > 0 m; got "
+                         f"{reference_height!r}")
+    heights, speeds, directions = mast_profiles(records)
+    labels = (records[time_column].astype(str).tolist() if time_column in records.columns
+              else [str(i) for i in records.index])
+    if len(records) == 0:
+        raise ValueError("fit_site: records is empty")
+    per_record = {k: v for k, v in fit_options_and_inputs.items() if np.ndim(v) == 1}
+    fit_inputs = dict(fit_options_and_inputs)
+
+    def fit(keep, policy):
+        inputs = {**fit_inputs, **{k: np.asarray(v)[keep] for k, v in per_record.items()}}
+        return EkmanABL.fit_profile(
+            heights, speeds[keep], None if directions is None else directions[keep],
+            on_misfit=policy, labels=[labels[i] for i in keep], **inputs,
+        )
+
+    everything = np.arange(len(records))
+    abl = fit(everything, "raise" if on_misfit == "raise" else "flag")
+    dropped = []
+    if on_misfit == "drop" and not np.all(abl.profile_fit.fits):
+        keep = everything[abl.profile_fit.fits]
+        dropped = [labels[i] for i in everything[~abl.profile_fit.fits]]
+        if keep.size == 0:
+            raise ValueError(f"fit_site: no record fits an atmosphere of the model "
+                             f"({len(dropped)} records)")
+        abl = fit(keep, "raise")
+    profile = abl.profile_fit
+    z_ref = np.array([float(reference_height)])
+    return SiteAtmosphere(
+        labels=list(profile.labels),
+        abl=abl,
+        reference_height=float(reference_height),
+        wind_speeds=profile.speed(z_ref)[:, 0],
+        wind_directions=profile.direction(z_ref)[:, 0],
+        turbulence_intensities=np.asarray(abl.turbulence_intensity(float(reference_height)),
+                                          float).reshape(-1),
+        atmosphere=profile.atmosphere(stability_input, reference_height=float(reference_height)),
+        dropped=dropped,
+    )
