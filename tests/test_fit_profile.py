@@ -220,5 +220,6 @@ def test_bad_data_are_refused():
         EkmanABL.fit_profile(MAST, s, d[:3], **SITE)
     with pytest.raises(ValueError, match=r"speeds must be a real number"):
         EkmanABL.fit_profile(MAST, ["8"] * MAST.size, d, **SITE)
-    with pytest.raises(ValueError, match=r"record 0 has 1 speeds"):
-        EkmanABL.fit_profile(MAST, np.where(MAST > 30, np.nan, s), d, **SITE)
+    with pytest.raises(ValueError, match=r"record 0 has 1 speeds and 0 direction changes"):
+        EkmanABL.fit_profile(MAST, np.where(MAST > 30, np.nan, s), np.where(MAST > 30, np.nan, d),
+                             **SITE)

@@ -155,3 +155,41 @@ def test_shipped_synthetic_mast_is_labelled_and_fitted():
     np.testing.assert_allclose(fit.obukhov_length[stable], records["true_obukhov_length"][stable],
                                rtol=0.15)
     assert np.all(fit.obukhov_length[~np.isfinite(records["true_obukhov_length"])] > 1000.0)
+
+
+def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
+    """One of rotor veer and shear with the hub speed determines u* and L: the veer is met
+    exactly and the shear follows (docs/measurements.md#simpler-site-inputs)."""
+    from floris_ekman_veer.coupling.site import atmosphere_from_shear_and_veer
+
+    bottom, top = 27.0, 153.0
+    for veer in (2.0, 10.0, 20.0):
+        abl = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, veer=veer, **SITE)
+        assert float(abl.wind_direction_change(bottom, top)) == pytest.approx(veer, abs=1e-6)
+        assert float(abl.speed(90.0)) == pytest.approx(8.0, rel=1e-8)
+        # The same state from the hub speed and its Obukhov length (the other simple input).
+        again = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=float(
+            abl.profile_fit.obukhov_length), **SITE)
+        assert float(again.geostrophic_wind) == pytest.approx(float(abl.geostrophic_wind),
+                                                              rel=1e-7)
+    # More veer, more stable: L falls, the shear across the rotor grows.
+    lengths = [float(atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, veer=v, **SITE)
+                     .profile_fit.obukhov_length) for v in (2.0, 5.0, 10.0)]
+    assert lengths[0] > lengths[1] > lengths[2]
+    # A shear exponent alone: the model's shear between the tips within 0.01 of it.
+    for shear in (0.2, 0.3):
+        abl = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=shear, **SITE)
+        model_shear = np.log(float(abl.speed(top) / abl.speed(bottom))) / np.log(top / bottom)
+        assert model_shear == pytest.approx(shear, abs=0.01)
+    # Below the neutral shear of this roughness (0.156) no stable atmosphere is left.
+    with pytest.raises(ValueError, match="fits no atmosphere"):
+        atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.1, **SITE)
+    # Both: at z0 = 0.05 m shear 0.3 goes with about 7.5 deg of veer, not 20.
+    with pytest.raises(ValueError, match="fits no atmosphere"):
+        atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.3, veer=20.0, **SITE)
+    both = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.3, veer=7.5, **SITE)
+    assert both.profile_fit.fits
+    with pytest.raises(ValueError, match="needs shear_exponent, veer or both"):
+        atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, **SITE)
+    vector = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, veer=[2.0, 10.0], **SITE)
+    np.testing.assert_allclose(vector.profile_fit.obukhov_length, lengths[::2], rtol=1e-6)

@@ -449,13 +449,13 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     n_unknowns = 3 if fit_roughness else 2
     observations = valid_speeds + (0 if directions is None
                                    else np.maximum(np.sum(np.isfinite(directions), axis=1) - 1, 0))
-    short = (valid_speeds < 2) | (observations < n_unknowns)
+    short = (valid_speeds < 1) | (observations < n_unknowns)
     if np.any(short):
         i = int(np.argmax(short))
         raise ValueError(
             f"fit_profile: record {labels[i]} has {valid_speeds[i]} speeds and "
-            f"{observations[i] - valid_speeds[i]} direction changes; the fit needs at least 2 "
-            f"speeds and {n_unknowns} data in all ({n_unknowns} unknowns)"
+            f"{observations[i] - valid_speeds[i]} direction changes; the fit needs a speed and "
+            f"{n_unknowns} data in all ({n_unknowns} unknowns)"
         )
 
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
@@ -532,7 +532,13 @@ def _multistart(model, n, max_iterations):
     x, cost, converged, iterations = _levenberg_marquardt(
         model, x, max_iterations, np.repeat(rows, lams.size)
     )
-    best = np.argmin(cost.reshape(n, lams.size), axis=1)
+    # Among equally good end points (data that do not pin the state, e.g. one speed and one
+    # direction change) the weakest stability: a deeper boundary layer rather than one collapsed
+    # below the heights.
+    cost = cost.reshape(n, lams.size)
+    tie = cost <= np.min(cost, axis=1, keepdims=True) * (1.0 + 1e-6) + 1e-12
+    best = np.argmin(np.where(tie, x.reshape(n, lams.size, -1)[:, :, 1], np.inf), axis=1)
+    cost = cost.reshape(-1)
     pick = rows * lams.size + best
     return x[pick], cost[pick], converged[pick], iterations[pick]
 

@@ -27,6 +27,9 @@ from floris_ekman_veer.coupling.inflow import set_atmosphere
 #: Column names of the measured speeds and directions: the height in metres is in the name.
 SPEED_COLUMN = re.compile(r"^speed_(\d+(?:\.\d+)?)m$")
 DIRECTION_COLUMN = re.compile(r"^direction_(\d+(?:\.\d+)?)m$")
+#: Fractions of the rotor radius at which :func:`atmosphere_from_shear_and_veer` samples the
+#: power law: bottom tip, half way, hub, half way, top tip.
+ROTOR_SAMPLES = (-1.0, -0.5, 0.0, 0.5, 1.0)
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")
 
@@ -200,4 +203,61 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                                           float).reshape(-1),
         atmosphere=profile.atmosphere(stability_input, reference_height=float(reference_height)),
         dropped=dropped,
+    )
+
+
+def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_exponent=None,
+                                   veer=None, *, speed_tolerance=0.01, veer_tolerance=0.5,
+                                   **fit_options_and_inputs) -> EkmanABL:
+    """The atmosphere of FLORIS's simpler inflow inputs (docs/measurements.md#simpler-site-inputs):
+    a hub speed [m/s] with a power-law ``shear_exponent`` and/or the ``veer`` [deg, positive
+    veering] from the bottom to the top of the rotor.
+
+    The power law U_hub (z/z_hub)^shear is sampled at the rotor's bottom tip, half radius, hub,
+    and up, and the veer taken as the direction change between the tips; ``EkmanABL.fit_profile``
+    fits them with ``speed_noise = speed_tolerance * hub_speed`` and ``direction_noise =
+    veer_tolerance``. With one of shear and veer the atmosphere follows exactly (two unknowns,
+    u* and L, two data: the hub speed and that number) and its profile gives the other; with
+    both, the model has one stability to meet two numbers (at a given z0 its shear and veer go
+    together) and the fit is refused when no stability meets both within the tolerances
+    (``fit_roughness=True`` lets z0 meet the shear). Vectorised: the inputs broadcast over
+    conditions of shape (n,).
+    """
+    if shear_exponent is None and veer is None:
+        raise ValueError("atmosphere_from_shear_and_veer needs shear_exponent, veer or both")
+    single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
+                                           shear_exponent, veer))
+    hub_speed, hub_height, rotor_diameter = (
+        np.atleast_1d(np.asarray(v, dtype=float)) for v in (hub_speed, hub_height, rotor_diameter)
+    )
+    n = np.broadcast_shapes(hub_speed.shape, hub_height.shape, rotor_diameter.shape,
+                            np.shape(shear_exponent or 0.0), np.shape(veer or 0.0))
+    if len(n) != 1:
+        raise ValueError("atmosphere_from_shear_and_veer: inputs must be numbers or 1-D arrays")
+    radius = 0.5 * np.broadcast_to(rotor_diameter, n)[:, None]
+    hub = np.broadcast_to(hub_height, n)[:, None]
+    if np.any(~(radius < hub)):
+        raise ValueError("atmosphere_from_shear_and_veer: the rotor's bottom tip must be above "
+                         f"the ground (rotor_diameter / 2 < hub_height); got rotor_diameter "
+                         f"{rotor_diameter}, hub_height {hub_height}")
+    heights = hub + radius * np.asarray(ROTOR_SAMPLES)[None, :]
+    centre = ROTOR_SAMPLES.index(0.0)
+    speed = np.broadcast_to(hub_speed, n)[:, None]
+    if shear_exponent is None:
+        speeds = np.where(np.arange(heights.shape[1]) == centre, speed, np.nan)
+    else:
+        speeds = speed * (heights / hub) ** np.broadcast_to(shear_exponent, n)[:, None]
+    directions = None
+    if veer is not None:
+        # Meteorological direction grows with veering; only the tips carry the veer.
+        turn = np.broadcast_to(veer, n)[:, None] * (heights - hub) / (2.0 * radius)
+        directions = np.where(np.isin(np.arange(heights.shape[1]), (0, heights.shape[1] - 1)),
+                              270.0 + turn, np.nan)
+    if single:
+        heights, speeds = heights[0], speeds[0]
+        directions = None if directions is None else directions[0]
+    return EkmanABL.fit_profile(
+        heights, speeds, directions,
+        speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
+        **fit_options_and_inputs,
     )
