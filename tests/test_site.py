@@ -193,3 +193,24 @@ def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
         atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, **SITE)
     vector = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, veer=[2.0, 10.0], **SITE)
     np.testing.assert_allclose(vector.profile_fit.obukhov_length, lengths[::2], rtol=1e-6)
+
+
+def test_site_fit_example_reduced(tmp_path):
+    """examples/site_fit.py on four records: the fit, the FLORIS run from the YAML it writes,
+    annual energy with and without steering, the figure."""
+    import sys
+
+    sys.path.insert(0, str(REPO / "examples"))
+    import site_fit
+
+    result = site_fit.run_example(reduced=True, models=("ekman_veer", "gch"))
+    table, energy = result["table"], result["energy"].table
+    assert len(table) == 4 and np.all(table["misfit"] < 2.0)
+    year = energy[energy["stability"] == "all"].set_index("model")
+    assert set(year.index) == {"ekman_veer", "gch"}
+    assert np.all(year["aep_steered_gwh"] >= year["aep_baseline_gwh"])
+    path = site_fit.write_input(result["site"], tmp_path)
+    again = FlorisModel(path)  # the YAML, with its per-record atmosphere lists, runs as written
+    again.run()
+    np.testing.assert_allclose(again.get_farm_power() / 1e3, table["farm_power_kw"], rtol=1e-12)
+    assert site_fit.plot_profiles(result["site"], tmp_path).stat().st_size > 10_000
