@@ -11,10 +11,9 @@ script, not a test:
    against the true profile, as median, 95th percentile and maximum over the records.
 """
 
-import time
-
 import numpy as np
 
+from benchmarks.bench_models import best_time
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 
 HEIGHTS = np.arange(30.0, 151.0, 20.0)
@@ -37,15 +36,6 @@ def sample(abl, rng=None, n=None):
     return s, d
 
 
-def best_of(function, repeats=3):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return min(times)
-
-
 def main():
     rng = np.random.default_rng(0)
     n = 1000
@@ -55,8 +45,8 @@ def main():
     clean = sample(truth)
     noisy = sample(truth, rng)
     for label, (s, d) in (("noise-free", clean), ("noisy", noisy)):
-        seconds = best_of(lambda: EkmanABL.fit_profile(HEIGHTS, s, d, on_misfit="flag", **NOISE,
-                                                       **SITE))
+        seconds = best_time(lambda: EkmanABL.fit_profile(HEIGHTS, s, d, on_misfit="flag",
+                                                         **NOISE, **SITE), repeats=3)
         fit = EkmanABL.fit_profile(HEIGHTS, s, d, on_misfit="flag", **NOISE, **SITE).profile_fit
         print(f"fit_profile, {n} records, {label}: {seconds:.2f} s per 1,000 records "
               f"(median iterations {np.median(fit.iterations):.0f}, records fitting "
