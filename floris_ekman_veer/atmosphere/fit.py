@@ -56,6 +56,8 @@ DEFAULT_DIRECTION_NOISE = 1.0
 DEFAULT_REFUSAL_PROBABILITY = 1e-6
 #: Starting Obukhov lengths [m] of the multi-start (inf: neutral).
 STARTING_OBUKHOV_LENGTHS = (np.inf, 400.0, 200.0, 100.0, 50.0, 25.0)
+#: Factors on the best end point's 1/L of the restarts across the profile's step near h.
+_POLISH_FACTORS = (0.9, 0.97, 1.03, 1.1)
 #: Default starting roughness length [m] when it is fitted and none is given.
 DEFAULT_ROUGHNESS_START = 0.05
 #: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
@@ -511,36 +513,69 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     return abl
 
 
-def _multistart(model, n, max_iterations):
-    """Levenberg-Marquardt from each starting stability (u* from the lowest speed by the
-    log-linear law), all records and starts in one batch; the best end point per record.
-
-    Several starts because the objective has kinks: where the ABL top h (or the matching height
-    0.2 h) crosses a measurement height the profile's slope jumps, and an iteration can stop on
-    the kink, a local minimum, while another start reaches the fit.
-    """
-    lowest = np.argmin(np.where(model.ms, model.z, np.inf), axis=1)
+def _starts(model, lams):
+    """Starting unknowns (n * k, p) for stabilities lam (n, k): u* from the lowest speed by the
+    log-linear law U = (u*/kappa) (ln(z/z0) + 5 z/L), z0 its given (starting) value."""
+    n, k = lams.shape
     rows = np.arange(n)
-    z1, s1 = model.z[rows, lowest], model.s[rows, lowest]
-    lams = _LENGTH_SCALE / np.asarray(STARTING_OBUKHOV_LENGTHS)
-    u_star = model.kappa * s1[:, None] / (np.log(z1 / model.z0)[:, None] + 5.0 * z1[:, None]
-                                           * lams[None, :] / _LENGTH_SCALE)
-    columns = [np.log(u_star), np.broadcast_to(lams, (n, lams.size))]
+    lowest = np.argmin(np.where(model.ms, model.z, np.inf), axis=1)
+    z1, s1 = model.z[rows, lowest][:, None], model.s[rows, lowest][:, None]
+    u_star = model.kappa * s1 / (np.log(z1 / model.z0[:, None]) + 5.0 * z1 * lams / _LENGTH_SCALE)
+    columns = [np.log(u_star), lams]
     if model.fit_roughness:
-        columns.append(np.broadcast_to(np.log(model.z0)[:, None], (n, lams.size)))
-    x = np.stack([np.asarray(c, float) for c in columns], axis=-1).reshape(-1, len(columns))
-    x, cost, converged, iterations = _levenberg_marquardt(
-        model, x, max_iterations, np.repeat(rows, lams.size)
-    )
-    # Among equally good end points (data that do not pin the state, e.g. one speed and one
-    # direction change) the weakest stability: a deeper boundary layer rather than one collapsed
-    # below the heights.
-    cost = cost.reshape(n, lams.size)
+        columns.append(np.broadcast_to(np.log(model.z0)[:, None], (n, k)))
+    return np.stack([np.asarray(c, float) for c in columns], axis=-1).reshape(n * k, -1)
+
+
+def _best(x, cost, n, k):
+    """Index (into n * k rows) of each record's best end point; among equally good ones (data
+    that do not pin the state, e.g. one speed and one direction change) the weakest stability:
+    a deeper boundary layer rather than one collapsed below the heights."""
+    cost = cost.reshape(n, k)
     tie = cost <= np.min(cost, axis=1, keepdims=True) * (1.0 + 1e-6) + 1e-12
-    best = np.argmin(np.where(tie, x.reshape(n, lams.size, -1)[:, :, 1], np.inf), axis=1)
-    cost = cost.reshape(-1)
-    pick = rows * lams.size + best
-    return x[pick], cost[pick], converged[pick], iterations[pick]
+    best = np.argmin(np.where(tie, x.reshape(n, k, -1)[:, :, 1], np.inf), axis=1)
+    return np.arange(n) * k + best
+
+
+def _multistart(model, n, max_iterations):
+    """Levenberg-Marquardt from each starting stability, all records and starts in one batch,
+    then from a few stabilities next to the best end point; the best end point per record.
+
+    Several starts because the objective has kinks and a step: where the ABL top h, or the
+    matching height 0.2 h, crosses a measurement height the profile's slope jumps, and where
+    0.9973 h does the direction steps (docs/atmosphere.md#lateral-velocity-near-the-abl-top);
+    an iteration can stop there, a local minimum, while a start on the other side reaches the
+    fit.
+    """
+    rows = np.arange(n)
+    grid = np.broadcast_to(_LENGTH_SCALE / np.asarray(STARTING_OBUKHOV_LENGTHS), (n, len(STARTING_OBUKHOV_LENGTHS)))
+    results = []
+    for stage in ("grid", "polish"):
+        if stage == "grid":
+            starts = _starts(model, grid)
+        else:
+            # Next to the best end point: its 1/L times a few factors either side, with u* from
+            # the log-linear law and from the end point's own state.
+            factors = np.asarray(_POLISH_FACTORS)
+            best = results[0][0]
+            near = np.repeat(best, factors.size, axis=0)
+            near[:, 1] *= np.tile(factors, n)
+            # u* moved with the stability as at a fixed speed aloft (u* ~ L^-1/2 there)
+            near[:, 0] += 0.5 * np.log(np.tile(factors, n))
+            starts = np.concatenate([
+                _starts(model, best[:, 1][:, None] * factors[None, :]).reshape(n, factors.size, -1),
+                near.reshape(n, factors.size, -1),
+            ], axis=1).reshape(n * 2 * factors.size, -1)
+        k = starts.shape[0] // n
+        x, cost, converged, iterations = _levenberg_marquardt(
+            model, starts, max_iterations, np.repeat(rows, k)
+        )
+        pick = _best(x, cost, n, k)
+        results.append((x[pick], cost[pick], converged[pick], iterations[pick]))
+    (x, cost, converged, iterations), polished = results
+    better = polished[1] < cost * (1.0 - 1e-6) - 1e-12
+    return tuple(np.where(better[:, None] if a.ndim == 2 else better, b, a)
+                 for a, b in zip((x, cost, converged, iterations), polished))
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
