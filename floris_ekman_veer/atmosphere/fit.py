@@ -58,6 +58,8 @@ DEFAULT_REFUSAL_PROBABILITY = 1e-6
 STARTING_OBUKHOV_LENGTHS = (np.inf, 400.0, 200.0, 100.0, 50.0, 25.0)
 #: Factors on the best end point's 1/L of the restarts across the profile's step near h.
 _POLISH_FACTORS = (0.9, 0.97, 1.03, 1.1)
+#: ... for records whose fitted ABL top is below this times their highest measurement.
+_POLISH_HEIGHT_RATIO = 1.2
 #: Default starting roughness length [m] when it is fitted and none is given.
 DEFAULT_ROUGHNESS_START = 0.05
 #: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
@@ -233,7 +235,7 @@ class _ProfileModel:
         return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
 
     def state(self, x, index):
-        """(G, mu, z0, valid) for unknowns x of records ``index``."""
+        """(G, mu, z0, valid, h) for unknowns x of records ``index``."""
         log_u = x[:, 0]
         u_star = np.exp(log_u)
         z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
@@ -248,7 +250,7 @@ class _ProfileModel:
                 # a surface layer above the roughness, with margin for the re-solve's round-off
                 & (self.template.matching_fraction * h_hat * u_star / p["f"] > 1.001 * z0)
             )
-        return g, mu, z0, valid
+        return g, mu, z0, valid, h_hat * u_star / p["f"]
 
     def abl(self, g, mu, z0, index):
         return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
@@ -256,7 +258,7 @@ class _ProfileModel:
 
     def residuals(self, x, index):
         """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
-        g, mu, z0, valid = self.state(x, index)
+        g, mu, z0, valid, _ = self.state(x, index)
         # Invalid trial states are evaluated at a harmless stand-in and discarded.
         g = np.where(valid, g, 10.0)
         mu = np.where(valid, mu, 0.0)
@@ -464,7 +466,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                           float(speed_noise), float(direction_noise))
     x, cost, converged, iterations = _multistart(model, n, max_iterations)
     index = np.arange(n)
-    g, mu, z0_fit, valid = model.state(x, index)
+    g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
     dof = np.maximum(observations - n_unknowns, 1)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
@@ -549,33 +551,47 @@ def _multistart(model, n, max_iterations):
     """
     rows = np.arange(n)
     grid = np.broadcast_to(_LENGTH_SCALE / np.asarray(STARTING_OBUKHOV_LENGTHS), (n, len(STARTING_OBUKHOV_LENGTHS)))
-    results = []
-    for stage in ("grid", "polish"):
-        if stage == "grid":
-            starts = _starts(model, grid)
-        else:
-            # Next to the best end point: its 1/L times a few factors either side, with u* from
-            # the log-linear law and from the end point's own state.
-            factors = np.asarray(_POLISH_FACTORS)
-            best = results[0][0]
-            near = np.repeat(best, factors.size, axis=0)
-            near[:, 1] *= np.tile(factors, n)
-            # u* moved with the stability as at a fixed speed aloft (u* ~ L^-1/2 there)
-            near[:, 0] += 0.5 * np.log(np.tile(factors, n))
-            starts = np.concatenate([
-                _starts(model, best[:, 1][:, None] * factors[None, :]).reshape(n, factors.size, -1),
-                near.reshape(n, factors.size, -1),
-            ], axis=1).reshape(n * 2 * factors.size, -1)
-        k = starts.shape[0] // n
-        x, cost, converged, iterations = _levenberg_marquardt(
-            model, starts, max_iterations, np.repeat(rows, k)
+    x, cost, converged, iterations = _levenberg_marquardt(
+        model, _starts(model, grid), max_iterations, np.repeat(rows, grid.shape[1])
+    )
+    pick = _best(x, cost, n, grid.shape[1])
+    x, cost, converged, iterations = x[pick], cost[pick], converged[pick], iterations[pick]
+    # Records whose fitted ABL top lies within or just above the heights, where the step is:
+    # restarts next to the end point, its 1/L times a few factors either side, with u* from
+    # the log-linear law and from the end point's own state, u* moved with the stability as at
+    # a fixed speed aloft (u* ~ L^-1/2 there).
+    _, _, _, valid, h = model.state(x, rows)
+    near_top = np.flatnonzero(valid & (x[:, 1] > 0)
+                              & (h < _POLISH_HEIGHT_RATIO * np.max(model.z, axis=1)))
+    if near_top.size:
+        factors = np.asarray(_POLISH_FACTORS)
+        m, k = near_top.size, 2 * factors.size
+        best = x[near_top]
+        near = np.repeat(best, factors.size, axis=0)
+        near[:, 1] *= np.tile(factors, m)
+        near[:, 0] += 0.5 * np.log(np.tile(factors, m))
+        sub = _SubsetModel(model, near_top)
+        starts = np.concatenate([
+            _starts(sub, best[:, 1][:, None] * factors[None, :]).reshape(m, factors.size, -1),
+            near.reshape(m, factors.size, -1),
+        ], axis=1).reshape(m * k, -1)
+        x2, cost2, converged2, iterations2 = _levenberg_marquardt(
+            model, starts, max_iterations, np.repeat(near_top, k)
         )
-        pick = _best(x, cost, n, k)
-        results.append((x[pick], cost[pick], converged[pick], iterations[pick]))
-    (x, cost, converged, iterations), polished = results
-    better = polished[1] < cost * (1.0 - 1e-6) - 1e-12
-    return tuple(np.where(better[:, None] if a.ndim == 2 else better, b, a)
-                 for a, b in zip((x, cost, converged, iterations), polished))
+        pick = _best(x2, cost2, m, k)
+        better = cost2[pick] < cost[near_top] * (1.0 - 1e-6) - 1e-12
+        chosen = near_top[better]
+        x[chosen], cost[chosen] = x2[pick][better], cost2[pick][better]
+        converged[chosen], iterations[chosen] = converged2[pick][better], iterations2[pick][better]
+    return x, cost, converged, iterations
+
+
+class _SubsetModel:
+    """The data of some records of a `_ProfileModel`, for `_starts`."""
+
+    def __init__(self, model, index):
+        self.ms, self.z, self.s = model.ms[index], model.z[index], model.s[index]
+        self.z0, self.kappa, self.fit_roughness = model.z0[index], model.kappa, model.fit_roughness
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
