@@ -11,8 +11,8 @@ top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and e
   speeds;
 * said once per study: a warning is repeated only when it concerns wind speeds (or settings) not
   reported yet in this process, so a yaw optimiser's many re-builds and runs, an annual-energy
-  study's classes and a script's repeated ``set()`` report each condition once. A change of the
-  warning filters (``warnings.catch_warnings``, ``pytest.warns``) starts afresh.
+  study's classes and a script's repeated ``set()`` report each condition once. A recording
+  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh.
 
 Silencing, for this process and every worker process or Dask worker it starts or sends models
 to::
@@ -155,18 +155,26 @@ def user_frame():
 
 
 # --------------------------------------------------------------------------- once per study
+def _recorder():
+    """What shows warnings now: ``catch_warnings(record=True)`` (and so ``pytest.warns`` and
+    pytest's per-test capture) installs its own list's ``append`` there."""
+    return getattr(warnings, "_showwarnmsg_impl", None) or warnings.filters
+
+
 class _Reported:
-    """Items reported per warning class; forgotten when the warning filters change."""
+    """Items reported per warning class; forgotten when a recording context starts."""
 
     def __init__(self):
-        self.filters = None
+        self.recorder = None
         self.items: dict = {}
 
     def new(self, key, items) -> bool:
-        if self.filters is not warnings.filters:
-            # catch_warnings (and pytest.warns) install a fresh filter list: start afresh, as
-            # Python's own "default" action does.
-            self.filters, self.items = warnings.filters, {}
+        recorder = _recorder()
+        if self.recorder is not recorder:
+            # a warnings.catch_warnings(record=True) (pytest.warns, pytest's capture of each
+            # test) starts afresh: what it records is all it sees. (Held, so that its id is not
+            # reused by a later one.)
+            self.recorder, self.items = recorder, {}
         seen = self.items.setdefault(key, set())
         fresh = set(items) - seen
         seen.update(fresh)
