@@ -23,8 +23,9 @@ to::
 
 or, before Python starts, ``FLORIS_EKMAN_VEER_WARNINGS=ignore`` (or a comma-separated list of
 class names) in the environment. The setting lives in that environment variable, which process
-pools inherit, and it travels with every model the package sends to a ParFlorisModel or Dask
-worker (coupling/parallel.py). ``silence_warnings(None)`` restores the default. Python's own
+pools inherit; it travels with every model the package sends to a ParFlorisModel worker
+(coupling/parallel.py) and is set on the Dask workers at each run (coupling/distributed.py). ``silence_warnings(None)`` restores the
+default. Python's own
 warning filters work as usual in the process where they are set.
 """
 
@@ -112,9 +113,11 @@ def silence_warnings(*categories) -> None:
 
 
 def apply_setting(setting: str | None) -> None:
-    """Adopt a setting carried from another process (a worker receiving a model)."""
+    """Adopt the setting of the process that sends this worker its models (None: the default)."""
     if setting:
         os.environ[ENVIRONMENT_VARIABLE] = setting
+    else:
+        os.environ.pop(ENVIRONMENT_VARIABLE, None)
 
 
 def _silenced(category: type) -> bool:

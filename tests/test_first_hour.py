@@ -414,3 +414,50 @@ def test_quick_start_example_converts_floris_defaults_and_shows_what_veer_change
     # GCH's additions act behind the yawed rotor, mostly on the last turbine (+3 % and +4.5 %)
     np.testing.assert_allclose(gch[:, 1], yawed[:, 1], rtol=1e-5)
     assert np.all(gch[:, 2] / yawed[:, 2] - 1.0 > 0.02)
+
+
+DASK_SCRIPT = '''
+import os
+import floris_ekman_veer
+from floris import FlorisModel
+
+def setting():
+    return os.environ.get("FLORIS_EKMAN_VEER_WARNINGS")
+
+def main():
+    from distributed import Client, LocalCluster
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_sbl6"))
+    fmodel.set(wind_directions=[270.0] * 2, wind_speeds=[3.5, 9.0], turbulence_intensities=[0.06] * 2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as cluster, \\
+            Client(cluster) as client:
+        floris_ekman_veer.silence_warnings()  # after the workers started
+        par = floris_ekman_veer.ParFlorisModel(fmodel, interface="dask", client=client)
+        par.run()  # 3.5 m/s: the thrust limit acts on a worker, silenced
+        silenced = sorted(set(client.run(setting).values()))
+        import sys, time
+        time.sleep(0.5)  # the workers' stderr reaches ours through their nannies
+        print("SILENCED-RUN-DONE", file=sys.stderr, flush=True)
+        floris_ekman_veer.silence_warnings(None)
+        par.run()
+        restored = sorted(set(map(str, client.run(setting).values())))
+        time.sleep(0.5)
+    print("RESULT", silenced, restored)
+
+if __name__ == "__main__":
+    main()
+'''
+
+
+def test_silencing_reaches_dask_workers_started_before_it(tmp_path):
+    pytest.importorskip("distributed")
+    script = tmp_path / "dask_silence.py"
+    script.write_text(DASK_SCRIPT)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    env.pop(package_warnings.ENVIRONMENT_VARIABLE, None)
+    done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "RESULT ['ignore'] ['None']" in done.stdout
+    silenced_run, _, restored_run = done.stderr.partition("SILENCED-RUN-DONE")
+    assert "ThrustLimitWarning" not in silenced_run
+    assert "ThrustLimitWarning" in restored_run  # the worker running 3.5 m/s says it again
