@@ -1,6 +1,6 @@
 """ABL profiles and turbulence of the paper's Table 1 cases, from the shipped inputs.
 
-    python examples/abl_profiles.py [--output DIR]
+    python examples/abl_profiles.py [--output DIR] [--gallery DIR]
 
 CNBL and SBL-1..6 (``inputs/cnbl.yaml``, ``inputs/sbl1.yaml`` ... ``inputs/sbl6.yaml``: G = 15 m/s,
 z0 = 0.1 m, f_c = 1e-4 1/s, N = 6.1e-3 1/s, Theta0 = 265 K, Q0 = C_r h with the LES cooling rates
@@ -11,6 +11,8 @@ h, mu, alpha_0, the veer across the rotor, I_u(z_h) and k_w, and writes to DIR (
   direction relative to hub height, the ABL height h marked;
 * ``turbulence_intensity.png``: I_u(z) of Eq. (Iu_model) per case (normalised by U_h, hub height
   marked) and k_w of Eq. (kw_CNBL_SBL_model) against I_u(z_h) (the paper's turbulence figure).
+
+``--gallery DIR`` also writes a small copy of ``abl_profiles.png`` for the README (``docs/``).
 """
 
 from __future__ import annotations
@@ -70,7 +72,7 @@ def profiles(case: Case, z) -> tuple[np.ndarray, ...]:
     return u, v, np.hypot(u, v), -np.rad2deg(np.arctan2(v, u))
 
 
-def profiles_figure(cases: dict[str, Case], output: Path) -> Path:
+def profiles_figure(cases: dict[str, Case], output: Path, dpi: int = 90) -> Path:
     z = np.linspace(0.5, 1300.0, 1300)
     fig, axes = plt.subplots(1, 4, figsize=(15, 5.5), sharey=True, constrained_layout=True)
     colours = plt.cm.viridis(np.linspace(0.0, 0.9, len(cases)))
@@ -90,7 +92,7 @@ def profiles_figure(cases: dict[str, Case], output: Path) -> Path:
     fig.suptitle("Ekman-surface-layer ABL of the paper's cases, G = 15 m/s (dots: ABL height h; "
                  "shaded: rotor)")
     path = output / "abl_profiles.png"
-    fig.savefig(path, dpi=90)
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
 
@@ -123,11 +125,14 @@ def turbulence_figure(cases: dict[str, Case], table, output: Path) -> Path:
 
 
 def main(argv=None) -> None:
-    output = arguments(__doc__, argv, gallery=False).output
+    args = arguments(__doc__, argv)
     cases = {name: Case(name) for name in CASE_FILES}
     table = case_table(cases)
     print_table(table)
-    for path in (profiles_figure(cases, output), turbulence_figure(cases, table, output)):
+    paths = [profiles_figure(cases, args.output), turbulence_figure(cases, table, args.output)]
+    if args.gallery is not None:
+        paths.append(profiles_figure(cases, args.gallery, dpi=60))
+    for path in paths:
         print(f"figure: {path}")
 
 

@@ -2,7 +2,7 @@
 
 Run it from anywhere (after ``pip install .``, or from a checkout):
 
-    python examples/yaw_study.py [--output DIR]
+    python examples/yaw_study.py [--output DIR] [--gallery DIR]
 
 Two atmospheres, read from the project's inputs: the paper's neutral CNBL (the atmosphere block of
 ``inputs/cnbl.yaml``) and its strongly stable SBL-6 (``inputs/farm_sbl6.yaml``); the farm, the
@@ -191,7 +191,7 @@ def run_study(reduced: bool = False) -> dict:
 
 
 # ----------------------------------------------------------------------------------- figures
-def plot_row(yaw: pd.DataFrame, output: Path) -> Path:
+def plot_row(yaw: pd.DataFrame, output: Path, dpi: int = 120) -> Path:
     import matplotlib.pyplot as plt
 
     labels = list(dict.fromkeys(yaw["atmosphere"]))
@@ -211,7 +211,7 @@ def plot_row(yaw: pd.DataFrame, output: Path) -> Path:
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     path = output / "yaw_study_row.png"
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
 
@@ -232,6 +232,8 @@ def plot_energy(energy, output: Path) -> Path:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--output", type=Path, default=Path("output"))
+    parser.add_argument("--gallery", type=Path, default=None,
+                        help="also write the README gallery's small copy of yaw_study_row.png")
     args = parser.parse_args(argv)
     args.output.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
@@ -267,7 +269,11 @@ def main(argv=None) -> None:
           f"(Weibull k = {ROSE_WEIBULL[0]:g}, A = {ROSE_WEIBULL[1]:g} m/s; nights "
           f"{NIGHT_FREQUENCY:.0%} of the year, SBL-6; days CNBL):")
     print(energy.table.to_string(index=False, float_format="%.3f"))
-    for path in (plot_row(yaw, args.output), plot_energy(energy, args.output)):
+    paths = [plot_row(yaw, args.output), plot_energy(energy, args.output)]
+    if args.gallery is not None:
+        args.gallery.mkdir(parents=True, exist_ok=True)
+        paths.append(plot_row(yaw, args.gallery, dpi=60))
+    for path in paths:
         print(f"wrote {path}")
     print(f"done in {time.perf_counter() - started:.1f} s")
 

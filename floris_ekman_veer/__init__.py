@@ -12,6 +12,10 @@ FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
 optimisers on scalar and per-condition atmospheres alike and returns FLORIS's ``df_opt``.
 ``floris_ekman_veer.annual_energy(fmodel, wind_data, stability, optimizer_class, ...)`` gives the
 AEP per stability class, baseline and with wake steering, for ekman_veer and FLORIS's GCH.
+``floris_ekman_veer.example_input("farm_sbl6")`` is the path of one of the package's FLORIS
+inputs, installed with it. Every warning class of the package is importable from here, and
+``floris_ekman_veer.silence_warnings()`` silences them in this process and its workers
+(docs/user_guide.md#warnings).
 """
 
 from floris_ekman_veer._version import __version__
@@ -21,8 +25,20 @@ from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
 from floris_ekman_veer.coupling.site import fit_site
+from floris_ekman_veer.example_inputs import example_input, example_inputs
+from floris_ekman_veer.warnings import (
+    FlorisEkmanVeerWarning,
+    HeterogeneousInflowWarning,
+    ModelSettingsWarning,
+    ShallowBoundaryLayerWarning,
+    ThrustLimitWarning,
+    TurbinePlacementWarning,
+    silence_warnings,
+)
 
-__all__ = ["EkmanABL", "ParFlorisModel", "__version__", "annual_energy", "fit_site",
-           "optimize_yaw", "register"]
+__all__ = ["EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
+           "ModelSettingsWarning", "ParFlorisModel", "ShallowBoundaryLayerWarning",
+           "ThrustLimitWarning", "TurbinePlacementWarning", "__version__", "annual_energy",
+           "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings"]
 
 register()

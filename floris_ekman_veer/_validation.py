@@ -164,6 +164,9 @@ def _is_real(value) -> bool:
         return value.dtype.kind == "O" and all(_is_real(v) for v in value.ravel())
     if isinstance(value, (list, tuple)):
         return all(_is_real(v) for v in value)
+    if hasattr(value, "__array__") and not isinstance(value, (str, bytes, np.generic)):
+        # pandas Series and Index, xarray, and other array-likes: judged by their values
+        return _is_real(np.asarray(value))
     return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
 
 

@@ -241,10 +241,10 @@ def test_roughness_sublayer(abl):
 
 
 def test_sublayer_capped_at_matching_height():
-    """A boundary layer so shallow that e z0 reaches its matching height 0.2 h: the sublayer ends
-    there (U continuous, its slope not)."""
-    a = EkmanABL.from_reference_wind(
-        3.4, 135.8, latitude=-38.0, roughness_length=0.003, brunt_vaisala_frequency=0.0137,
+    """A boundary layer so shallow over rough ground (26 m deep, z0 = 1 m) that the sublayer
+    reaches its matching height 0.2 h: the sublayer ends there (U continuous, its slope not)."""
+    a = EkmanABL(
+        geostrophic_wind=4.0, latitude=-38.0, roughness_length=1.0, brunt_vaisala_frequency=0.0137,
         surface_heat_flux=-0.0061,
     )
     z_m = 0.2 * float(a.boundary_layer_height)
@@ -709,7 +709,14 @@ BASE = dict(geostrophic_wind=10.0, latitude=45.0, roughness_length=0.1)
     (dict(surface_heat_flux=-0.01, obukhov_length=100.0),
      r"give at most one stability input .*obukhov_length.*surface_heat_flux"),
     (dict(cooling_rate=0.5),
-     r"cooling_rate must be <= 0 K/h .*unstable \(convective\) conditions are not covered"),
+     r"cooling_rate must be -10 to 0 K/h.*unstable \(convective\) conditions are not covered"),
+    # unit mistakes: K/day for K/h, Celsius for kelvin, K/km for K/m
+    (dict(cooling_rate=-100.0), r"cooling_rate must be -10 to 0 K/h, surface cooling in kelvin "
+                                r"per hour.*; got -100"),
+    (dict(reference_potential_temperature=15.0),
+     r"reference_potential_temperature must be 200 to 350 K \(a potential temperature in "
+     r"kelvin, not degrees Celsius\); got 15"),
+    (dict(reference_potential_temperature=400.0), r"reference_potential_temperature must be 200 to 350 K"),
     (dict(stability_parameter=-1.0),
      r"stability_parameter must be >= 0.*unstable \(convective\) conditions are not covered"),
     (dict(surface_heat_flux=0.02),
@@ -719,7 +726,8 @@ BASE = dict(geostrophic_wind=10.0, latitude=45.0, roughness_length=0.1)
     (dict(brunt_vaisala_frequency=0.01, lapse_rate=0.003),
      r"give at most one of brunt_vaisala_frequency \[1/s\] or lapse_rate \[K/m\]"),
     (dict(brunt_vaisala_frequency=-0.01), r"brunt_vaisala_frequency must be >= 0 1/s"),
-    (dict(lapse_rate=-0.001), r"lapse_rate must be >= 0 K/m"),
+    (dict(lapse_rate=-0.001), r"lapse_rate must be 0 to 0.1 K/m"),
+    (dict(lapse_rate=3.5), r"lapse_rate must be 0 to 0.1 K/m .*in K/m, not K/km\); got 3.5"),
     (dict(c_g=0.0), r"c_g must be > 0 and finite \(a model constant\); got 0"),
     (dict(matching_fraction=1.2), r"matching_fraction must be in \(0, 1\)"),
 ])
@@ -761,7 +769,7 @@ def test_from_reference_wind_rejects_geostrophic_wind():
                                      roughness_length=0.1)
 
 
-@pytest.mark.parametrize("g, c_r", [(2.0, -20.0), (2.0, -100.0), (1.0, -20.0)])
+@pytest.mark.parametrize("g, c_r", [(2.0, -10.0), (2.0, -5.0), (1.0, -10.0)])
 def test_collapsed_sbl_raises_naming_inputs(g, c_r):
     """Too strong cooling for a weak wind: no model ABL (the SBL collapses)."""
     with pytest.raises(ValueError) as info:
@@ -773,6 +781,6 @@ def test_collapsed_sbl_raises_naming_inputs(g, c_r):
 
 
 def test_collapse_reported_for_the_offending_element():
-    with pytest.raises(ValueError, match=r"geostrophic_wind=2, .*cooling_rate=-20"):
+    with pytest.raises(ValueError, match=r"geostrophic_wind=2, .*cooling_rate=-10"):
         EkmanABL(geostrophic_wind=np.array([15.0, 2.0]), latitude=45.0, roughness_length=0.1,
-                 cooling_rate=np.array([-1.0, -20.0]))
+                 cooling_rate=np.array([-1.0, -10.0]))

@@ -487,8 +487,8 @@ def test_worker_dict_prepares_the_unpickling_process(monkeypatch):
         ({"geostrophic_wind": 12.0}, "geostrophic_wind is not allowed"),
         ({"roughness_length": "rough"}, "atmosphere.roughness_length must be a real number"),
         ({"cooling_rate": [[-0.1, -0.2]]}, "atmosphere.cooling_rate must be a number or a 1-D list"),
-        ({"cooling_rate": float("nan")}, r"atmosphere.cooling_rate must be <= 0 K/h and finite.*got nan"),
-        ({"cooling_rate": 1.0}, r"ekman_veer.atmosphere.cooling_rate must be <= 0 K/h.*got 1"),  # heating
+        ({"cooling_rate": float("nan")}, r"atmosphere.cooling_rate must be -10 to 0 K/h.*got nan"),
+        ({"cooling_rate": 1.0}, r"ekman_veer.atmosphere.cooling_rate must be -10 to 0 K/h.*got 1"),  # heating
         ({"roughness_length": None}, "missing required key.*roughness_length"),
     ],
 )
@@ -511,10 +511,10 @@ def test_reference_height_below_roughness_raises():
                     reference_wind_height=0.3)
 
 
-def test_non_positive_wind_speed_raises_at_set():
-    fmodel = ekman_model()
-    with pytest.raises(ValueError, match="wind_speeds must be > 0"):
-        fmodel.set(wind_speeds=[8.0, 0.0, 9.0])
+def test_negative_wind_speed_raises_at_set():
+    fmodel = ekman_model()  # a calm condition (0 m/s) is at rest (tests/test_first_hour.py)
+    with pytest.raises(ValueError, match=r"wind_speeds must be finite and >= 0.*-1 at condition 1"):
+        fmodel.set(wind_speeds=[8.0, -1.0, 9.0])
 
 
 def test_conditions_can_come_later():

@@ -56,7 +56,7 @@ PYTHON = {
     "f_c below -2 Omega": (lambda: EkmanABL(geostrophic_wind=10.0, coriolis_parameter=-2e-4, roughness_length=0.1),
                            r"^coriolis_parameter must be .*2 Omega.*got -0.0002"),
     "per-entry index": (lambda: build(cooling_rate=[-0.5, 0.3, -1.0]),
-                        r"^cooling_rate must be <= 0 K/h.*got 0.3 at condition 1"),
+                        r"^cooling_rate must be -10 to 0 K/h.*got 0.3 at condition 1"),
     "NaN entry index": (lambda: build(roughness_length=[0.1, np.nan]),
                         r"^roughness_length must be > 0 m; got nan at condition 1"),
     # NaN heights in every profile method (never NaN out, never a finite V(NaN))
@@ -88,7 +88,7 @@ FLORIS = {
     "z0 boolean": (dict(roughness_length=True), PATH + r"roughness_length must be a real number.*got True \(bool\)"),
     "cooling rate boolean list": (dict(cooling_rate=[True, False]), PATH + r"cooling_rate must be a real number"),
     "f_c above 2 Omega": (dict(coriolis_parameter=0.01), PATH + r"coriolis_parameter must be .*2 Omega.*got 0.01"),
-    "per-condition range": (dict(cooling_rate=[-0.5, -1.0, 0.5]), PATH + r"cooling_rate must be <= 0 K/h.*got 0.5 at condition 2"),
+    "per-condition range": (dict(cooling_rate=[-0.5, -1.0, 0.5]), PATH + r"cooling_rate must be -10 to 0 K/h.*got 0.5 at condition 2"),
     "per-condition NaN": (dict(roughness_length=[0.1, np.nan, 0.1]), PATH + r"roughness_length must be > 0 m; got nan at condition 1"),
     "list of lists": (dict(cooling_rate=[[-0.5], [-1.0], [-0.5]]), PATH + r"cooling_rate must be a number or a 1-D list"),
     "wrong length": (dict(cooling_rate=[-0.5, -1.0]),

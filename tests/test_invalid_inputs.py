@@ -66,6 +66,15 @@ def layout(x, y):
     return lambda c: c["farm"].update(layout_x=x, layout_y=y)
 
 
+def nrel_5mw(**changes):
+    import floris
+
+    def spoil(c):
+        path = f"{floris.__path__[0]}/turbine_library/nrel_5MW.yaml"
+        c["farm"]["turbine_type"] = [{**load_yaml(path), **changes}]
+    return spoil
+
+
 def disk(**table):
     def spoil(c):
         turbine = actuator_disk_turbine()
@@ -139,9 +148,15 @@ BUILD_CASES = [
     ("layout NaN", layout([0.0, math.nan], [0.0, 0.0]),
      ["farm.layout_x", "nan at turbine 1", "finite"]),
     ("coincident turbines", layout([0.0, 0.0], [0.0, 0.0]),
-     ["farm.layout_x", "turbines 0 and 1", "0 m apart", "rotors would intersect"]),
-    ("intersecting rotors", layout([0.0, 100.0], [0.0, 0.0]),
-     ["farm.layout_x", "turbines 0 and 1", "100 m apart", "125.88 m"]),
+     ["farm.layout_x", "turbines 0 and 1", "0 m apart", "cannot stand in one place"]),
+    # (intersecting rotors run, with a warning: tests/test_first_hour.py)
+    ("reference height negative", flow("reference_wind_height", -5.0),
+     ["flow_field.reference_wind_height", "> 0 m", "or -1", "got -5.0"]),
+    ("reference height zero", flow("reference_wind_height", 0.0),
+     ["flow_field.reference_wind_height", "> 0 m", "got 0.0"]),
+    ("rotor below the ground", nrel_5mw(hub_height=50.0),
+     ["farm.turbine_type[0].hub_height", ">= rotor_diameter / 2 = 62.94 m", "got 50 m at turbine 0",
+      "12.94 m below the ground"]),
     ("ct_prime beyond momentum theory", disk(ct_prime=40.0),
      [f"{DISK}.ct_prime", "40.0", "in (0, 4]"]),
     ("ct_prime zero", disk(ct_prime=0.0), [f"{DISK}.ct_prime", "0.0", "in (0, 4]"]),

@@ -63,9 +63,10 @@ def test_wind_rose_3_to_25_ms_runs_with_finite_powers_and_counts_shallow_conditi
     assert 0 < hub_above < shallow < len(speeds)
     message = str(caught[-1].message)
     assert message.startswith(
-        f"{shallow * len(directions)} of {len(speeds) * len(directions)} conditions have a "
-        f"boundary layer shallower than the rotor (rotor top above h; "
-        f"{hub_above * len(directions)} with the hub at or above h)")
+        f"{shallow * len(directions)} of {len(speeds) * len(directions)} conditions (wind "
+        f"speeds 3, 4, 5, 6, 7, 8, 9 and 10 m/s at 90 m; h = {h.min():.4g} to "
+        f"{h[shallow - 1]:.4g} m) have a boundary layer shallower than the rotor top")
+    assert f"{hub_above * len(directions)} of them with h at or below the hub" in message
 
 
 def test_strict_mode_names_condition_speed_h_and_hub_height_at_build():
@@ -104,10 +105,18 @@ def test_strict_mode_indexes_per_condition_atmospheres():
 
 def test_bad_policy_is_refused_with_its_path():
     config = farm_config()
-    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["shallow_boundary_layer"] = "ignore"
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["shallow_boundary_layer"] = "quiet"
     with pytest.raises(ValueError, match=r"shallow_boundary_layer must be one of "
-                                         r"\['warn', 'raise'\]; got 'ignore'"):
+                                         r"\['warn', 'raise', 'ignore'\]; got 'quiet'"):
         FlorisModel(config)
+
+
+def test_ignore_policy_counts_silently():
+    config = farm_config()  # 9 m/s: h = 125 m, below the rotor top
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["shallow_boundary_layer"] = "ignore"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ShallowBoundaryLayerWarning)
+        FlorisModel(config).run()
 
 
 def test_no_warning_when_every_rotor_is_inside_the_boundary_layer():

@@ -51,6 +51,21 @@ PAPER_BRUNT_VAISALA_FREQUENCY = 6.1e-3
 PAPER_POTENTIAL_TEMPERATURE = 265.0
 
 _STABLE_ONLY = "unstable (convective) conditions are not covered by this model"
+#: Physical bounds of the thermal inputs (docs/atmosphere.md#input-ranges): they catch unit
+#: mistakes (a potential temperature in degrees Celsius, a lapse rate in K/km, a cooling rate in
+#: K/day) that the model would otherwise solve into boundary layers millimetres deep.
+#: Theta0 [K]: near-surface potential temperatures on Earth (-73 to +77 degrees C).
+POTENTIAL_TEMPERATURE_RANGE = (200.0, 350.0)
+#: Free-atmosphere lapse rate dTheta/dz [K/m]: 0 (neutral) to 0.1 K/m, ten times the
+#: troposphere's typical 3-10 K/km and the strongest inversions' order of magnitude.
+MAX_LAPSE_RATE = 0.1
+#: Surface cooling rate C_r [K/h]: 0 to -10 K/h, beyond the strongest clear-sky nocturnal
+#: cooling (a few K/h; the paper's strongest case, SBL-6, is -1 K/h).
+MIN_COOLING_RATE = -10.0
+#: The shallowest boundary layer the model accepts [m]: 10 m, below which no rotor and no
+#: measurement mast stands inside the Ekman-surface-layer profile (its surface layer, 0.2 h,
+#: would be 2 m deep); shallower solutions raise ValueError (docs/atmosphere.md#shallow-boundary-layer).
+MIN_BOUNDARY_LAYER_HEIGHT = 10.0
 #: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#input-ranges
 #: state it. Every input is a real number or an array of them (strings and booleans are refused).
 VALID_RANGES = {
@@ -65,11 +80,19 @@ VALID_RANGES = {
         "has no solution at the equator, where f_c = 0)"
     ),
     "roughness_length": "> 0 m",
-    "reference_potential_temperature": "> 0 K",
+    "reference_potential_temperature": (
+        f"{POTENTIAL_TEMPERATURE_RANGE[0]:g} to {POTENTIAL_TEMPERATURE_RANGE[1]:g} K (a potential "
+        "temperature in kelvin, not degrees Celsius)"
+    ),
     "brunt_vaisala_frequency": ">= 0 1/s",
-    "lapse_rate": ">= 0 K/m (a neutral or stably stratified free atmosphere)",
+    "lapse_rate": (
+        f"0 to {MAX_LAPSE_RATE:g} K/m (a neutral or stably stratified free atmosphere; in K/m, "
+        "not K/km)"
+    ),
     "stability_parameter": f">= 0 and finite ({_STABLE_ONLY})",
-    "cooling_rate": f"<= 0 K/h and finite, surface cooling ({_STABLE_ONLY})",
+    "cooling_rate": (
+        f"{MIN_COOLING_RATE:g} to 0 K/h, surface cooling in kelvin per hour ({_STABLE_ONLY})"
+    ),
     "surface_heat_flux": f"<= 0 K m/s and finite, downward heat flux ({_STABLE_ONLY})",
     "obukhov_length": f"> 0 m, stable; inf for neutral ({_STABLE_ONLY})",
     **{name: "> 0 and finite (a model constant)"
@@ -93,6 +116,30 @@ def _checked(name, value, ok, valid=None):
     array = finite_real(name, value, valid)
     require_at(ok(array), name, valid, array)
     return array
+
+
+def require_broadcastable(named) -> None:
+    """ValueError naming two inputs whose shapes do not broadcast together (numpy's rules: one
+    number, or arrays of one shape with one entry per condition)."""
+    shapes = {name: np.shape(value) for name, value in named.items()}
+    try:
+        np.broadcast_shapes(*shapes.values())
+    except ValueError:
+        names = list(shapes)
+        for k, first in enumerate(names):
+            for second in names[k + 1:]:
+                try:
+                    np.broadcast_shapes(shapes[first], shapes[second])
+                except ValueError:
+                    raise ValueError(
+                        f"{first} (shape {shapes[first]}) and {second} (shape {shapes[second]}) "
+                        "do not broadcast together: give single numbers, or arrays of one shape "
+                        "(one entry per condition)"
+                    ) from None
+        raise ValueError(
+            "the inputs' shapes do not broadcast together: "
+            + ", ".join(f"{name} {shape}" for name, shape in shapes.items())
+        ) from None
 
 
 def coriolis_parameter_from_latitude(latitude):
@@ -246,15 +293,26 @@ class EkmanABL:
         self._set_coriolis(coriolis_parameter, latitude)
         self.roughness_length = _checked("roughness_length", roughness_length, lambda z0: z0 > 0)
         self.reference_potential_temperature = _checked(
-            "reference_potential_temperature", reference_potential_temperature, lambda t: t > 0
+            "reference_potential_temperature", reference_potential_temperature,
+            lambda t: (t >= POTENTIAL_TEMPERATURE_RANGE[0]) & (t <= POTENTIAL_TEMPERATURE_RANGE[1]),
         )
         self._set_free_atmosphere(brunt_vaisala_frequency, lapse_rate)
         self._set_stability_closure(
             stability_parameter, cooling_rate, surface_heat_flux, obukhov_length
         )
+        given = {
+            "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
+            "roughness_length": self.roughness_length,
+            "reference_potential_temperature": self.reference_potential_temperature,
+            "lapse_rate" if lapse_rate is not None else "brunt_vaisala_frequency":
+                self.brunt_vaisala_frequency,
+            self.stability_input: self._stability_value,
+        }
         if geostrophic_wind is _INPUTS_ONLY:
+            require_broadcastable(given)
             return
         self.geostrophic_wind = _checked("geostrophic_wind", geostrophic_wind, lambda g: g > 0)
+        require_broadcastable({"geostrophic_wind": self.geostrophic_wind, **given})
         self._solve()
 
     @classmethod
@@ -308,7 +366,7 @@ class EkmanABL:
                 "give at most one of brunt_vaisala_frequency [1/s] or lapse_rate [K/m]"
             )
         if lapse_rate is not None:
-            gamma = _checked("lapse_rate", lapse_rate, lambda g: g >= 0)
+            gamma = _checked("lapse_rate", lapse_rate, lambda g: (g >= 0) & (g <= MAX_LAPSE_RATE))
             n_inf = np.sqrt(GRAVITY / self.reference_potential_temperature * gamma)
         else:
             if brunt_vaisala_frequency is None:
@@ -333,7 +391,7 @@ class EkmanABL:
         # L = +inf is the neutral limit of the Obukhov length; everything else must be finite.
         ok = {
             "stability_parameter": lambda v: np.isfinite(v) & (v >= 0),
-            "cooling_rate": lambda v: np.isfinite(v) & (v <= 0),
+            "cooling_rate": lambda v: np.isfinite(v) & (v <= 0) & (v >= MIN_COOLING_RATE),
             "surface_heat_flux": lambda v: np.isfinite(v) & (v <= 0),
             "obukhov_length": lambda v: (v > 0) & ~np.isnan(v),
         }[name]
@@ -373,7 +431,7 @@ class EkmanABL:
             r = log_u_star + 0.5 * np.log(along**2 + b**2) - np.log(self.von_karman * p["g"])
         return np.where(along > 0, r, -np.inf)
 
-    def _failure(self, mask, reason):
+    def _failure(self, mask, reason, lead="the ABL solve did not converge"):
         idx = tuple(np.argwhere(mask)[0])
         details = ", ".join(
             f"{name}={np.broadcast_to(np.asarray(value, float), mask.shape)[idx]:.6g}"
@@ -385,7 +443,7 @@ class EkmanABL:
                 brunt_vaisala_frequency=self.brunt_vaisala_frequency,
             ).items()
         )
-        return ValueError(f"the ABL solve did not converge ({reason}) for inputs {details}")
+        return ValueError(f"{lead} ({reason}) for inputs {details}")
 
     def _parameters(self, geostrophic_wind, shape=()):
         """The per-condition parameters of the solve, broadcast together (and to ``shape``)."""
@@ -432,6 +490,17 @@ class EkmanABL:
             )
         self._params = {k: v.reshape(shape) for k, v in flat.items()}
         self._set_solution(x.reshape(shape), self._params)
+        self._require_depth(lambda mask: self._failure(
+            mask, f"the stable boundary layer collapses: h below {MIN_BOUNDARY_LAYER_HEIGHT:g} m, "
+            "the shallowest the model accepts (docs/atmosphere.md#shallow-boundary-layer)",
+            lead="no model ABL",
+        ))
+
+    def _require_depth(self, error):
+        """Raise ``error(mask of the offending conditions)`` where h < MIN_BOUNDARY_LAYER_HEIGHT."""
+        shallow = np.asarray(self.boundary_layer_height) < MIN_BOUNDARY_LAYER_HEIGHT
+        if np.any(shallow):
+            raise error(np.atleast_1d(shallow).reshape(np.shape(shallow) or (1,)))
 
     def _set_solution(self, log_u_star, p):
         u_star, mu, h_hat, a, b, along = self._state(log_u_star, p)
@@ -603,6 +672,9 @@ class EkmanABL:
         speed = _checked("speed", speed, lambda s: s > 0, "> 0 m/s")
         template = cls.check_inputs(**inputs)
         height = _checked("height", height, lambda h: h > 0, "> roughness_length z0")
+        require_broadcastable({"speed": speed, "height": height, **{
+            name: value for name, value in inputs.items() if value is not None
+        }})
         z0 = template.roughness_length
         require_at(
             height > z0, "height", "> roughness_length z0",
@@ -663,6 +735,7 @@ class EkmanABL:
         abl.geostrophic_wind = g
         abl._params, _ = abl._parameters(g, shape)
         abl._set_solution(log_u_star[inverse.ravel()].reshape(shape), abl._params)
+        abl._require_depth(lambda mask: _too_shallow_for_reference_wind(abl, mask, speed, height, inputs))
         return abl
 
     @classmethod
@@ -755,6 +828,23 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     # _ROUNDOFF_ACCEPTANCE in ln speed (a true step of the profile stays refused).
     converged |= np.abs(log_speed_error(root)) <= max(tolerance, _ROUNDOFF_ACCEPTANCE)
     return np.where(found & converged, root, np.nan), slowest
+
+
+def _too_shallow_for_reference_wind(abl, mask, speed, height, inputs):
+    """The ValueError of a reference wind whose ABL is shallower than the model accepts."""
+    index = tuple(np.argwhere(mask)[0]) if mask.ndim else ()
+    shape = mask.shape
+    varying = [i for i, n in zip(index, shape) if n > 1]
+    where = "" if not varying else f" at condition {varying[0] if len(varying) == 1 else index}"
+    pick = lambda v: float(np.broadcast_to(np.asarray(v, float), shape)[index])  # noqa: E731
+    given = ", ".join(f"{k}={pick(v):.6g}" for k, v in inputs.items())
+    return ValueError(
+        f"from_reference_wind: the ABL with {pick(speed):.6g} m/s at {pick(height):.6g} m{where} "
+        f"({given}) is h = {pick(abl.boundary_layer_height):.3g} m deep, below the "
+        f"{MIN_BOUNDARY_LAYER_HEIGHT:g} m the model accepts (the stable boundary layer collapses; "
+        "docs/atmosphere.md#shallow-boundary-layer): check the units of the inputs (cooling "
+        "rate in K/h, heat flux in K m/s, lapse rate in K/m) or give weaker stratification"
+    )
 
 
 def _no_reference_wind(speed, height, slowest, index, shape, inputs):

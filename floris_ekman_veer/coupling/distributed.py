@@ -28,6 +28,7 @@ import copy
 
 from floris.par_floris_model import ParFlorisModel as _FlorisParFlorisModel
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._version import __version__
 from floris_ekman_veer.coupling.parallel import prepare_worker
 
@@ -157,6 +158,9 @@ class ParFlorisModel(_FlorisParFlorisModel):
             yield
             return
         client, pool = self._client, self._PoolExecutor
+        # The workers follow this process's silencing of the package's warnings (Dask hands
+        # them the chunks' inputs as plain dicts, so WorkerDict cannot carry it).
+        client.run(package_warnings.apply_setting, package_warnings.warnings_setting())
         self._interface, self._PoolExecutor = "concurrent", lambda _: client.get_executor()
         try:
             yield

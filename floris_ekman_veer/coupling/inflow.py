@@ -121,6 +121,7 @@ _check_floris_version(floris.__version__)
 from floris.core import Core, FlowField, TurbineGrid  # noqa: E402  (only after the version check)
 from floris.floris_model import FlorisModel  # noqa: E402
 
+import floris_ekman_veer.warnings as package_warnings  # noqa: E402
 from floris_ekman_veer.coupling.rotor import (  # noqa: E402
     TURBINE_MOMENTS,
     turbine_grid_inflow,
@@ -194,6 +195,9 @@ class AtmosphereSpec:
     inputs: dict
     n_conditions: int | None
     key: tuple
+    #: Wind speeds at or below this one may be at rest (calm; below every turbine's cut-in):
+    #: see :func:`solve`. Set from the Core's turbines by :func:`atmosphere_of`.
+    rest_below: float = 0.0
 
     @classmethod
     def from_mapping(cls, atmosphere: Mapping) -> AtmosphereSpec:
@@ -289,9 +293,11 @@ def atmosphere_of(core: Core) -> AtmosphereSpec | None:
     atmosphere = read_atmosphere(core.wake.wake_velocity_parameters)
     if atmosphere is None:
         return None
+    from floris_ekman_veer.coupling.input_checks import zero_power_speed
+
     spec = AtmosphereSpec.from_mapping(atmosphere)
     spec.check_conditions(core.flow_field.n_findex)
-    return spec
+    return attrs.evolve(spec, rest_below=zero_power_speed(core.farm.turbine_definitions))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -313,16 +319,37 @@ def solve(spec: AtmosphereSpec, wind_speeds, reference_height: float):
     wind_speeds = np.asarray(wind_speeds, dtype=float).reshape(-1)
     reference_height = float(reference_height)
     spec.check_conditions(wind_speeds.size)
-    key = (spec.key, wind_speeds.tobytes(), reference_height)
+    key = (spec.key, wind_speeds.tobytes(), reference_height, spec.rest_below)
     with _SOLVE_LOCK:
         if key in _SOLVE_CACHE:
             _SOLVE_CACHE.move_to_end(key)
             return _SOLVE_CACHE[key]
-    if not np.all(wind_speeds > 0.0):
-        raise ValueError(
-            f"flow_field.wind_speeds must be > 0 when {CONFIG_PATH} is given (they drive the "
-            f"ABL solve); got minimum {wind_speeds.min()}"
-        )
+    # Calm conditions (0 m/s) are at rest: no ABL is solved for them (they take the ABL of a
+    # moving condition, unused) and the inflow is 0, so they give zero power. Conditions below
+    # every turbine's cut-in are at rest too when no valid ABL reaches their speed
+    # (docs/user_guide.md#calm-and-weak-winds).
+    at_rest = wind_speeds <= 0.0
+    try:
+        abl = _solve_moving(spec, wind_speeds, reference_height, at_rest)
+    except ValueError:
+        weak = at_rest | (wind_speeds <= spec.rest_below)
+        if not np.any(weak & ~at_rest):
+            raise
+        at_rest = weak
+        abl = _solve_moving(spec, wind_speeds, reference_height, at_rest)
+    abl.at_rest = at_rest
+    with _SOLVE_LOCK:
+        _SOLVE_CACHE[key] = abl
+        while len(_SOLVE_CACHE) > _SOLVE_CACHE_SIZE:
+            _SOLVE_CACHE.popitem(last=False)
+    return abl
+
+
+def _solve_moving(spec: AtmosphereSpec, wind_speeds, reference_height: float, at_rest):
+    """from_reference_wind for the conditions not at rest (those at rest take the fastest
+    moving condition's speed, or 10 m/s when every condition is at rest)."""
+    moving = wind_speeds[~at_rest]
+    wind_speeds = np.where(at_rest, moving.max() if moving.size else 10.0, wind_speeds)
     z0 = spec.inputs.get("roughness_length")
     if z0 is not None and np.any(reference_height <= np.asarray(z0)):
         raise ValueError(
@@ -338,10 +365,6 @@ def solve(spec: AtmosphereSpec, wind_speeds, reference_height: float):
             f"{CONFIG_PATH} driven by flow_field.wind_speeds at flow_field.reference_wind_height: "
             f"{error}"
         ) from error
-    with _SOLVE_LOCK:
-        _SOLVE_CACHE[key] = abl
-        while len(_SOLVE_CACHE) > _SOLVE_CACHE_SIZE:
-            _SOLVE_CACHE.popitem(last=False)
     return abl
 
 
@@ -487,8 +510,12 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
             lambda z: inflow_profile(abl, z, self.reference_wind_height)[0], grid
         )
     shape = self.u_initial_sorted.shape
+    if np.any(abl.at_rest):
+        moving = ~abl.at_rest.reshape(-1, 1, 1, 1)
+        U, dUdz = np.where(moving, U, 0.0), np.where(moving, dUdz, 0.0)
     if self.het_map is not None:
-        speed_ups = self.u_initial_sorted / self.wind_speeds[:, None, None, None]
+        speeds = self.wind_speeds[:, None, None, None]
+        speed_ups = np.divide(self.u_initial_sorted, speeds, out=np.ones(shape), where=speeds > 0)
         U, dUdz = speed_ups * U, speed_ups * dUdz
     self.u_initial_sorted = np.broadcast_to(U, shape).copy()
     self.dudz_initial_sorted = np.broadcast_to(dUdz, shape).copy()
@@ -516,15 +543,47 @@ def _with_core_atmosphere(method):
         # Which rotor average each turbine takes (coupling/rotor.py).
         moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
         try:
-            result = method(self, *args, **kwargs)
+            # The package's per-wake warnings are said once, summarised, at the end of a solve.
+            with package_warnings.run_scope(self.flow_field.wind_speeds,
+                                            self.flow_field.reference_wind_height), \
+                    _at_rest(self, atmosphere) as rest:
+                result = method(self, *args, **kwargs)
         finally:
             TURBINE_MOMENTS.reset(moments)
             _ACTIVE.reset(token)
+        if rest is not None:
+            result = _still(self.flow_field, rest, result)
         if full_flow and input_checks.uses_wake_models(self):
             result = _without_reversed_flow(self.flow_field, result)
         return result
 
     return wrapper
+
+
+@contextlib.contextmanager
+def _at_rest(core: Core, atmosphere):
+    """The conditions at rest of a Core's solve (None if there are none), FLORIS's divisions by
+    their zero inflow quiet: their flow is set to 0 afterwards (:func:`_still`)."""
+    rest = None
+    if atmosphere is not None and core.flow_field.n_findex:
+        abl = solve(atmosphere, core.flow_field.wind_speeds, core.flow_field.reference_wind_height)
+        rest = abl.at_rest if np.any(abl.at_rest) else None
+    if rest is None:
+        yield None
+        return
+    with np.errstate(divide="ignore", invalid="ignore"):
+        yield rest
+
+
+def _still(flow_field: FlowField, rest, result):
+    """No flow in the conditions at rest (FLORIS's own models divide by their zero inflow)."""
+    for name in ("u_sorted", "v_sorted", "w_sorted", "u", "v", "w"):
+        field = getattr(flow_field, name, None)
+        if isinstance(field, np.ndarray) and field.ndim and field.shape[0] == rest.size:
+            field[rest] = 0.0
+    if isinstance(result, np.ndarray) and result.ndim and result.shape[0] == rest.size:
+        result[rest] = 0.0
+    return result
 
 
 def _without_reversed_flow(flow_field: FlowField, result):
@@ -555,24 +614,54 @@ def _validating_post_init(method):
         if input_checks.uses_package(self, spec):
             input_checks.check_core(self)
         method(self)
-        # reference_wind_height = -1 is FLORIS's "use the hub height" sentinel; FlorisModel
-        # replaces it through set(), which builds (and validates) again.
-        # No conditions yet (n_findex = 0): nothing to solve until set() gives them.
-        if (
-            spec is not None
-            and self.flow_field.n_findex
-            and abs(self.flow_field.reference_wind_height + 1.0) > 1e-6
-        ):
-            abl = solve(spec, self.flow_field.wind_speeds, self.flow_field.reference_wind_height)
-            shallow.check_rotor_inside(
-                self.wake.wake_velocity_parameters.get(PARAMETER_BLOCK), abl.boundary_layer_height,
-                self.flow_field.wind_speeds, self.flow_field.reference_wind_height,
-                self.farm.hub_heights, self.farm.rotor_diameters,
-            )
+        if spec is not None and self.flow_field.n_findex:
+            _check_solved_conditions(self, spec)
         elif spec is not None:
+            # No conditions yet (n_findex = 0): nothing to solve until set() gives them.
             shallow.policy(self.wake.wake_velocity_parameters.get(PARAMETER_BLOCK))
 
     return wrapper
+
+
+def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
+    """At build: the shallow-boundary-layer check (coupling/shallow.py), hubs in the roughness
+    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
+    from floris_ekman_veer.coupling import shallow
+
+    flow_field = core.flow_field
+    height = flow_field.reference_wind_height
+    if abs(height + 1.0) < 1e-6:
+        # FLORIS's "use the hub height" sentinel, which FlorisModel replaces without a rebuild.
+        hubs = np.unique(core.farm.hub_heights)
+        if hubs.size != 1:
+            return  # FLORIS refuses it
+        height = float(hubs[0])
+    abl = solve(spec, flow_field.wind_speeds, height)
+    shallow.check_rotor_inside(
+        core.wake.wake_velocity_parameters.get(PARAMETER_BLOCK),
+        np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1)),
+        flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+    )
+    sublayer = np.max(np.where(abl.at_rest, 0.0, np.reshape(abl.roughness_sublayer_height, -1)))
+    low = np.flatnonzero(np.asarray(core.farm.hub_heights, dtype=float) < sublayer)
+    if low.size:
+        package_warnings.warn(
+            f"{low.size} turbine(s) (turbine {', '.join(str(i) for i in low[:5])}) have the hub "
+            f"in the roughness sublayer (below {sublayer:.3g} m), where the wind "
+            "falls linearly to 0 at the ground (docs/atmosphere.md#roughness-sublayer): no "
+            "measured wake or turbine stands there",
+            package_warnings.TurbinePlacementWarning,
+            items=[("sublayer", int(i)) for i in low],
+        )
+    if flow_field.heterogeneous_inflow_config is not None:
+        package_warnings.warn(
+            f"flow_field.heterogeneous_inflow_config is given with {CONFIG_PATH}: each "
+            "condition's ABL is solved from flow_field.wind_speeds (the speed before the map's "
+            "speed-ups) and its profile U(z) is multiplied by the speed-ups at each point, so h, "
+            "veer and turbulence are those of the unmultiplied wind everywhere "
+            "(docs/user_guide.md#heterogeneous-inflow)",
+            package_warnings.HeterogeneousInflowWarning,
+        )
 
 
 @contextlib.contextmanager

@@ -11,7 +11,11 @@ its condition or turbine index) and the valid range (docs/coupling.md#input-vali
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
+
+import floris_ekman_veer.warnings as package_warnings
 
 from floris_ekman_veer._validation import number, require_each
 from floris_ekman_veer.coupling.names import (
@@ -56,6 +60,7 @@ def _turbine_path(farm, index: int) -> str:
 def check_core(core) -> None:
     """Layout, conditions and turbine definitions of a Core that uses the package."""
     _check_layout(core.farm)
+    check_reference_height(core.flow_field)
     _check_conditions(core.flow_field)
     _check_turbines(core.farm)
 
@@ -75,20 +80,67 @@ def _check_layout(farm) -> None:
                           _is_positive)
         radius[index] = 0.5 * number(turbine["rotor_diameter"], f"{path}.rotor_diameter",
                                      "finite and > 0 [m]", _is_positive)
-    # Two rotors whose hubs are closer than the sum of their radii intersect for some wind
-    # direction or yaw: no wake model describes that (FLORIS would give coincident turbines
-    # each the power of a lone turbine).
+    below = np.flatnonzero(z < radius)
+    if below.size:
+        i = below[0]
+        raise ValueError(
+            f"{_turbine_path(farm, i)}.hub_height must be >= rotor_diameter / 2 = {radius[i]:.6g} m "
+            f"(a rotor above the ground); got {z[i]:.6g} m at turbine {i}: its blades would reach "
+            f"{radius[i] - z[i]:.4g} m below the ground"
+        )
+    # Coincident hubs (two turbines in one place) are no farm: FLORIS would give each the power
+    # of a lone turbine. Rotors that merely intersect for some wind direction or yaw (hubs closer
+    # than the sum of their radii) occur in the trial layouts of FLORIS's layout optimisers and
+    # its plots with added turbines, so they run; in a layout the user gives they are warned.
     distance = np.sqrt(
         (x[:, None] - x) ** 2 + (y[:, None] - y) ** 2 + (z[:, None] - z) ** 2
     )
-    clash = np.triu(distance < radius[:, None] + radius, k=1)
-    if np.any(clash):
-        i, j = np.argwhere(clash)[0]
+    coincident = np.triu(distance < COINCIDENT_DISTANCE, k=1)
+    if np.any(coincident):
+        i, j = np.argwhere(coincident)[0]
         raise ValueError(
-            f"farm.layout_x/layout_y: turbines {i} and {j} are {distance[i, j]:.6g} m apart "
-            f"(hub to hub), less than the sum of their rotor radii "
-            f"({radius[i] + radius[j]:.6g} m): their rotors would intersect"
-            + (f" ({int(clash.sum())} such pairs)" if clash.sum() > 1 else "")
+            f"farm.layout_x/layout_y: turbines {i} and {j} are {distance[i, j]:.6g} m apart (hub "
+            f"to hub), less than {COINCIDENT_DISTANCE:g} m: two turbines cannot stand in one place"
+        )
+    clash = np.triu(distance < radius[:, None] + radius, k=1)
+    if np.any(clash) and not _floris_trial_layout():
+        pairs = np.argwhere(clash)
+        listed = ", ".join(f"{i} and {j} ({distance[i, j]:.4g} m)" for i, j in pairs[:3])
+        more = f" and {len(pairs) - 3} more pairs" if len(pairs) > 3 else ""
+        package_warnings.warn(
+            f"farm.layout_x/layout_y: the rotors of turbines {listed}{more} would intersect for "
+            "some wind direction or yaw (hubs closer than the sum of their rotor radii), which no "
+            "wake model describes: check the layout",
+            package_warnings.TurbinePlacementWarning,
+            items=[(int(i), int(j), round(float(distance[i, j]), 3)) for i, j in pairs],
+        )
+
+
+#: Hubs closer than this [m] are one place.
+COINCIDENT_DISTANCE = 1e-3
+#: FLORIS modules whose layouts are trials, not the user's: its layout optimisers and the plots
+#: that add a turbine at each point of a plane.
+_TRIAL_LAYOUT_MODULES = ("floris.optimization.layout_optimization", "floris.flow_visualization")
+
+
+def _floris_trial_layout() -> bool:
+    """Whether FLORIS's layout optimisation or flow visualisation is setting this layout."""
+    frame = sys._getframe(1)
+    while frame is not None:
+        if str(frame.f_globals.get("__name__", "")).startswith(_TRIAL_LAYOUT_MODULES):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def check_reference_height(flow_field) -> None:
+    """FLORIS's reference_wind_height: > 0 m, or -1 (FLORIS: the hub height)."""
+    height = number(flow_field.reference_wind_height, "flow_field.reference_wind_height",
+                    "finite and > 0 [m], or -1 for the hub height")
+    if not (height > 0.0 or abs(height + 1.0) < 1e-6):
+        raise ValueError(
+            "flow_field.reference_wind_height must be > 0 m (the height of flow_field.wind_speeds) "
+            f"or -1 (FLORIS: the hub height); got {height!r}"
         )
 
 
@@ -119,7 +171,14 @@ def _check_turbines(farm) -> None:
 
 
 def check_operation(core) -> None:
-    """Yaw angles of a Core whose wakes are this package's (|yaw| < 90 deg, finite)."""
+    """At least one condition to solve; yaw angles of a Core whose wakes are this package's
+    (|yaw| < 90 deg, finite)."""
+    if not core.flow_field.n_findex:
+        raise ValueError(
+            "flow_field.wind_directions, wind_speeds and turbulence_intensities are empty: there "
+            "is no condition to run; give at least one with fmodel.set(wind_directions=..., "
+            "wind_speeds=..., turbulence_intensities=...) or fmodel.set(wind_data=...)"
+        )
     if not uses_wake_models(core):
         return
     yaw = np.asarray(core.farm.yaw_angles, dtype=float)
@@ -135,3 +194,24 @@ def check_points(x, y, z) -> None:
         value = np.atleast_1d(np.asarray(value, dtype=float))
         require_each(np.isfinite(value), f"sample_flow_at_points {name}", "finite [m]", value,
                      "point")
+
+
+def zero_power_speed(turbine_definitions) -> float:
+    """The highest wind speed at which every turbine's power curve still gives no power (the
+    last zero-power entry below its first positive one; the smallest over the turbines), or 0
+    when a turbine has no tabulated power curve (the actuator disk): conditions this slow are
+    below every cut-in (docs/user_guide.md#calm-and-weak-winds)."""
+    speeds = []
+    for turbine in turbine_definitions:
+        table = turbine.get("power_thrust_table") or {}
+        wind_speed, power = table.get("wind_speed"), table.get("power")
+        if wind_speed is None or power is None:
+            return 0.0
+        wind_speed, power = np.asarray(wind_speed, dtype=float), np.asarray(power, dtype=float)
+        order = np.argsort(wind_speed)
+        wind_speed, power = wind_speed[order], power[order]
+        producing = np.flatnonzero(power > 0.0)
+        if producing.size == 0 or producing[0] == 0:
+            return 0.0
+        speeds.append(wind_speed[producing[0] - 1])
+    return float(min(speeds)) if speeds else 0.0

@@ -41,6 +41,7 @@ from attrs import define, field
 from floris.core import BaseModel, FlowField, Grid, TurbineCubatureGrid, TurbineGrid
 from floris.utilities import rotate_coordinates_rel_west
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import (
     boolean_field,
     choice_field,
@@ -143,13 +144,8 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
     limit = max_thrust_coefficient / np.cos(yaw) ** 2
     heavy = ct > limit
     if np.any(heavy):
-        warnings.warn(
-            f"{int(np.count_nonzero(heavy))} wake(s) with C_T cos^2(yaw) > "
-            f"{max_thrust_coefficient:g}, beyond momentum theory: evaluated at C_T cos^2(yaw) = "
-            f"{max_thrust_coefficient:g} (max_thrust_coefficient)",
-            RuntimeWarning,
-            stacklevel=3,
-        )
+        # One summary per run, naming the conditions' wind speeds (floris_ekman_veer.warnings).
+        package_warnings.note_thrust_limit(heavy, max_thrust_coefficient)
     return np.where(heavy, limit, ct)
 
 

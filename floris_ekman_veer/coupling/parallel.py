@@ -22,6 +22,8 @@ import functools
 
 import numpy as np
 
+import floris_ekman_veer.warnings as package_warnings
+from floris_ekman_veer.coupling import shallow
 from floris_ekman_veer.coupling.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
@@ -43,16 +45,18 @@ def prepare_worker() -> None:
     install_parallel_hook()
 
 
-def _unpickle_worker_dict(data: dict) -> dict:
+def _unpickle_worker_dict(data: dict, warnings_setting: str | None = None) -> dict:
     prepare_worker()
+    package_warnings.apply_setting(warnings_setting)
     return data
 
 
 class WorkerDict(dict):
-    """A FLORIS input dict that prepares the receiving process when it is unpickled."""
+    """A FLORIS input dict that prepares the receiving process when it is unpickled, and carries
+    the sender's silencing of the package's warnings (floris_ekman_veer.warnings)."""
 
     def __reduce__(self):
-        return _unpickle_worker_dict, (dict(self),)
+        return _unpickle_worker_dict, (dict(self), package_warnings.warnings_setting())
 
 
 # Flow-field entries that are per condition in FloriS's input dict.
@@ -70,6 +74,10 @@ def _splitting_preprocessing(method):
             # ParFlorisModel splits conditions into contiguous, ordered chunks (np.array_split).
             share = slice(start, start + len(set_args["wind_speeds"]))
             start = share.stop
+            block = fmodel_dict["wake"]["wake_velocity_parameters"].get(PARAMETER_BLOCK)
+            if spec is not None and block.get(shallow.POLICY_KEY, "warn") == "warn":
+                # This model's own build has reported its shallow conditions: not again per chunk.
+                block[shallow.POLICY_KEY] = "ignore"
             if per_condition:
                 flow_field = fmodel_dict["flow_field"]
                 for key in _CONDITION_KEYS:

@@ -3,7 +3,8 @@
 ``register()`` makes the wake models selectable by name in a FLORIS input
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
 bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
-inflow hook and the support of ParFlorisModel, UncertainFlorisModel and the yaw optimisers.
+inflow hook, the support of ParFlorisModel, UncertainFlorisModel and the yaw optimisers, and the
+conversion of FLORIS wake inputs (coupling/wake_settings.py).
 Importing ``floris_ekman_veer`` calls it.
 
 This is the top of the coupling layer: it imports the model, turbine, inflow, parallel, uncertain
@@ -70,6 +71,7 @@ def register() -> None:
     from floris_ekman_veer.coupling.optimization import install_optimizer_hook
     from floris_ekman_veer.coupling.parallel import install_parallel_hook
     from floris_ekman_veer.coupling.uncertain import install_uncertain_hook
+    from floris_ekman_veer.coupling.wake_settings import install_wake_settings_hook
 
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
                 "velocity_model")
@@ -82,3 +84,4 @@ def register() -> None:
     install_parallel_hook()
     install_uncertain_hook()
     install_optimizer_hook()
+    install_wake_settings_hook()

@@ -12,28 +12,27 @@ its floor. Those conditions lie outside what the paper validated, so when a mode
         ekman_veer:
           shallow_boundary_layer: raise
 
-refused with a ValueError naming each such condition's index, wind speed, h and hub height.
-A condition is affected when any rotor's top (hub height + D/2) is above h.
+refused with a ValueError naming each such condition's index, wind speed, h and hub height
+(``ignore``: counted silently; the package sends its ParFlorisModel and Dask workers their share
+of conditions with ``ignore``, because the model they came from has said it already). A condition
+is affected when any rotor's top (hub height + D/2) is above h.
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Mapping
 
 import numpy as np
 
+import floris_ekman_veer.warnings as package_warnings
+from floris_ekman_veer.warnings import ShallowBoundaryLayerWarning  # noqa: F401  (its home once)
+
 #: Key of the policy in ``wake.wake_velocity_parameters.ekman_veer``, and its values.
 POLICY_KEY = "shallow_boundary_layer"
-POLICIES = ("warn", "raise")
+POLICIES = ("warn", "raise", "ignore")
 POLICY_PATH = f"wake.wake_velocity_parameters.ekman_veer.{POLICY_KEY}"
 
 _SHOWN = 5  # conditions listed in a message
-
-
-class ShallowBoundaryLayerWarning(UserWarning):
-    """Some conditions have a boundary layer shallower than the rotor (outside the paper's
-    validated range; the model's behaviour there is documented, continuous and finite)."""
 
 
 def policy(block: Mapping | None) -> str:
@@ -60,7 +59,7 @@ def check_rotor_inside(
     tops = hubs + 0.5 * np.asarray(rotor_diameters, dtype=float).reshape(-1)
     highest = np.argmax(tops)
     affected = tops[highest] > h
-    if not np.any(affected):
+    if not np.any(affected) or mode == "ignore":
         return affected
     hub, top = hubs[highest], tops[highest]
     index = np.flatnonzero(affected)
@@ -76,13 +75,16 @@ def check_rotor_inside(
             f"{index.size} of {h.size} conditions have a boundary layer shallower than the rotor "
             f"(rotor top above h), refused by {POLICY_PATH} = 'raise': {listed}{more}"
         )
-    warnings.warn(
-        f"{index.size} of {h.size} conditions have a boundary layer shallower than the rotor "
-        f"(rotor top above h; {hub_above} with the hub at or above h), outside the paper's "
-        f"validated range: the inflow above h is the geostrophic wind and the wake expansion "
-        f"falls continuously to its floor (docs/atmosphere.md#shallow-boundary-layer). "
-        f"{listed}{more}. Set {POLICY_PATH}: raise to refuse them.",
+    package_warnings.warn(
+        f"{index.size} of {h.size} conditions (wind speeds "
+        f"{package_warnings.speeds_text(speeds[index])} at {reference_height:.6g} m; h = "
+        f"{package_warnings.range_text(h[index], 'm')}) have a boundary layer shallower than "
+        f"the rotor top ({top:.6g} m; hub {hub:.6g} m, {hub_above} of them with h at or below "
+        "the hub), outside the paper's validated range: above h the inflow is the geostrophic "
+        "wind and the wake expansion falls continuously to its floor "
+        f"(docs/atmosphere.md#shallow-boundary-layer). Set {POLICY_PATH}: raise to refuse "
+        "them, or ignore (or call floris_ekman_veer.silence_warnings()) to silence this.",
         ShallowBoundaryLayerWarning,
-        stacklevel=4,
+        items=[(round(float(s), 6), round(float(d), 3)) for s, d in zip(speeds[index], h[index])],
     )
     return affected

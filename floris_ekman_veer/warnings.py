@@ -1,0 +1,278 @@
+"""The package's warnings: their classes, and how they reach the user (docs/user_guide.md#warnings).
+
+Every warning of the package is a :class:`FlorisEkmanVeerWarning`, importable from the package's
+top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and each is
+
+* located at the user's own line: the frames of FLORIS, of this package and of the standard
+  library's context managers are skipped (a frame walk, so it works on every supported Python),
+  so ``python -W`` filters and ``warnings.filterwarnings(..., module=...)`` see the user's module;
+* summarised: one warning per run (the thrust limit) or per model build (the shallow boundary
+  layer, the model settings) says how many conditions or turbines it concerns and which wind
+  speeds;
+* said once per study: a warning is repeated only when it concerns wind speeds (or settings) not
+  reported yet in this process, so a yaw optimiser's many re-builds and runs, an annual-energy
+  study's classes and a script's repeated ``set()`` report each condition once. A recording
+  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh.
+
+Silencing, for this process and every worker process or Dask worker it starts or sends models
+to::
+
+    import floris_ekman_veer
+    floris_ekman_veer.silence_warnings()                       # all of the package's warnings
+    floris_ekman_veer.silence_warnings("ShallowBoundaryLayerWarning")  # or some classes
+
+or, before Python starts, ``FLORIS_EKMAN_VEER_WARNINGS=ignore`` (or a comma-separated list of
+class names) in the environment. The setting lives in that environment variable, which process
+pools inherit; it travels with every model the package sends to a ParFlorisModel worker
+(coupling/parallel.py) and is set on the Dask workers at each run (coupling/distributed.py). ``silence_warnings(None)`` restores the
+default. Python's own
+warning filters work as usual in the process where they are set.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import os
+import sys
+import warnings
+from pathlib import Path
+
+#: The environment variable that silences the package's warnings ("ignore", or class names).
+ENVIRONMENT_VARIABLE = "FLORIS_EKMAN_VEER_WARNINGS"
+
+
+class FlorisEkmanVeerWarning(UserWarning):
+    """Base class of every warning of floris_ekman_veer."""
+
+
+class ShallowBoundaryLayerWarning(FlorisEkmanVeerWarning):
+    """Some conditions have a boundary layer shallower than the rotor (outside the paper's
+    validated range; the model's behaviour there is documented, continuous and finite)."""
+
+
+class ThrustLimitWarning(FlorisEkmanVeerWarning, RuntimeWarning):
+    """Some wakes have a rotor-normal loading C_T cos^2(yaw) above ``max_thrust_coefficient``,
+    beyond momentum theory: they are evaluated at the limit."""
+
+
+class ModelSettingsWarning(FlorisEkmanVeerWarning):
+    """The input mixes the package's wake models with FLORIS's (a velocity model without its
+    deflection model, GCH's switches on): it runs, but it is not the paper's model."""
+
+
+class TurbinePlacementWarning(FlorisEkmanVeerWarning):
+    """A layout the user gave has intersecting rotors, or a hub in the roughness sublayer."""
+
+
+class HeterogeneousInflowWarning(FlorisEkmanVeerWarning):
+    """A heterogeneous inflow map is given together with the atmosphere (how they combine:
+    docs/user_guide.md#heterogeneous-inflow)."""
+
+
+#: Every warning class, by name (what ``silence_warnings`` and the environment variable take).
+CLASSES = {
+    cls.__name__: cls
+    for cls in (FlorisEkmanVeerWarning, ShallowBoundaryLayerWarning, ThrustLimitWarning,
+                ModelSettingsWarning, TurbinePlacementWarning, HeterogeneousInflowWarning)
+}
+
+
+# ------------------------------------------------------------------------------------ silencing
+def _parse(setting: str | None) -> tuple[type, ...]:
+    if not setting or not setting.strip():
+        return ()
+    names = [name.strip() for name in setting.split(",") if name.strip()]
+    if names == ["ignore"]:
+        return (FlorisEkmanVeerWarning,)
+    unknown = sorted(set(names) - set(CLASSES))
+    if unknown:
+        raise ValueError(
+            f"{ENVIRONMENT_VARIABLE}: unknown warning class(es) {unknown}; give 'ignore' or a "
+            f"comma-separated list of {sorted(CLASSES)}"
+        )
+    return tuple(CLASSES[name] for name in names)
+
+
+def warnings_setting() -> str | None:
+    """The current silencing setting (the environment variable's value, or None)."""
+    return os.environ.get(ENVIRONMENT_VARIABLE) or None
+
+
+def silence_warnings(*categories) -> None:
+    """Silence the package's warnings (all of them, or the given classes or class names) here
+    and in every worker that runs this process's models; ``silence_warnings(None)`` restores
+    them. The setting is the environment variable ``FLORIS_EKMAN_VEER_WARNINGS``."""
+    if categories == (None,):
+        os.environ.pop(ENVIRONMENT_VARIABLE, None)
+        return
+    names = [c if isinstance(c, str) else getattr(c, "__name__", repr(c)) for c in categories]
+    setting = ",".join(names) if names else "ignore"
+    _parse(setting)  # an unknown name is an error now, not in a worker later
+    os.environ[ENVIRONMENT_VARIABLE] = setting
+
+
+def apply_setting(setting: str | None) -> None:
+    """Adopt the setting of the process that sends this worker its models (None: the default)."""
+    if setting:
+        os.environ[ENVIRONMENT_VARIABLE] = setting
+    else:
+        os.environ.pop(ENVIRONMENT_VARIABLE, None)
+
+
+def _silenced(category: type) -> bool:
+    return issubclass(category, _parse(warnings_setting()) or ())
+
+
+# ------------------------------------------------------------------------- the user's location
+_PACKAGE_DIR = str(Path(__file__).resolve().parent)
+_SKIPPED_FILES = (contextlib.__file__,)
+
+
+def _library_dirs() -> tuple[str, ...]:
+    import floris
+
+    return (_PACKAGE_DIR, str(Path(floris.__file__).resolve().parent))
+
+
+def _is_library(filename: str, libraries: tuple[str, ...]) -> bool:
+    if filename.startswith("<"):
+        return filename.startswith("<attrs generated")
+    if filename in _SKIPPED_FILES:
+        return True
+    path = os.path.realpath(filename)
+    return any(path == d or path.startswith(d + os.sep) for d in libraries)
+
+
+def user_frame():
+    """The innermost frame outside FLORIS, this package, attrs' generated code and contextlib
+    (the outermost frame if every frame is theirs)."""
+    libraries = _library_dirs()
+    frame = sys._getframe(1)
+    last = frame
+    while frame is not None:
+        if not _is_library(frame.f_code.co_filename, libraries):
+            return frame
+        last, frame = frame, frame.f_back
+    return last
+
+
+# --------------------------------------------------------------------------- once per study
+def _recorder():
+    """What shows warnings now: ``catch_warnings(record=True)`` (and so ``pytest.warns`` and
+    pytest's per-test capture) installs its own list's ``append`` there."""
+    return getattr(warnings, "_showwarnmsg_impl", None) or warnings.filters
+
+
+class _Reported:
+    """Items reported per warning class; forgotten when a recording context starts."""
+
+    def __init__(self):
+        self.recorder = None
+        self.items: dict = {}
+
+    def new(self, key, items) -> bool:
+        recorder = _recorder()
+        if self.recorder is not recorder:
+            # a warnings.catch_warnings(record=True) (pytest.warns, pytest's capture of each
+            # test) starts afresh: what it records is all it sees. (Held, so that its id is not
+            # reused by a later one.)
+            self.recorder, self.items = recorder, {}
+        seen = self.items.setdefault(key, set())
+        fresh = set(items) - seen
+        seen.update(fresh)
+        return bool(fresh)
+
+
+_REPORTED = _Reported()
+
+
+def warn(message: str, category: type, items=()) -> None:
+    """Issue ``message`` at the user's line, unless silenced or every one of its ``items`` (wind
+    speeds, settings; none: the message itself) has been reported before."""
+    if _silenced(category) or not _REPORTED.new(category, tuple(items) or (message,)):
+        return
+    frame = user_frame()
+    filename, lineno = frame.f_code.co_filename, frame.f_lineno
+    module_globals = frame.f_globals
+    # (no module_globals: its loader would be asked for the source of a script run from stdin)
+    warnings.warn_explicit(
+        message, category, filename, lineno,
+        module=module_globals.get("__name__", "<unknown>"),
+        registry=module_globals.setdefault("__warningregistry__", {}),
+    )
+
+
+def speeds_text(speeds) -> str:
+    """The distinct wind speeds of a list, as text: '8, 9 and 11 m/s'."""
+    values = sorted({round(float(s), 6) for s in speeds})
+    shown = [f"{v:g}" for v in values[:8]]
+    if len(values) > 8:
+        shown.append(f"{len(values) - 8} more")
+    text = shown[0] if len(shown) == 1 else ", ".join(shown[:-1]) + " and " + shown[-1]
+    return f"{text} m/s"
+
+
+def range_text(values, unit: str) -> str:
+    """'90.1 to 125 m', or '125 m' for one value."""
+    low, high = float(min(values)), float(max(values))
+    return f"{low:.4g} {unit}" if f"{low:.4g}" == f"{high:.4g}" else f"{low:.4g} to {high:.4g} {unit}"
+
+
+# ------------------------------------------------------------------------------ once per run
+_RUN: contextvars.ContextVar = contextvars.ContextVar("floris_ekman_veer_run", default=None)
+
+
+@contextlib.contextmanager
+def run_scope(wind_speeds, reference_height):
+    """Collect the per-wake notes of one FLORIS solve (:func:`note_thrust_limit`) and issue one
+    summary warning at its end. Nested scopes report to the outermost."""
+    if _RUN.get() is not None:
+        yield
+        return
+    notes: dict = {}
+    token = _RUN.set(notes)
+    try:
+        yield
+    finally:
+        _RUN.reset(token)
+    if notes:
+        _issue_thrust_limit(notes, wind_speeds, reference_height)
+
+
+def note_thrust_limit(heavy, limit: float) -> None:
+    """Record the wakes (``heavy``: boolean, condition axis first) evaluated at the thrust
+    limit; reported once at the end of the run, or now outside a run."""
+    import numpy as np
+
+    heavy = np.asarray(heavy)
+    conditions = heavy.reshape(heavy.shape[0], -1).any(axis=1) if heavy.ndim else heavy[None]
+    notes = _RUN.get()
+    if notes is None:
+        _issue_thrust_limit({limit: [int(np.count_nonzero(heavy)), conditions]}, None, None)
+        return
+    entry = notes.setdefault(limit, [0, np.zeros(conditions.shape, dtype=bool)])
+    entry[0] += int(np.count_nonzero(heavy))
+    if entry[1].shape == conditions.shape:
+        entry[1] |= conditions
+    else:  # a full-flow solve of one condition inside a run of many: no per-condition summary
+        entry[1] = np.zeros(0, dtype=bool)
+
+
+def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
+    import numpy as np
+
+    for limit, (count, conditions) in notes.items():
+        where, items = "", ()
+        if wind_speeds is not None and conditions.size == np.size(wind_speeds):
+            speeds = np.asarray(wind_speeds, dtype=float).reshape(-1)[conditions]
+            where = (f" in {int(conditions.sum())} of {conditions.size} conditions (wind speeds "
+                     f"{speeds_text(speeds)} at {float(reference_height):g} m)")
+            items = tuple(sorted({round(float(s), 6) for s in speeds}))
+        warn(
+            f"turbine wakes{where} have C_T cos^2(yaw) > {limit:g}, beyond momentum "
+            f"theory: evaluated at C_T cos^2(yaw) = {limit:g} "
+            "(wake.wake_velocity_parameters.ekman_veer.max_thrust_coefficient; "
+            "docs/conventions.md#thrust-coefficient-and-yaw)",
+            ThrustLimitWarning, items,
+        )
