@@ -833,12 +833,14 @@ def test_regression_row_yawed():
         print_baseline(results)
     assert_results_arrays(results, yawed_baseline_row)
 
-    # Physics: the yawed turbine sees the same inflow, its Ct is the cosine-loss Ct cos(20 deg),
-    # it produces less; the downstream turbines change because the wake moved.
+    # Physics: the yawed turbine sees the same inflow, its Ct is the cosine-loss Ct cos(20 deg)
+    # times the veer-aware rotor's <u_n^2>/<(U cos b)^2>, below 1 at +20 deg in this veer
+    # (docs/yaw_steering.md#the-veer-aware-rotor), it produces less; the downstream turbines
+    # change because the wake moved.
     straight = results_array(farm(ROW))
     np.testing.assert_array_equal(results[:, 0, 0], straight[:, 0, 0])
-    np.testing.assert_allclose(results[:, 0, 1], straight[:, 0, 1] * np.cos(np.deg2rad(20.0)),
-                               rtol=1e-12)
+    veer_factor = results[:, 0, 1] / (straight[:, 0, 1] * np.cos(np.deg2rad(20.0)))
+    assert np.all((veer_factor > 0.85) & (veer_factor < 0.99)), veer_factor
     assert np.all(results[:, 0, 2] < 0.95 * straight[:, 0, 2])
     waked = np.array(WIND_DIRECTIONS) == 270.0
     assert np.all(np.abs(results[waked, 1, 0] - straight[waked, 1, 0]) > 0.05)

@@ -426,6 +426,10 @@ def _profile_and_gradient(abl, z, reference_height):
 
 
 _ACTIVE: contextvars.ContextVar = contextvars.ContextVar("ekman_veer_atmosphere", default=None)
+
+#: Context managers ``make(core)`` entered around every wrapped Core solve (the veer-aware rotor,
+#: coupling/yawed_rotor.py, gives the operation models the Core's ambient V this way).
+CORE_CONTEXTS: list = []
 _SOLVED: dict = {}  # id(flow_field) -> (weakref to the flow field, EkmanABL)
 
 
@@ -516,7 +520,10 @@ def _with_core_atmosphere(method):
         # Which rotor average each turbine takes (coupling/rotor.py).
         moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
         try:
-            result = method(self, *args, **kwargs)
+            with contextlib.ExitStack() as stack:
+                for make in CORE_CONTEXTS:
+                    stack.enter_context(make(self))
+                result = method(self, *args, **kwargs)
         finally:
             TURBINE_MOMENTS.reset(moments)
             _ACTIVE.reset(token)
