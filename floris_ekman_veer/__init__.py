@@ -12,6 +12,8 @@ FLORIS inputs without ``wake.wake_velocity_parameters.ekman_veer.atmosphere``.
 optimisers on scalar and per-condition atmospheres alike and returns FLORIS's ``df_opt``.
 ``floris_ekman_veer.annual_energy(fmodel, wind_data, stability, optimizer_class, ...)`` gives the
 AEP per stability class, baseline and with wake steering, for ekman_veer and FLORIS's GCH.
+``floris_ekman_veer.validity_report(fmodel)`` says per condition whether the atmosphere lies inside
+the paper's validated CNBL..SBL-6 envelope (docs/yaw_steering.md#the-validated-envelope).
 """
 
 from floris_ekman_veer._version import __version__
@@ -20,8 +22,9 @@ from floris_ekman_veer.coupling.distributed import ParFlorisModel
 from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
+from floris_ekman_veer.coupling.validity import validity_report
 
 __all__ = ["EkmanABL", "ParFlorisModel", "__version__", "annual_energy", "optimize_yaw",
-           "register"]
+           "register", "validity_report"]
 
 register()
