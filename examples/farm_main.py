@@ -56,6 +56,7 @@ from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 
@@ -183,6 +184,12 @@ def print_abl(farm: Farm, speeds) -> dict:
               "inflow is the geostrophic wind and k_w falls continuously to its floor "
               "(docs/atmosphere.md#shallow-boundary-layer); the ShallowBoundaryLayerWarning of "
               "each model build is silenced in this example")
+    report_model = FlorisModel(FARM_INPUT)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        report_model.set(wind_speeds=list(speeds), wind_directions=[270.0] * len(speeds),
+                         turbulence_intensities=[0.06] * len(speeds))
+    print("  " + validity_summary(validity_report(report_model), FARM_INPUT.name))
 
 
 def ratio(a: float, b: float) -> str:
