@@ -21,7 +21,7 @@ from floris_ekman_veer import optimize_yaw
 from floris_ekman_veer.coupling import inflow, registry
 from floris_ekman_veer.coupling.optimization import atmosphere_groups
 
-from conftest import STABLE_ATMOSPHERE, make_config
+from conftest import STABLE_ATMOSPHERE, assert_as_plain_floris, make_config
 
 pytestmark = pytest.mark.usefixtures("inflow_hook")
 
@@ -232,11 +232,4 @@ def test_plain_floris_optimizer_and_uncertain_model_are_bitwise_unchanged():
         return np.vstack(df.yaw_angles_opt), df.farm_power_opt.to_numpy(), \
             ufmodel.get_turbine_powers()
 
-    hooked = outputs()
-    inflow.uninstall_inflow_hook()
-    try:
-        plain = outputs()
-    finally:
-        registry.register()
-    for a, b in zip(hooked, plain, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_as_plain_floris(outputs)

@@ -24,6 +24,8 @@ from floris_ekman_veer.coupling.crossflow import CROSSFLOW, MOMENTS
 from floris_ekman_veer.coupling.inflow import set_atmosphere
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
 
+from conftest import assert_as_plain_floris
+
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -191,14 +193,7 @@ def test_unconfigured_yawed_farm_is_bitwise_floris():
         return (fmodel.get_turbine_powers(), fmodel.get_turbine_thrust_coefficients(),
                 fmodel.get_turbine_ais())
 
-    hooked = outputs()
-    inflow.uninstall_inflow_hook()
-    try:
-        plain = outputs()
-    finally:
-        floris_ekman_veer.register()
-    for a, b in zip(hooked, plain, strict=True):
-        np.testing.assert_array_equal(a, b)
+    assert_as_plain_floris(outputs)
 
 
 # --------------------------------------------------------------------------------- the disk
