@@ -256,9 +256,11 @@ def yaw_demo(farm: Farm) -> None:
                   f"{base[i] / 1e6:8.2f}{best[i] / 1e6:8.2f}{100 * (best[i] / base[i] - 1):+7.2f}%"
                   f"{100 * (mirror[i] / base[i] - 1):+7.2f}%")
     print("  gain: farm power at the optimum vs zero yaw; mirror: the optimal angles with the "
-          "opposite sign.\n  Without veer (M-2) the mirrored set gains as much at 270 deg (the "
-          "optimiser's choice of sign is arbitrary);\n  with veer (M-1) the sheared wake favours "
-          "one sign (docs/coupling.md#yaw-optimisation), so search negative yaw too.")
+          "opposite sign.\n  Veer favours one sign twice: the veer-aware rotor (every model, "
+          "docs/yaw_steering.md#the-veer-aware-rotor)\n  and, in M-1, the sheared wake "
+          "(docs/coupling.md#yaw-optimisation). FLORIS's optimiser is run here as it is (one "
+          "search);\n  floris_ekman_veer.optimize_yaw searches both signs "
+          "(docs/yaw_steering.md#finding-the-optimum).")
 
 
 # ----------------------------------------------------------------------------------- figures
