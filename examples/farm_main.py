@@ -56,6 +56,7 @@ from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 
@@ -183,6 +184,12 @@ def print_abl(farm: Farm, speeds) -> dict:
               "inflow is the geostrophic wind and k_w falls continuously to its floor "
               "(docs/atmosphere.md#shallow-boundary-layer); the ShallowBoundaryLayerWarning of "
               "each model build is silenced in this example")
+    report_model = FlorisModel(FARM_INPUT)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        report_model.set(wind_speeds=list(speeds), wind_directions=[270.0] * len(speeds),
+                         turbulence_intensities=[0.06] * len(speeds))
+    print("  " + validity_summary(validity_report(report_model), FARM_INPUT.name))
 
 
 def ratio(a: float, b: float) -> str:
@@ -249,9 +256,11 @@ def yaw_demo(farm: Farm) -> None:
                   f"{base[i] / 1e6:8.2f}{best[i] / 1e6:8.2f}{100 * (best[i] / base[i] - 1):+7.2f}%"
                   f"{100 * (mirror[i] / base[i] - 1):+7.2f}%")
     print("  gain: farm power at the optimum vs zero yaw; mirror: the optimal angles with the "
-          "opposite sign.\n  Without veer (M-2) the mirrored set gains as much at 270 deg (the "
-          "optimiser's choice of sign is arbitrary);\n  with veer (M-1) the sheared wake favours "
-          "one sign (docs/coupling.md#yaw-optimisation), so search negative yaw too.")
+          "opposite sign.\n  Veer favours one sign twice: the veer-aware rotor (every model, "
+          "docs/yaw_steering.md#the-veer-aware-rotor)\n  and, in M-1, the sheared wake "
+          "(docs/coupling.md#yaw-optimisation). FLORIS's optimiser is run here as it is (one "
+          "search);\n  floris_ekman_veer.optimize_yaw searches both signs "
+          "(docs/yaw_steering.md#finding-the-optimum).")
 
 
 # ----------------------------------------------------------------------------------- figures

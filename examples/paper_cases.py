@@ -63,6 +63,7 @@ from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
 from floris_ekman_veer.wake.deficit import max_deficit, potential_core_length  # noqa: E402
 
 INPUTS = REPOSITORY / "inputs"
@@ -448,6 +449,9 @@ def main(argv=None) -> None:
     start = time.perf_counter()
 
     cases = {name: Case(name) for name in WAKE_CASES}
+    for name in WAKE_CASES:  # the paper's own cases: inside its envelope by construction
+        case_input = INPUTS / f"{name.lower().replace('-', '')}.yaml"
+        print(validity_summary(validity_report(FlorisModel(case_input)), name))
     print_wake_table(cases)
     path, x0s = cx_figure(cases, args.output)
     written = [path]

@@ -1,23 +1,27 @@
-"""Wake steering with veer: optimal yaw per direction and day/night annual energy.
+"""Wake steering with veer: optimal yaw of a 3-turbine row, both signs, and day/night energy.
 
 Run it from anywhere (after ``pip install .``, or from a checkout):
 
     python examples/yaw_study.py [--output DIR] [--gallery DIR]
 
-Two atmospheres, read from the project's inputs: the paper's neutral CNBL (the atmosphere block of
-``inputs/cnbl.yaml``) and its strongly stable SBL-6 (``inputs/farm_sbl6.yaml``); the farm, the
-turbines and the solver settings are those of ``inputs/farm_sbl6.yaml`` (NREL 5 MW at 7 D).
-Three wake models on the same Ekman inflow: ``ekman_veer`` (the input's own) and FLORIS's GCH and
-cc (``floris_ekman_veer.coupling.comparison.builtin_model``), each built-in given the fair inflow
-scalars of ``comparison.fair_builtin_set_kwargs`` (turbulence intensity I_u(z_h), rotor-layer veer
-and shear of the atmosphere); the script prints what each model sees.
+Three atmospheres, each named by a forcing fixed across wind speeds and read from the project's
+inputs: the neutral day (CNBL, ``inputs/farm_day.yaml``), the paper's SBL-4 cooling rate
+(-0.375 K/h, ``inputs/sbl4.yaml``) and the shipped stable night (Obukhov length 100 m,
+``inputs/farm_night.yaml``). One line per atmosphere says which conditions lie inside the
+paper's validated envelope (``floris_ekman_veer.validity_report``): SBL-4 at 8 m/s has h below
+the NREL 5 MW rotor top, and its rows are flagged.
 
-1. A 3-turbine row (the farm's first column turned into a row along 270 degrees): the optimal yaw
-   angles per wind direction, searched separately with positive and with negative yaw
-   (FLORIS's YawOptimizationSR through ``floris_ekman_veer.optimize_yaw``): veer makes the two
-   signs differ.
-2. The 3 x 3 farm over a wind rose with stable nights and neutral days
-   (``floris_ekman_veer.annual_energy``): AEP per class with and without wake steering.
+1. A 3-turbine NREL 5 MW row along 270 degrees at 4, 5 and 7 D, at 8, 10 and 12 m/s: the optimal
+   yaw over -25..25 deg (``floris_ekman_veer.optimize_yaw``, both signs searched), the farm gain,
+   the best gain restricted to positive and to negative yaw, and the front rotor's own
+   P(+20 deg)/P(-20 deg) (the veer-aware rotor, docs/yaw_steering.md). Models on the same Ekman
+   inflow and the same rotor: ``ekman_veer`` (the paper's M-1), FLORIS's GCH with
+   ``wind_veer = 0`` (the comparison) and GCH with the fair scalar wind_veer of
+   ``comparison.fair_builtin_set_kwargs`` (flagged: gauss's cos(wind_veer) narrowing, not
+   steering, drives its gains at tens of degrees of veer).
+2. With ``--energy``: the 3 x 3 farm of ``inputs/farm_day.yaml`` over a wind rose with stable
+   nights and neutral days (``floris_ekman_veer.annual_energy``): AEP per class with and without
+   wake steering.
 
 Figures (PNG) go to DIR (default ./output); tables are printed. ``run_study(reduced=True)`` is the
 same computation on a coarser grid (tests/test_yaw_study.py).
@@ -47,35 +51,49 @@ from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import annual_energy, optimize_yaw  # noqa: E402
 from floris_ekman_veer.coupling.comparison import builtin_model, fair_builtin_set_kwargs  # noqa: E402
-from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere  # noqa: E402
+from floris_ekman_veer.coupling.inflow import set_atmosphere  # noqa: E402
+from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 
-FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
-NEUTRAL_INPUT = REPOSITORY / "inputs" / "cnbl.yaml"
-MODELS = ("ekman_veer", "gch", "cc")
+DAY_INPUT = REPOSITORY / "inputs" / "farm_day.yaml"
+NIGHT_INPUT = REPOSITORY / "inputs" / "farm_night.yaml"
+SBL4_INPUT = REPOSITORY / "inputs" / "sbl4.yaml"
+#: name -> (label printed, FLORIS configuration): GCH with wind_veer = 0 is the comparison.
+MODELS = {
+    "ekman_veer": "ekman_veer (M-1)",
+    "gch": "GCH, wind_veer 0 (the comparison)",
+    "gch_fair_veer": "GCH, fair wind_veer (flagged: cos(wind_veer) narrowing)",
+}
 
 # Study settings (inputs of the study, not results).
-ROW_SPEED = 8.0                                # m/s at the reference height
-YAW_LIMIT = 25.0                               # degrees, each sign searched on its own
+YAW_LIMIT = 25.0                               # degrees, optimised over -YAW_LIMIT..YAW_LIMIT
+ASYMMETRY_YAW = 20.0                           # deg: the front rotor's P(+b)/P(-b)
 NY_PASSES = [5, 4]                             # YawOptimizationSR passes
 NIGHT_FREQUENCY = 0.5                          # stable nights, neutral days
 ROSE_WEIBULL = (2.0, 8.0)                      # shape k, scale A [m/s] of the speeds
 ROSE_PREVAILING, ROSE_SPREAD = 270.0, 60.0     # deg: direction of most wind, its spread
 GRIDS = {
-    False: dict(row_directions=np.arange(250.0, 290.1, 2.0), ny_passes=NY_PASSES, models=MODELS,
-                rose_directions=np.arange(0.0, 360.0, 15.0), rose_speeds=np.arange(4.0, 16.1, 2.0)),
-    # Each FLORIS optimiser evaluation rebuilds a model: the reduced study makes few of them.
-    True: dict(row_directions=np.array([266.0, 274.0]), ny_passes=[5], models=MODELS[:2],
-               rose_directions=np.array([270.0, 300.0]), rose_speeds=np.array([8.0])),
+    False: dict(spacings=(4.0, 5.0, 7.0), speeds=(8.0, 10.0, 12.0), models=tuple(MODELS),
+                atmospheres=("CNBL", "SBL-4", "night L=100 m"),
+                rose_directions=np.arange(0.0, 360.0, 30.0), rose_speeds=np.arange(4.0, 14.1, 2.0),
+                rose_models=("ekman_veer", "gch"), rose_bounds=(-YAW_LIMIT, YAW_LIMIT)),
+    # Each FLORIS optimiser evaluation rebuilds a model: the reduced study makes few of them
+    # (and steers the farm one way only, two optimiser runs instead of six).
+    True: dict(spacings=(5.0,), speeds=(8.0,), models=("ekman_veer",),
+               atmospheres=("CNBL", "night L=100 m"),
+               rose_directions=np.array([270.0]), rose_speeds=np.array([8.0]),
+               rose_models=("ekman_veer",), rose_bounds=(0.0, YAW_LIMIT)),
 }
 
 
-def atmospheres() -> dict[str, dict]:
-    """The neutral day (CNBL) and stable night (SBL-6) atmosphere blocks, from the inputs."""
-    def block(path):
-        return load_yaml(path)["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
+def _block(path):
+    return load_yaml(path)["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
 
-    return {"CNBL": block(NEUTRAL_INPUT), "SBL-6": block(FARM_INPUT)}
+
+def atmospheres() -> dict[str, dict]:
+    """The neutral day, SBL-4 and the shipped night, from the inputs."""
+    return {"CNBL": _block(DAY_INPUT), "SBL-4": _block(SBL4_INPUT),
+            "night L=100 m": _block(NIGHT_INPUT)}
 
 
 def wind_rose(directions, speeds) -> WindRose:
@@ -89,105 +107,118 @@ def wind_rose(directions, speeds) -> WindRose:
                     freq_table=freq / freq.sum())
 
 
-def row_model() -> FlorisModel:
-    """The farm input's first column of three turbines, turned into a row along 270 degrees."""
-    fmodel = FlorisModel(FARM_INPUT)
-    spacing = float(np.diff(fmodel.layout_y[:2])[0])
-    fmodel.set(layout_x=spacing * np.arange(3), layout_y=np.zeros(3))
+def row_model(spacing: float) -> FlorisModel:
+    """Three NREL 5 MW of the day input in a row along 270 degrees, ``spacing`` rotor diameters."""
+    fmodel = FlorisModel(DAY_INPUT)
+    diameter = float(fmodel.core.farm.rotor_diameters[0])
+    fmodel.set(layout_x=spacing * diameter * np.arange(3), layout_y=np.zeros(3))
     return fmodel
 
 
-def models_on(fmodel, atmosphere: dict, directions, speed: float, models=MODELS) -> dict:
-    """ekman_veer, GCH and cc on these conditions and this atmosphere, with the fair scalars."""
-    built = {}
-    for name in models:
-        model = fmodel.copy() if name == "ekman_veer" else builtin_model(fmodel, name)
-        set_atmosphere(model, atmosphere, wind_directions=directions,
-                       wind_speeds=np.full(len(directions), speed),
-                       turbulence_intensities=np.full(len(directions), 0.06))
-        fair = fair_builtin_set_kwargs(model)
-        if name == "ekman_veer":  # reads neither FLORIS's veer nor its shear
-            model.set(turbulence_intensities=fair["turbulence_intensities"])
-        else:
-            model.set(**fair)
-        built[name] = model
-    return built
+def model_on(fmodel, name: str, atmosphere: dict, speeds, yaw=None):
+    """``name`` (a MODELS key) on these speeds (wind from 270 deg) and this atmosphere, with the
+    atmosphere's I_u(z_h) as FLORIS's turbulence intensity."""
+    base = "gch" if name.startswith("gch") else None
+    model = fmodel.copy() if base is None else builtin_model(fmodel, base)
+    n = len(speeds)
+    set_atmosphere(model, atmosphere, wind_directions=np.full(n, 270.0),
+                   wind_speeds=np.asarray(speeds, float), turbulence_intensities=np.full(n, 0.06),
+                   yaw_angles=yaw)
+    fair = fair_builtin_set_kwargs(model)
+    if name == "gch_fair_veer":
+        model.set(**fair)
+    else:  # ekman_veer reads neither FLORIS's veer nor its shear; GCH gets wind_veer 0
+        model.set(turbulence_intensities=fair["turbulence_intensities"], wind_veer=0.0)
+    return model
 
 
-def inflow_seen(fmodel, atmospheres_: dict, speed: float) -> pd.DataFrame:
-    """What each model is given, per atmosphere, at ``speed``."""
-    rows = []
-    input_ti = float(fmodel.core.flow_field.turbulence_intensities[0])
-    expansion = fmodel.core.wake.wake_velocity_parameters["ekman_veer"].get("wake_expansion",
-                                                                             "ambient")
-    ekman_use = {
-        "ambient": "k_w (Eq. kw_CNBL_SBL_model) from the ABL's I_u(z_h)",
-        "local_turbulence": "k_w from this TI plus FLORIS's wake-added TI",
-    }.get(expansion, f"wake_expansion: {expansion}")
+def validity_lines(atmospheres_: dict, speeds) -> dict[str, tuple[str, pd.DataFrame]]:
+    """Per atmosphere: the one-line validity summary and the report of the row's conditions."""
+    out = {}
     for label, atmosphere in atmospheres_.items():
-        for name, model in models_on(fmodel, atmosphere, [270.0], speed).items():
-            flow_field = model.core.flow_field
-            ti = float(flow_field.turbulence_intensities[0])
-            rows.append({
-                "atmosphere": label, "model": name,
-                "turbulence_intensity": ti,
-                "used_as": ekman_use if name == "ekman_veer" else "FLORIS ambient TI",
-                "wind_veer_deg": np.nan if name == "ekman_veer" else float(flow_field.wind_veer),
-                "input_file_ti": input_ti,
-            })
+        report = validity_report(model_on(row_model(5.0), "ekman_veer", atmosphere, speeds))
+        out[label] = (validity_summary(report, label), report)
+    return out
+
+
+def front_rotor_asymmetry(atmosphere: dict, speeds) -> np.ndarray:
+    """P(+b)/P(-b) of one unwaked NREL 5 MW yawed by b = ASYMMETRY_YAW, per speed."""
+    fmodel = FlorisModel(DAY_INPUT)
+    fmodel.set(layout_x=[0.0], layout_y=[0.0])
+    speeds = np.asarray(speeds, float)
+    yaw = np.concatenate([np.full(speeds.size, ASYMMETRY_YAW), np.full(speeds.size, -ASYMMETRY_YAW)])
+    n = yaw.size
+    set_atmosphere(fmodel, atmosphere, wind_directions=np.full(n, 270.0),
+                   wind_speeds=np.tile(speeds, 2), turbulence_intensities=np.full(n, 0.06),
+                   yaw_angles=yaw[:, None])
+    fmodel.run()
+    power = fmodel.get_turbine_powers()[:, 0]
+    return power[: speeds.size] / power[speeds.size:]
+
+
+def row_yaw_study(atmospheres_: dict, spacings, speeds, models, inside: dict):
+    """Per atmosphere, spacing, speed and model: the optimum over both signs and per sign."""
+    rows = []
+    for label, atmosphere in atmospheres_.items():
+        asymmetry = front_rotor_asymmetry(atmosphere, speeds)
+        for spacing in spacings:
+            row = row_model(spacing)
+            for name in models:
+                model = model_on(row, name, atmosphere, speeds)
+                runs = {}
+                for key, bounds in (("both", (-YAW_LIMIT, YAW_LIMIT)), ("+", (0.0, YAW_LIMIT)),
+                                    ("-", (-YAW_LIMIT, 0.0))):
+                    runs[key] = optimize_yaw(model, YawOptimizationSR,
+                                             minimum_yaw_angle=bounds[0],
+                                             maximum_yaw_angle=bounds[1], Ny_passes=NY_PASSES,
+                                             progress=False)
+                for k, speed in enumerate(speeds):
+                    best = runs["both"].iloc[k]
+                    yaw = np.asarray(best["yaw_angles_opt"], float)
+
+                    def gain(df):
+                        return 100.0 * (df["farm_power_opt"].iloc[k]
+                                        / df["farm_power_baseline"].iloc[k] - 1.0)
+
+                    rows.append({
+                        "atmosphere": label, "spacing_D": spacing, "wind_speed": speed,
+                        "model": name, "yaw_T1": yaw[0], "yaw_T2": yaw[1], "yaw_T3": yaw[2],
+                        "gain_percent": gain(runs["both"]), "gain_plus_only": gain(runs["+"]),
+                        "gain_minus_only": gain(runs["-"]),
+                        "front_P_plus_over_minus": asymmetry[k],
+                        "inside_envelope": bool(inside[label].loc[k, "inside_envelope"]),
+                    })
     return pd.DataFrame(rows)
 
 
-def row_yaw_study(atmospheres_: dict, directions, ny_passes=NY_PASSES, models=MODELS):
-    """Optimal yaw per direction for the 3-turbine row, positive and negative yaw searched apart."""
-    row = row_model()
-    frames = []
-    for label, atmosphere in atmospheres_.items():
-        for name, model in models_on(row, atmosphere, directions, ROW_SPEED, models).items():
-            for sign, bounds in (("+", (0.0, YAW_LIMIT)), ("-", (-YAW_LIMIT, 0.0))):
-                df = optimize_yaw(model, YawOptimizationSR, minimum_yaw_angle=bounds[0],
-                                  maximum_yaw_angle=bounds[1], Ny_passes=ny_passes,
-                                  progress=False)
-                yaw = np.vstack(df["yaw_angles_opt"])
-                frames.append(pd.DataFrame({
-                    "atmosphere": label, "model": name, "sign": sign,
-                    "wind_direction": df["wind_direction"].to_numpy(),
-                    "yaw_T1": yaw[:, 0], "yaw_T2": yaw[:, 1], "yaw_T3": yaw[:, 2],
-                    "gain_percent": 100.0 * (df["farm_power_opt"] / df["farm_power_baseline"]
-                                             - 1.0).to_numpy(),
-                }))
-    return pd.concat(frames, ignore_index=True)
-
-
-def day_night_energy(atmospheres_: dict, directions, speeds, ny_passes=NY_PASSES, models=MODELS):
-    """AEP of the 3 x 3 farm: neutral days and stable nights, with and without steering."""
+def day_night_energy(atmospheres_: dict, directions, speeds, models, bounds=(-YAW_LIMIT, YAW_LIMIT)):
+    """AEP of the 3 x 3 farm: neutral days and stable nights (L = 100 m), with and without
+    steering."""
     stability = {
         "neutral day": {"frequency": 1.0 - NIGHT_FREQUENCY, "atmosphere": atmospheres_["CNBL"]},
-        "stable night": {"frequency": NIGHT_FREQUENCY, "atmosphere": atmospheres_["SBL-6"]},
+        "stable night": {"frequency": NIGHT_FREQUENCY, "atmosphere": _block(NIGHT_INPUT)},
     }
-    return annual_energy(FlorisModel(FARM_INPUT), wind_rose(directions, speeds), stability,
-                         YawOptimizationSR, models=models, minimum_yaw_angle=-YAW_LIMIT,
-                         maximum_yaw_angle=YAW_LIMIT, Ny_passes=ny_passes)
+    return annual_energy(FlorisModel(DAY_INPUT), wind_rose(directions, speeds), stability,
+                         YawOptimizationSR, models=models, minimum_yaw_angle=bounds[0],
+                         maximum_yaw_angle=bounds[1], Ny_passes=NY_PASSES)
 
 
-def run_study(reduced: bool = False) -> dict:
-    """The whole computation (no figures); ``reduced``: the coarse grid, one optimiser pass and
-    ekman_veer and GCH only (GRIDS)."""
+def run_study(reduced: bool = False, energy: bool = True) -> dict:
+    """The whole computation (no figures); ``reduced``: the coarse grid (GRIDS); ``energy``:
+    also the day/night AEP of the 3 x 3 farm (None in the result otherwise)."""
     grid = GRIDS[reduced]
-    atmospheres_ = atmospheres()
+    atmospheres_ = {k: v for k, v in atmospheres().items() if k in grid["atmospheres"]}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ShallowBoundaryLayerWarning)
-        inflow = inflow_seen(row_model(), atmospheres_, ROW_SPEED)
-        yaw = row_yaw_study(atmospheres_, grid["row_directions"], grid["ny_passes"],
-                            grid["models"])
+        validity = validity_lines(atmospheres_, grid["speeds"])
+        yaw = row_yaw_study(atmospheres_, grid["spacings"], grid["speeds"], grid["models"],
+                            {k: v[1] for k, v in validity.items()})
         energy = day_night_energy(atmospheres_, grid["rose_directions"], grid["rose_speeds"],
-                                  grid["ny_passes"], grid["models"])
-    shallow = [w for w in caught if issubclass(w.category, ShallowBoundaryLayerWarning)]
+                                  grid["rose_models"], grid["rose_bounds"]) if energy else None
     for w in caught:
-        if not issubclass(w.category, ShallowBoundaryLayerWarning):
+        if not issubclass(w.category, ShallowBoundaryLayerWarning):  # said by the validity lines
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return {"inflow": inflow, "yaw": yaw, "energy": energy,
-            "shallow_warnings": sorted({str(w.message) for w in shallow})}
+    return {"validity": {k: v[0] for k, v in validity.items()}, "yaw": yaw, "energy": energy}
 
 
 # ----------------------------------------------------------------------------------- figures
@@ -195,20 +226,21 @@ def plot_row(yaw: pd.DataFrame, output: Path, dpi: int = 120) -> Path:
     import matplotlib.pyplot as plt
 
     labels = list(dict.fromkeys(yaw["atmosphere"]))
-    fig, axes = plt.subplots(2, len(labels), figsize=(11, 6.5), sharex=True, sharey="row")
-    colours = {"ekman_veer": "m", "gch": "tab:cyan", "cc": "tab:orange"}
+    fig, axes = plt.subplots(2, len(labels), figsize=(4.2 * len(labels), 6.5), sharex=True,
+                             squeeze=False)
+    colours = {"ekman_veer": "m", "gch": "tab:cyan", "gch_fair_veer": "tab:gray"}
     for j, label in enumerate(labels):
-        for (name, sign), df in yaw[yaw["atmosphere"] == label].groupby(["model", "sign"]):
-            style = "-" if sign == "+" else "--"
-            axes[0, j].plot(df["wind_direction"], df["yaw_T1"], style, color=colours[name],
-                            label=f"{name}, {sign} yaw")
-            axes[1, j].plot(df["wind_direction"], df["gain_percent"], style,
-                            color=colours[name], label=f"{name}, {sign} yaw")
-        axes[0, j].set_title(f"{label}: 3-turbine row, {ROW_SPEED:g} m/s")
-        axes[1, j].set_xlabel("wind direction [deg]")
-    axes[0, 0].set_ylabel("optimal yaw of the front turbine [deg]")
-    axes[1, 0].set_ylabel("farm power gain [%]")
-    axes[0, 0].legend(fontsize=7)
+        for (name, speed), df in yaw[yaw["atmosphere"] == label].groupby(["model", "wind_speed"]):
+            style = {8.0: "-o", 10.0: "--s", 12.0: ":^"}.get(speed, "-")
+            axes[0, j].plot(df["spacing_D"], df["gain_percent"], style, color=colours[name],
+                            label=f"{name}, {speed:g} m/s")
+            axes[1, j].plot(df["spacing_D"], df["yaw_T1"], style, color=colours[name])
+        axes[0, j].set_title(f"{label}: 3-turbine row, 270 deg")
+        axes[1, j].set_xlabel("spacing [D]")
+        axes[1, j].axhline(0.0, color="k", lw=0.5)
+    axes[0, 0].set_ylabel("farm power gain [%]")
+    axes[1, 0].set_ylabel("optimal yaw of the front turbine [deg]")
+    axes[0, 0].legend(fontsize=6)
     fig.tight_layout()
     path = output / "yaw_study_row.png"
     fig.savefig(path, dpi=dpi)
@@ -234,46 +266,52 @@ def main(argv=None) -> None:
     parser.add_argument("--output", type=Path, default=Path("output"))
     parser.add_argument("--gallery", type=Path, default=None,
                         help="also write the README gallery's small copy of yaw_study_row.png")
+    parser.add_argument("--energy", action="store_true",
+                        help="also the day/night AEP of the 3 x 3 farm (six optimiser runs per "
+                             "class and model: slow)")
     args = parser.parse_args(argv)
     args.output.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    study = run_study()
+    study = run_study(energy=args.energy)
     pd.set_option("display.width", 250)
-    pd.set_option("display.max_rows", 200)
+    pd.set_option("display.max_rows", 300)
 
-    print("What each model sees at the hub (row study wind speed "
-          f"{ROW_SPEED:g} m/s; the farm input's own TI is what FLORIS would use otherwise):")
-    print(study["inflow"].to_string(index=False, float_format="%.4f"))
-    if study["shallow_warnings"]:
-        print(f"note: {len(study['shallow_warnings'])} model builds had stable conditions with a "
-              "boundary layer shallower than the rotor, e.g.\n  " + study["shallow_warnings"][0])
-    veer = study["inflow"].groupby("atmosphere")["wind_veer_deg"].max()
-    print("note: GCH and cc get FLORIS wind_veer = "
-          + ", ".join(f"{v:.1f} deg ({a})" for a, v in veer.items())
-          + "; at tens of degrees gauss's cos(wind_veer) narrowing makes its unsteered wakes "
-          "very deep, which inflates its steering gains (docs/coupling.md#floris-inflow)")
+    print("Validity of the row's conditions (docs/yaw_steering.md#the-validated-envelope):")
+    for line in study["validity"].values():
+        print("  " + line)
+    print("Models (same Ekman inflow, same veer-aware rotor): "
+          + "; ".join(f"{k} = {v}" for k, v in MODELS.items()))
+    print("The comparison is GCH with wind_veer 0; GCH with the fair wind_veer is shown for "
+          "reference only: at tens of degrees of veer gauss's cos(wind_veer) narrowing makes its "
+          "unsteered wakes very deep and its gains measure that, not steering "
+          "(docs/yaw_steering.md#comparing-with-floriss-models).")
 
     yaw = study["yaw"]
-    print(f"\n3-turbine row at {ROW_SPEED:g} m/s, wind along the row (270 deg): optimal yaw "
-          "[deg] and farm power gain per sign of yaw")
-    aligned = yaw[np.isclose(yaw["wind_direction"], 270.0)]
-    print(aligned.drop(columns="wind_direction").to_string(index=False, float_format="%.2f"))
-    for value, title in (("gain_percent", "farm power gain [%]"),
-                         ("yaw_T1", "optimal yaw of the front turbine [deg]")):
-        print(f"\n{title} per wind direction [deg], positive and negative yaw searched apart:")
-        print(yaw.pivot_table(index=["atmosphere", "model", "sign"], columns="wind_direction",
-                              values=value).to_string(float_format="%.1f"))
+    print(f"\n3-turbine NREL 5 MW row, wind along the row: optimal yaw [deg] over +-{YAW_LIMIT:g} "
+          "deg (both signs), farm power gain [%], the best gain with each sign alone, and the "
+          f"front rotor's own P(+{ASYMMETRY_YAW:g})/P(-{ASYMMETRY_YAW:g}). "
+          "inside_envelope False: h below the rotor top, extrapolated, not validated.")
+    print(yaw.to_string(index=False, float_format="%.3f"))
+    table = yaw.pivot_table(index=["atmosphere", "model"], columns=["spacing_D", "wind_speed"],
+                            values="gain_percent")
+    print("\nfarm power gain [%] by spacing [D] and wind speed [m/s]:")
+    print(table.to_string(float_format="%.2f"))
 
     energy = study["energy"]
-    print("\n3 x 3 farm, day/night annual energy [GWh] with and without wake steering "
-          f"(Weibull k = {ROSE_WEIBULL[0]:g}, A = {ROSE_WEIBULL[1]:g} m/s; nights "
-          f"{NIGHT_FREQUENCY:.0%} of the year, SBL-6; days CNBL):")
-    print(energy.table.to_string(index=False, float_format="%.3f"))
-    paths = [plot_row(yaw, args.output), plot_energy(energy, args.output)]
+    paths = [plot_row(yaw, args.output)]
     if args.gallery is not None:
         args.gallery.mkdir(parents=True, exist_ok=True)
         paths.append(plot_row(yaw, args.gallery, dpi=60))
-    for path in paths:
+    if energy is None:
+        for path in paths:
+            print(f"wrote {path}")
+        print(f"done in {time.perf_counter() - started:.1f} s (day/night AEP: --energy)")
+        return
+    print("\n3 x 3 farm, day/night annual energy [GWh] with and without wake steering "
+          f"(Weibull k = {ROSE_WEIBULL[0]:g}, A = {ROSE_WEIBULL[1]:g} m/s; nights "
+          f"{NIGHT_FREQUENCY:.0%} of the year, L = 100 m; days CNBL):")
+    print(energy.table.to_string(index=False, float_format="%.3f"))
+    for path in paths + [plot_energy(energy, args.output)]:
         print(f"wrote {path}")
     print(f"done in {time.perf_counter() - started:.1f} s")
 

@@ -16,6 +16,8 @@ AEP per stability class, baseline and with wake steering, for ekman_veer and FLO
 inputs, installed with it. Every warning class of the package is importable from here, and
 ``floris_ekman_veer.silence_warnings()`` silences them in this process and its workers
 (docs/user_guide.md#warnings).
+``floris_ekman_veer.validity_report(fmodel)`` says per condition whether the atmosphere lies inside
+the paper's validated CNBL..SBL-6 envelope (docs/yaw_steering.md#the-validated-envelope).
 """
 
 from floris_ekman_veer._version import __version__
@@ -25,6 +27,7 @@ from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.optimization import optimize_yaw
 from floris_ekman_veer.coupling.registry import register
 from floris_ekman_veer.coupling.site import fit_site
+from floris_ekman_veer.coupling.validity import validity_report
 from floris_ekman_veer.example_inputs import example_input, example_inputs
 from floris_ekman_veer.warnings import (
     FlorisEkmanVeerWarning,
@@ -39,6 +42,7 @@ from floris_ekman_veer.warnings import (
 __all__ = ["EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
            "ModelSettingsWarning", "ParFlorisModel", "ShallowBoundaryLayerWarning",
            "ThrustLimitWarning", "TurbinePlacementWarning", "__version__", "annual_energy",
-           "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings"]
+           "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings",
+           "validity_report"]
 
 register()

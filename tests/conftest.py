@@ -91,3 +91,20 @@ def inflow_hook():
     inputs without an atmosphere block)."""
     inflow.install_inflow_hook()
     return inflow
+
+
+def assert_as_plain_floris(outputs):
+    """``outputs()`` (a sequence of arrays) is bitwise the same with the package's hooks
+    installed and with all of them removed (plain FLORIS); the hooks are installed again."""
+    import numpy as np
+
+    from floris_ekman_veer.coupling import registry
+
+    hooked = outputs()
+    inflow.uninstall_inflow_hook()
+    try:
+        plain = outputs()
+    finally:
+        registry.register()
+    for a, b in zip(hooked, plain, strict=True):
+        np.testing.assert_array_equal(a, b)

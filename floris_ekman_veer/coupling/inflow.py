@@ -449,6 +449,10 @@ def _profile_and_gradient(abl, z, reference_height):
 
 
 _ACTIVE: contextvars.ContextVar = contextvars.ContextVar("ekman_veer_atmosphere", default=None)
+
+#: Context managers ``make(core)`` entered around every wrapped Core solve (the veer-aware rotor,
+#: coupling/yawed_rotor.py, gives the operation models the Core's ambient V this way).
+CORE_CONTEXTS: list = []
 _SOLVED: dict = {}  # id(flow_field) -> (weakref to the flow field, EkmanABL)
 
 
@@ -546,7 +550,9 @@ def _with_core_atmosphere(method):
             # The package's per-wake warnings are said once, summarised, at the end of a solve.
             with package_warnings.run_scope(self.flow_field.wind_speeds,
                                             self.flow_field.reference_wind_height), \
-                    _at_rest(self, atmosphere) as rest:
+                    _at_rest(self, atmosphere) as rest, contextlib.ExitStack() as stack:
+                for make in CORE_CONTEXTS:
+                    stack.enter_context(make(self))
                 result = method(self, *args, **kwargs)
         finally:
             TURBINE_MOMENTS.reset(moments)

@@ -72,6 +72,7 @@ def register() -> None:
     from floris_ekman_veer.coupling.parallel import install_parallel_hook
     from floris_ekman_veer.coupling.uncertain import install_uncertain_hook
     from floris_ekman_veer.coupling.wake_settings import install_wake_settings_hook
+    from floris_ekman_veer.coupling.yawed_rotor import install_yawed_rotor_hook
 
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
                 "velocity_model")
@@ -85,3 +86,4 @@ def register() -> None:
     install_uncertain_hook()
     install_optimizer_hook()
     install_wake_settings_hook()
+    install_yawed_rotor_hook()

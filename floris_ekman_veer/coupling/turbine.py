@@ -31,6 +31,15 @@ disk velocity of Eq. (Ud), U_d = (1 - a) U_disk, in a wake. U_disk is the *plain
 the streamwise velocity over FLORIS's rotor points, as Eq. (Ud) prescribes: not FLORIS's default
 cubic mean, which belongs to power curves and would overstate the disk's power in shear.
 
+Veer-aware yawed disk
+---------------------
+In a veered inflow the disk-normal velocity is u_n = U cos beta + V sin beta per rotor cell (U, V
+hub-aligned; coupling/yawed_rotor.py, docs/yaw_steering.md), and the disk takes its disk mean
+<u_n> = <U> gamma, gamma = cos beta + sin beta <V>/<U>, wherever the formulas above take
+<U> cos beta: a(gamma) = C_T' gamma^2 / (4 + C_T' gamma^2), P = 1/2 rho A C_T' [(1 - a) <U> gamma]^3,
+and ct_i = C_T(gamma) gamma^2 / cos beta, so that the wake sees the rotor-normal loading
+C_T cos^2 beta = 4a(1 - a). Without an ambient V (no atmosphere), gamma = cos beta exactly.
+
 Yaw convention handed to the wake model (the decision)
 -------------------------------------------------------
 ``thrust_coefficient`` returns ct_i = C_T(beta) cos(beta): C_T' is held fixed under yaw, as in the
@@ -59,7 +68,9 @@ ct_prime, rotor_diameter and ref_air_density on every call so a stale table cann
 the analytic model; build them with :func:`actuator_disk_power_thrust_table`. The density in the
 power is FLORIS's flow ``air_density`` (power is linear in it), as FLORIS's own models correct
 their tables from ``ref_air_density``. Not modelled: tilt, cut-in/out, rated power, derating
-setpoints, AWC (the LES disk has none of these); |yaw| must stay below 90 deg.
+setpoints, AWC (the LES disk has none of these); |yaw| must stay below 90 deg. FLORIS's
+``disable_turbines`` is honoured (no power, no thrust, no induction); any other power set-point
+below FLORIS's default raises ValueError (a fixed-C_T' disk has no controller to derate).
 
 Registration: importing ``floris_ekman_veer`` registers the model (in every process, including
 ParFlorisModel workers); :func:`floris_ekman_veer.coupling.registry.register_operation_model`
@@ -71,10 +82,15 @@ from __future__ import annotations
 import numpy as np
 from attrs import define
 from floris.core.rotor_velocity import average_velocity
-from floris.core.turbine.operation_models import BaseOperationModel
+from floris.core.turbine.operation_models import (
+    POWER_SETPOINT_DEFAULT,
+    POWER_SETPOINT_DISABLED,
+    BaseOperationModel,
+)
 from floris.type_dec import NDArrayFloat
 
 from floris_ekman_veer._validation import number
+from floris_ekman_veer.coupling.crossflow import VEER_AWARE_KEY, ambient_crossflow
 
 OPERATION_MODEL_NAME = "actuator-disk"
 
@@ -92,7 +108,11 @@ def induction_factor(ct_prime, yaw_angles=0.0):
 
     Equals the paper's Eq. (ind_factor) evaluated with C_T = :func:`disk_thrust_coefficient`.
     """
-    c2 = np.cos(np.radians(yaw_angles)) ** 2
+    return _induction(ct_prime, np.cos(np.radians(yaw_angles)) ** 2)
+
+
+def _induction(ct_prime, c2):
+    # a from the squared effective cosine (cos^2 beta, or gamma^2 with veer).
     return ct_prime * c2 / (4.0 + ct_prime * c2)
 
 
@@ -128,6 +148,7 @@ def actuator_disk_power_thrust_table(
     rotor_diameter: float,
     ref_air_density: float = 1.225,
     wind_speed=DEFAULT_WIND_SPEEDS,
+    veer_aware_rotor: bool = True,
 ) -> dict:
     """A FLORIS power_thrust_table for the disk, with arrays consistent with Eq. (P0_ref).
 
@@ -146,6 +167,7 @@ def actuator_disk_power_thrust_table(
         "wind_speed": ws.tolist(),
         "power": _tabulated_power_kw(ct_prime, rotor_diameter, ref_air_density, ws).tolist(),
         "thrust_coefficient": np.full(ws.shape, disk_thrust_coefficient(ct_prime)).tolist(),
+        VEER_AWARE_KEY: bool(veer_aware_rotor),
     }
 
 
@@ -156,6 +178,7 @@ def actuator_disk_turbine(
     ref_air_density: float = 1.225,
     turbine_type: str = "actuator_disk_les",
     wind_speed=DEFAULT_WIND_SPEEDS,
+    veer_aware_rotor: bool = True,
 ) -> dict:
     """A complete FLORIS turbine definition (dict) for the disk; defaults are the paper's LES."""
     hub_height = _positive(hub_height, "hub_height")
@@ -167,7 +190,7 @@ def actuator_disk_turbine(
         "TSR": 8.0,
         "operation_model": OPERATION_MODEL_NAME,
         "power_thrust_table": actuator_disk_power_thrust_table(
-            ct_prime, rotor_diameter, ref_air_density, wind_speed
+            ct_prime, rotor_diameter, ref_air_density, wind_speed, veer_aware_rotor
         ),
     }
 
@@ -226,12 +249,48 @@ def _cos_yaw(yaw_angles):
     return np.clip(np.cos(np.radians(yaw_angles)), 0.0, None)
 
 
+def _normal_cosine(power_thrust_table, velocities, yaw_angles, u_disk, average_method,
+                   cubature_weights):
+    """gamma = <u_n> / <U> = cos beta + sin beta <V> / <U>, the disk's effective cosine.
+
+    Exactly cos beta without an ambient crossflow V (plain FLORIS, or no atmosphere), exactly 1
+    at beta = 0 (module docstring, docs/yaw_steering.md)."""
+    cos_yaw = _cos_yaw(yaw_angles)
+    crossflow = ambient_crossflow(power_thrust_table, velocities)
+    if crossflow is None:
+        return cos_yaw
+    v_disk = _disk_average(np.broadcast_to(crossflow["V"], np.shape(velocities)),
+                           average_method, cubature_weights)
+    flowing = u_disk > 0.0
+    ratio = np.where(flowing, v_disk / np.where(flowing, u_disk, 1.0), 0.0)
+    return np.clip(cos_yaw + np.sin(np.radians(yaw_angles)) * ratio, 0.0, None)
+
+
+def _disabled(power_setpoints, shape):
+    """Turbines FLORIS's ``disable_turbines`` switched off; ValueError for any other power
+    set-point (a fixed-C_T' disk has no controller to derate)."""
+    if power_setpoints is None:
+        return np.zeros(shape, dtype=bool)
+    setpoints = np.broadcast_to(np.asarray(power_setpoints, dtype=float), shape)
+    disabled = setpoints <= POWER_SETPOINT_DISABLED
+    derated = ~disabled & (setpoints < POWER_SETPOINT_DEFAULT)
+    if np.any(derated):
+        index = tuple(int(i) for i in np.argwhere(derated)[0])
+        raise ValueError(
+            f"power_setpoints: the actuator-disk turbine (fixed C_T', no controller) cannot be "
+            f"derated; got {setpoints[index]:g} W at (condition, turbine) {index}. Valid: the "
+            f"default {POWER_SETPOINT_DEFAULT:g} W (not derated) or disable_turbines (set-point "
+            f"{POWER_SETPOINT_DISABLED:g} W: no power, no thrust)"
+        )
+    return disabled
+
+
 @define
 class ActuatorDiskTurbine(BaseOperationModel):
     """FLORIS operation model of an actuator disk with fixed local thrust coefficient C_T'.
 
     Static methods with FLORIS's operation-model signatures; see the module docstring for the
-    momentum theory, the yaw convention and the power_thrust_table keys.
+    momentum theory, the yaw convention, the veer-aware rotor and the power_thrust_table keys.
     """
 
     @staticmethod
@@ -242,17 +301,21 @@ class ActuatorDiskTurbine(BaseOperationModel):
         yaw_angles: NDArrayFloat,
         average_method: str = "cubic-mean",
         cubature_weights: NDArrayFloat | None = None,
+        power_setpoints: NDArrayFloat | None = None,
         **_,
     ) -> NDArrayFloat:
-        """P = 1/2 rho A C_T' [(1 - a(beta)) U_disk cos beta]^3 in W (Eqs. P0_ref, P_hyp, Ud)."""
+        """P = 1/2 rho A C_T' [(1 - a) <u_n>]^3 in W, <u_n> = <U> gamma (Eqs. P0_ref, P_hyp, Ud)."""
         ct_prime, diameter = disk_parameters(power_thrust_table)
         u_disk = _disk_average(velocities, average_method, cubature_weights)
         # A disk-averaged speed below zero only arises from over-subtracted wake deficits; such a
         # disk extracts nothing rather than producing negative power.
         u_disk = np.clip(u_disk, 0.0, None)
-        u_normal = (1.0 - induction_factor(ct_prime, yaw_angles)) * u_disk * _cos_yaw(yaw_angles)
+        gamma = _normal_cosine(power_thrust_table, velocities, yaw_angles, u_disk,
+                               average_method, cubature_weights)
+        u_normal = (1.0 - _induction(ct_prime, gamma**2)) * u_disk * gamma
         area = np.pi * diameter**2 / 4.0
-        return 0.5 * air_density * area * ct_prime * u_normal**3
+        power = 0.5 * air_density * area * ct_prime * u_normal**3
+        return np.where(_disabled(power_setpoints, np.shape(power)), 0.0, power)
 
     @staticmethod
     def thrust_coefficient(
@@ -261,15 +324,27 @@ class ActuatorDiskTurbine(BaseOperationModel):
         yaw_angles: NDArrayFloat,
         average_method: str = "cubic-mean",
         cubature_weights: NDArrayFloat | None = None,
+        power_setpoints: NDArrayFloat | None = None,
         **_,
     ) -> NDArrayFloat:
-        """ct_i = C_T(beta) cos beta, so that ct_i / cos beta is the paper's C_T(beta).
+        """ct_i = C_T(gamma) gamma^2 / cos beta (= C_T(beta) cos beta without veer), so that
+        ct_i / cos beta is the C_T whose rotor-normal part C_T cos^2 beta is the disk's normal
+        force coefficient 4a(1 - a).
 
-        Independent of the wind speed: the disk's C_T' is constant.
+        Independent of the wind speed without veer: the disk's C_T' is constant.
         """
         ct_prime, _diameter = disk_parameters(power_thrust_table)
-        ct = disk_thrust_coefficient(ct_prime, yaw_angles) * _cos_yaw(yaw_angles)
-        return ct * np.ones(np.shape(velocities)[:2])  # (n_findex, n_turbines)
+        gamma = _normal_cosine(
+            power_thrust_table, velocities, yaw_angles,
+            np.clip(_disk_average(velocities, average_method, cubature_weights), 0.0, None),
+            average_method, cubature_weights,
+        )
+        cos_yaw = _cos_yaw(yaw_angles)
+        edge_on = cos_yaw <= 0.0
+        ct = (16.0 * ct_prime / (4.0 + ct_prime * gamma**2) ** 2) * gamma * np.where(
+            edge_on, 0.0, gamma / np.where(edge_on, 1.0, cos_yaw))
+        ct = ct * np.ones(np.shape(velocities)[:2])  # (n_findex, n_turbines)
+        return np.where(_disabled(power_setpoints, np.shape(ct)), 0.0, ct)
 
     @staticmethod
     def axial_induction(
@@ -278,9 +353,16 @@ class ActuatorDiskTurbine(BaseOperationModel):
         yaw_angles: NDArrayFloat,
         average_method: str = "cubic-mean",
         cubature_weights: NDArrayFloat | None = None,
+        power_setpoints: NDArrayFloat | None = None,
         **_,
     ) -> NDArrayFloat:
-        """a(beta) = C_T' cos^2 beta / (4 + C_T' cos^2 beta), the paper's Eq. (ind_factor)."""
+        """a = C_T' gamma^2 / (4 + C_T' gamma^2), the paper's Eq. (ind_factor) (gamma = cos beta
+        without veer)."""
         ct_prime, _diameter = disk_parameters(power_thrust_table)
-        return induction_factor(ct_prime, yaw_angles) * np.ones(np.shape(velocities)[:2])
-
+        gamma = _normal_cosine(
+            power_thrust_table, velocities, yaw_angles,
+            np.clip(_disk_average(velocities, average_method, cubature_weights), 0.0, None),
+            average_method, cubature_weights,
+        )
+        a = _induction(ct_prime, gamma**2) * np.ones(np.shape(velocities)[:2])
+        return np.where(_disabled(power_setpoints, np.shape(a)), 0.0, a)

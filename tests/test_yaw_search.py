@@ -1,0 +1,127 @@
+"""optimize_yaw finds the optimum over both signs of yaw, whatever the bounds
+(coupling/optimization.py, docs/yaw_steering.md#finding-the-optimum).
+
+The reference is a brute-force search on a 1-degree grid, built here: every pair of yaw angles of
+the two front turbines of a 3-turbine row, and for each pair the best yaw of the last turbine
+(whose yaw moves no wake onto a turbine, so its power given its inflow is all that depends on
+it: evaluated with the operation model on that inflow for every angle). The rows are held out:
+spacings and directions that examples/yaw_study.py does not use.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from floris import FlorisModel
+from floris.core.turbine.turbine import power
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+from floris.utilities import load_yaml
+
+import floris_ekman_veer  # noqa: F401
+from floris_ekman_veer import optimize_yaw
+from floris_ekman_veer.coupling.inflow import set_atmosphere
+from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.coupling.yawed_rotor import veer_aware
+
+INPUTS = Path(__file__).resolve().parents[1] / "inputs"
+DIAMETER = 126.0
+LIMIT = 25.0
+#: Held-out rows: (spacing in D, atmosphere input, wind direction, wind speed).
+ROWS = [(4.5, "sbl4", 266.0, 9.0), (6.0, "cnbl", 268.0, 9.0)]
+BOUNDS = [(-LIMIT, LIMIT), (0.0, LIMIT), (-LIMIT, 0.0)]
+
+
+def atmosphere(name):
+    return load_yaml(INPUTS / f"{name}.yaml")["wake"]["wake_velocity_parameters"]["ekman_veer"][
+        "atmosphere"]
+
+
+def row(spacing, name, direction, speed, yaw=None):
+    fmodel = FlorisModel(INPUTS / "farm_sbl6.yaml")
+    n = 1 if yaw is None else len(yaw)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        set_atmosphere(fmodel, atmosphere(name), layout_x=spacing * DIAMETER * np.arange(3),
+                       layout_y=np.zeros(3), wind_directions=np.full(n, direction),
+                       wind_speeds=np.full(n, speed), turbulence_intensities=np.full(n, 0.06),
+                       yaw_angles=yaw)
+    return fmodel
+
+
+def last_turbine_powers(fmodel, angles):
+    """(n_findex, angles) power of the last turbine yawed by each angle, in its inflow."""
+    farm, flow = fmodel.core.farm, fmodel.core.flow_field
+    out = []
+    with veer_aware(fmodel.core):
+        for angle in angles:
+            yaw = farm.yaw_angles.copy()
+            yaw[:, 2] = angle
+            out.append(power(
+                velocities=flow.u, turbulence_intensities=flow.turbulence_intensity_field[:, :, None, None],
+                air_density=flow.air_density, power_functions=farm.turbine_power_functions,
+                yaw_angles=yaw, tilt_angles=farm.tilt_angles, power_setpoints=farm.power_setpoints,
+                awc_modes=farm.awc_modes, awc_amplitudes=farm.awc_amplitudes,
+                tilt_interps=farm.turbine_tilt_interps, turbine_type_map=farm.turbine_type_map,
+                turbine_power_thrust_tables=farm.turbine_power_thrust_tables,
+                correct_cp_ct_for_tilt=farm.correct_cp_ct_for_tilt, ix_filter=[2],
+            )[:, 0])
+    return np.stack(out, axis=1)
+
+
+@pytest.fixture(scope="module")
+def brute_force():
+    """Per held-out row: (front yaw pairs, last-turbine angles, farm power table)."""
+    angles = np.arange(-LIMIT, LIMIT + 1.0)
+    y1, y2 = (a.ravel() for a in np.meshgrid(angles, angles, indexing="ij"))
+    pairs = np.stack([y1, y2, np.zeros_like(y1)], axis=1)
+    tables = []
+    for spacing, name, direction, speed in ROWS:
+        fmodel = row(spacing, name, direction, speed, pairs)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+            fmodel.run()
+        front = fmodel.get_turbine_powers()[:, :2].sum(axis=1)
+        tables.append(front[:, None] + last_turbine_powers(fmodel, angles))
+    return pairs, angles, tables
+
+
+def best_within(brute_force, k, lower, upper):
+    pairs, angles, tables = brute_force
+    inside = np.all((pairs[:, :2] >= lower) & (pairs[:, :2] <= upper), axis=1)
+    columns = (angles >= lower) & (angles <= upper)
+    return tables[k][np.ix_(inside, columns)].max()
+
+
+@pytest.mark.parametrize("bounds", BOUNDS, ids=["-25..25", "0..25", "-25..0"])
+def test_optimum_within_0_05_percent_of_brute_force(brute_force, bounds):
+    for k, (spacing, name, direction, speed) in enumerate(ROWS):
+        df = optimize_yaw(row(spacing, name, direction, speed), YawOptimizationSR,
+                          minimum_yaw_angle=bounds[0], maximum_yaw_angle=bounds[1],
+                          progress=False)
+        found = float(df["farm_power_opt"].iloc[0])
+        reference = best_within(brute_force, k, *bounds)
+        shortfall = 1.0 - found / reference
+        assert shortfall < 5e-4, (spacing, name, direction, bounds, shortfall)
+        yaw = np.vstack(df["yaw_angles_opt"])[0]
+        assert np.all((yaw >= bounds[0]) & (yaw <= bounds[1]))
+
+
+def test_single_search_is_floris_own_and_loses_the_other_sign(brute_force):
+    """search="single" is FLORIS's serial refine as it is; on a veered row over -25..25 deg it
+    falls short of the optimum by more than the both-signs search."""
+    spacing, name, direction, speed = ROWS[0]
+    fmodel = row(spacing, name, direction, speed)
+    single = optimize_yaw(fmodel, YawOptimizationSR, search="single", minimum_yaw_angle=-LIMIT,
+                          maximum_yaw_angle=LIMIT, progress=False)
+    own = YawOptimizationSR(fmodel, minimum_yaw_angle=-LIMIT, maximum_yaw_angle=LIMIT)
+    own = own.optimize(print_progress=False)
+    assert float(single["farm_power_opt"].iloc[0]) == float(own["farm_power_opt"].iloc[0])
+    both = optimize_yaw(fmodel, YawOptimizationSR, minimum_yaw_angle=-LIMIT,
+                        maximum_yaw_angle=LIMIT, progress=False)
+    reference = best_within(brute_force, 0, -LIMIT, LIMIT)
+    assert float(both["farm_power_opt"].iloc[0]) >= float(single["farm_power_opt"].iloc[0])
+    assert 1.0 - float(single["farm_power_opt"].iloc[0]) / reference > \
+        1.0 - float(both["farm_power_opt"].iloc[0]) / reference
