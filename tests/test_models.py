@@ -223,7 +223,9 @@ def test_switching_model_names_keeps_the_ekman_inflow():
     assert type(fmodel.core.wake.velocity_model) is Gaussian2014VelocityDeficit
     _, gauss = run("gauss", "gauss")
     np.testing.assert_array_equal(gauss[:3], m1[:3])  # x = 0: unwaked, same inflow
-    np.testing.assert_allclose(m3, m1, rtol=1e-12)
+    # To the rotor cells' cut-off: sub-point rows where a wake stays below 1e-5 U_h are not
+    # integrated, and the two models bound their wakes differently (coupling/models.py).
+    np.testing.assert_allclose(m3, m1, rtol=1e-6)
     assert np.max(np.abs(gauss[3:] - m1[3:])) > 0.05
 
     _, m1_yawed = run("ekman_veer", "ekman_veer", yaw=20.0)

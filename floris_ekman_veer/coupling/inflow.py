@@ -123,6 +123,7 @@ from floris.floris_model import FlorisModel  # noqa: E402
 
 from floris_ekman_veer.coupling.rotor import (  # noqa: E402
     TURBINE_MOMENTS,
+    WAKE_MODELS,
     turbine_grid_inflow,
     turbine_moments,
 )
@@ -515,9 +516,12 @@ def _with_core_atmosphere(method):
         token = _ACTIVE.set(atmosphere)
         # Which rotor average each turbine takes (coupling/rotor.py).
         moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
+        # How the solver combines wakes and adds turbulence (coupling/rotor.py).
+        wake_models = WAKE_MODELS.set(self.wake)
         try:
             result = method(self, *args, **kwargs)
         finally:
+            WAKE_MODELS.reset(wake_models)
             TURBINE_MOMENTS.reset(moments)
             _ACTIVE.reset(token)
         if full_flow and input_checks.uses_wake_models(self):
