@@ -102,9 +102,12 @@ ROTOR_PLANE_MARGIN = 0.1
 #: most 3e-5 of a turbine that sees no other wake, far less where wakes combine).
 NEGLIGIBLE_DEFICIT = 1e-5
 
+#: Rotors whose wake centre is evaluated at their sub-point rows at once.
+PAIR_CHUNK = 1024
+
 #: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
-#: about 1 MB each.
-ROW_CHUNK = 16384
+#: about 0.3 MB each.
+ROW_CHUNK = 4096
 
 #: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
 #: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
@@ -265,8 +268,9 @@ class RotorAmbient:
     """The rotor cells of a turbine grid (coupling/rotor.py) and the ambient at their rows.
 
     Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
-    radius; per sub-point row (n_findex, n_turbines, rows): height and the ambient (U, V) in
-    FLORIS's frame (U is FLORIS's inflow component, V the lateral one).
+    radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
+    (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
+    FLORIS's inflow component, V the lateral one).
     """
 
     cells: RotorCells
@@ -275,20 +279,25 @@ class RotorAmbient:
     y: np.ndarray
     z: np.ndarray
     radius: np.ndarray
-    u_rows: np.ndarray
-    v_rows: np.ndarray
-    row_heights: np.ndarray  # (n_findex, n_turbines, rows): heights of the sub-point rows
+    kind: np.ndarray
+    kind_heights: np.ndarray
+    kind_u: np.ndarray
+    kind_v: np.ndarray
     warned: set = field(factory=set)
 
     @classmethod
     def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
         cells = rotor_cells(grid.grid_resolution, *sub_quadrature(grid.grid_resolution))
         x, y, z, radius, _ = rotor_geometry(grid)
-        u, v = rows_profile(
+        kind, heights, u, v = rows_profile(
             lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
         )
-        heights = z[..., None] + radius[..., None] * cells.row_z
-        return cls(cells, sorted_moments(grid), x, y, z, radius, u, v, heights)
+        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v)
+
+    def rows(self, f, j):
+        """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""
+        kind = self.kind[f, j]
+        return self.kind_heights[kind], self.kind_u[f, kind], self.kind_v[f, kind]
 
 
 @define(frozen=True)
@@ -503,11 +512,12 @@ class _EkmanWakeModel(BaseModel):
         rows_at = getattr(deflection_field_i, "rows_at", None)
         if rows_at is not None and cells.n > 1:
             # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
-            # widened by twice its spread plus R/4 (the centre at the rows beyond +-R/2 and
-            # between them) are not integrated and their rows not evaluated.
+            # widened by its spread plus R/4 on either side (the centre at the rows beyond
+            # +-R/2, twice the linear extrapolation, and between them) are not integrated and
+            # their rows not evaluated.
             points = deflection_field_i[f, j, 0, :]
             spread = np.max(points, axis=1) - np.min(points, axis=1)
-            margin = 2.0 * spread + 0.25 * rotor.radius[f, j]
+            margin = spread + 0.25 * rotor.radius[f, j]
             offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
             lateral_gap = np.maximum(np.maximum(offset - np.max(points, axis=1),
                                                 np.min(points, axis=1) - offset)
@@ -523,9 +533,12 @@ class _EkmanWakeModel(BaseModel):
             # Another deflection model: its centre at the point rows, interpolated in height.
             centre = deflection_field_i[f, j, 0, :] @ row_interpolation(cells.n, cells.row_z)
         else:
-            centre = rows_at(f, j)
+            # In chunks of rotors, so that the deflection's temporaries stay small.
+            centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
+                                     for k in range(0, f.size, PAIR_CHUNK)])
         lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
-        dz = rotor.row_heights[f, j] - hub_height_i[f, 0, 0, 0][:, None]
+        dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
+        kind = rotor.kind[f, j]
         radius_j = rotor.radius[f, j][:, None]
         gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
         # Row by row: only the rows the wake reaches are integrated.
@@ -549,10 +562,10 @@ class _EkmanWakeModel(BaseModel):
             for start in range(0, group.size, ROW_CHUNK):
                 chunk = group[start:start + ROW_CHUNK]
                 pe, re = p[chunk], r[chunk]
-                fe, je = f[pe], j[pe]
+                fe = f[pe]
                 pair = {k: v[pe][:, None] for k, v in per_pair.items()}
-                u_rows = rotor.u_rows[fe, je, re][:, None]
-                v_rows = rotor.v_rows[fe, je, re][:, None]
+                u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
+                v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
                 dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
                 wake = _TurbineWake(
                     dx=x_pair[pe][:, None],
@@ -798,8 +811,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
             v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)
             points[f, j] = centre(f, j, z[f, j, 0, :], u[f, j], v[f, j])
         field_ = np.broadcast_to(points[:, :, None, :], z.shape).view(RotorDeflection)
-        field_.rows_at = lambda f, j: centre(  # noqa: E731
-            f, j, rotor.row_heights[f, j], rotor.u_rows[f, j], rotor.v_rows[f, j])
+        field_.rows_at = lambda f, j: centre(f, j, *rotor.rows(f, j))  # noqa: E731
         return field_
 
     def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):

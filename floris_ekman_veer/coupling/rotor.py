@@ -415,21 +415,29 @@ def rotor_geometry(grid):
 
 
 def rows_profile(profile, grid, cells: RotorCells):
-    """A height profile at the sub-point rows of every rotor: (n_findex, n_turbines, rows) per
-    output of ``profile(z)``, ``z`` shaped (1, 1, 1, heights); evaluated once per distinct row
-    height of the farm (one hub height and diameter: ``rows`` heights, whatever n_findex)."""
+    """A height profile at the sub-point rows of every kind of rotor (hub height, radius) of
+    the farm, evaluated once per distinct row height (one hub height and diameter: ``rows``
+    heights, whatever n_findex), so that the work and memory do not grow with the turbines.
+
+    ``profile(z)``, ``z`` shaped (1, 1, 1, heights), returns arrays broadcasting to
+    (n_findex, 1, 1, heights). Returns ``kind`` (n_findex, n_turbines), the kind of each sorted
+    turbine, ``heights`` (kinds, rows) the rows' heights, and per output of ``profile`` its
+    values (n_findex, kinds, rows).
+    """
     _, _, _, _, order = rotor_geometry(grid)
     coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
     radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)
-    heights = coordinates[:, 2, None] + radius[:, None] * cells.row_z  # (n_turbines, rows)
+    kinds, kind_of = np.unique(np.stack([coordinates[:, 2], radius], axis=1), axis=0,
+                               return_inverse=True)
+    heights = kinds[:, :1] + kinds[:, 1:] * cells.row_z  # (kinds, rows)
     distinct, inverse = np.unique(heights, return_inverse=True)
     inverse = inverse.reshape(heights.shape)
     n_findex = order.shape[0]
     out = []
     for values in profile(distinct.reshape(1, 1, 1, -1)):
         values = np.broadcast_to(values, (n_findex, 1, 1, distinct.size)).reshape(n_findex, -1)
-        out.append(values[:, inverse][np.arange(n_findex)[:, None], order])
-    return out
+        out.append(values[:, inverse])
+    return kind_of.ravel()[order], heights, *out
 
 
 def row_interpolation(n: int, row_z: np.ndarray) -> np.ndarray:
