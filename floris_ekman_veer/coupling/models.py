@@ -553,12 +553,16 @@ class _EkmanWakeModel(BaseModel):
         n2 = cells.n**2
         removed = np.zeros(f.size * n2)
         overlap = np.zeros(f.size) if track else None
-        # Rows of equal width (sub-points with weight) together, in chunks: no padding.
+        # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
+        # padding; few: all at once (the padding costs less than more calls).
         widths = cells.row_width[r]
-        order = np.argsort(widths, kind="stable")
-        bounds = np.flatnonzero(np.diff(widths[order])) + 1
-        for group in np.split(order, bounds):
-            width = int(cells.row_width[r[group[0]]])
+        if p.size <= ROW_CHUNK:
+            groups = [np.arange(p.size)]
+        else:
+            order = np.argsort(widths, kind="stable")
+            groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
+        for group in groups:
+            width = int(np.max(widths[group]))
             for start in range(0, group.size, ROW_CHUNK):
                 chunk = group[start:start + ROW_CHUNK]
                 pe, re = p[chunk], r[chunk]

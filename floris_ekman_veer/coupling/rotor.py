@@ -340,9 +340,10 @@ class RotorWakes:
                    np.zeros((pairs, cells.n**2)), turbulence, turbulence_model)
 
     def superpose(self, pair, row, du, ambient_u, moment) -> np.ndarray:
-        """Add one wake at sub-point rows of one width w: ``pair`` (entries,) flat rotor index
-        (condition * n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the
-        wake's velocity deficit [m/s] at the row's sub-points, ``ambient_u`` (entries, 1) U at
+        """Add one wake at sub-point rows: ``pair`` (entries,) flat rotor index (condition *
+        n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the wake's velocity
+        deficit [m/s] at the row's first w sub-points (w at least each row's width; beyond it,
+        the zero-weight padding), ``ambient_u`` (entries, 1) U at
         the row (0 where there is no flow), ``moment`` (entries, 1). Returns (entries, w) the
         moment the wake removes at each sub-point, weight (u_before^m - u_after^m)."""
         cells = self.cells
@@ -350,12 +351,19 @@ class RotorWakes:
         if self.rule is None:
             old = np.zeros_like(du)
         else:
-            flat = (pair * int(cells.row_width.sum()) + cells.row_start[row])[:, None] + np.arange(
-                width)
-            old = self.combined[flat].astype(float)
+            columns = np.arange(width)
+            flat = (pair * int(cells.row_width.sum()) + cells.row_start[row])[:, None] + columns
+            # Rows narrower than ``width`` (padding with zero weight) keep their storage.
+            used = columns < cells.row_width[row][:, None]
+            if used.all():
+                old = self.combined[flat].astype(float)
+            else:
+                flat = flat[used]
+                old = np.zeros(du.shape)
+                old[used] = self.combined[flat]
         new = ne.evaluate(_SUPERPOSED[self.rule], local_dict={"old": old, "du": du})
         if self.rule is not None:
-            self.combined[flat] = new
+            self.combined[flat] = new if used.all() else new[used]
         return ne.evaluate(_REMOVED, local_dict={
             "old": old, "new": new, "U": ambient_u, "weight": cells.weight[row, :width],
             "m": moment})
