@@ -347,7 +347,8 @@ class _EkmanWakeModel(BaseModel):
         """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant.
 
         ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
-        waked, with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
+        waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
+        coupling/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
         ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
         so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
