@@ -80,6 +80,22 @@ def test_in_line_wakes_superpose_as_velocities():
     assert np.hypot(*returned) == pytest.approx(np.hypot(2.0, 3.0) / U, rel=1e-12)
 
 
+def test_unknown_combination_returns_each_wake_alone():
+    """A combination model the cells do not know (or no FLORIS Core around the solve): each
+    call returns its own wake's cell deficit, as for a single wake, and FLORIS combines them."""
+    cells = rotor_cells(1, 8, 2)
+    wakes = RotorWakes.start(cells, 1, 1, _Manager("Custom"), 0.06)
+    assert wakes.rule is None
+    U, rows = 8.0, np.arange(cells.rows)
+    args = (np.full((cells.rows, 1), U), np.full((cells.rows, 1), 3.0))
+    for du in (2.0, 3.0):
+        removed = wakes.superpose(np.zeros(cells.rows, dtype=int), rows,
+                                  np.full(cells.sub_y.shape, du), *args)
+        alone = wakes.cell_returns(np.zeros(1, dtype=int), removed.sum().reshape(1, 1),
+                                   np.full((1, 1), U), np.full((1, 1), 3.0))[0, 0]
+        assert alone == pytest.approx(du / U, rel=1e-12)
+
+
 # -------------------------------------------------------------------------------- 2. convergence
 
 YAWED = np.array([[20.0, 20.0, 0.0, 0.0], [-20.0, -20.0, 0.0, 0.0], [20.0, -20.0, 0.0, 0.0]])

@@ -97,9 +97,10 @@ GLAUERT_THRUST_COEFFICIENT = 0.96
 #: model uses the same 0.1 m.
 ROTOR_PLANE_MARGIN = 0.1
 
-#: A rotor is integrated in a wake where the deficit, with the widest width the wake can have,
-#: exceeds this fraction of U_h somewhere on it; elsewhere the wake is 0 (a power change of at
-#: most 3e-5 of a turbine that sees no other wake, far less where wakes combine).
+#: A sub-point row of a rotor is integrated in a wake where the deficit, with the widest width
+#: the wake can have, exceeds this fraction of U_h somewhere on the row; elsewhere the wake is 0
+#: (a power change of at most 3e-5 of a turbine that sees no other wake, far less where wakes
+#: combine).
 NEGLIGIBLE_DEFICIT = 1e-5
 
 #: Rotors whose wake centre is evaluated at their sub-point rows at once.
