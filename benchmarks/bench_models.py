@@ -1,7 +1,7 @@
 """Speed and peak memory of the ekman_veer models against FLORIS's GCH and gauss on the same farm,
 inflow and conditions, in one process (hand-run script, not a test):
 
-    python benchmarks/bench_models.py [--conditions 80] [--repeats 3] [--seed 1] [--profile]
+    python benchmarks/bench_models.py [--conditions 100] [--repeats 3] [--seed 1] [--profile]
 
 Farm: 10 x 10 NREL 5 MW at 7 D (882 m), the wake settings of ``inputs/farm_sbl6.yaml`` (sosfs
 combination, crespo_hernandez turbulence) and its SBL-6 atmosphere (Ekman inflow for every
@@ -16,7 +16,9 @@ turbulence intensity 0.06, and every turbine yawed uniformly in [-20, 20] deg. M
     M-1     ekman_veer velocity and deflection (veer, curl, yaw), the shipped input;
     M-2     the same with veer off.
 
-Timed: ``FlorisModel.run()``, best of ``--repeats`` wall times after a warm-up run. Peak memory:
+Timed: ``FlorisModel.run()``, best of ``--repeats`` wall times after a warm-up run, the models
+interleaved (each repeat runs every model once, in turn), so that a load on the shared machine
+weighs on all models alike. Peak memory:
 the largest traced allocation (tracemalloc, numpy arrays included) above the level before one
 ``run()``, measured in a separate run. Prints a markdown table with the ratios to GCH and to
 gauss. ``--profile`` adds a cProfile of M-1 (top functions by internal time).
@@ -111,7 +113,7 @@ def peak_memory(fmodel: FlorisModel) -> float:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--conditions", type=int, default=80)
+    parser.add_argument("--conditions", type=int, default=100)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--profile", action="store_true")
@@ -121,13 +123,15 @@ def main(argv=None) -> None:
     print(f"{SIDE} x {SIDE} NREL 5 MW at 7 D, {args.conditions} random conditions (seed "
           f"{args.seed}), random yaw in [-20, 20] deg, turbine_grid 3 x 3, SBL-6 Ekman inflow; "
           f"best of {args.repeats}; {os.cpu_count()} CPUs\n")
-    times, memory, farm = {}, {}, {}
-    for model in MODELS:
-        fmodel = build(model, directions, speeds, yaw)
+    models = {model: build(model, directions, speeds, yaw) for model in MODELS}
+    for fmodel in models.values():
         fmodel.run()  # warm-up (first-call caches)
-        times[model] = best_time(fmodel.run, args.repeats)
-        memory[model] = peak_memory(fmodel)
-        farm[model] = np.mean(fmodel.get_farm_power()) / 1e6
+    times = dict.fromkeys(MODELS, np.inf)
+    for _ in range(args.repeats):
+        for model, fmodel in models.items():
+            times[model] = min(times[model], best_time(fmodel.run, 1))
+    memory = {model: peak_memory(fmodel) for model, fmodel in models.items()}
+    farm = {model: np.mean(fmodel.get_farm_power()) / 1e6 for model, fmodel in models.items()}
     print("| model | run() [s] | / GCH | / gauss | peak memory [MB] | / GCH | mean farm power [MW] |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for model in MODELS:

@@ -1,6 +1,8 @@
-"""Convergence of the rotor average on single wakes (hand-run study, not a test):
+"""Convergence of the rotor average on single and multiple wakes (hand-run study, not a test):
 
-    python benchmarks/bench_rotor_average.py [--reference 48x192] [--quick]
+    python benchmarks/bench_rotor_average.py [--reference 48x192] [--quick] [--multiwake]
+
+``--multiwake`` prints only the multi-wake table (below).
 
 For one upstream turbine and one downstream rotor, the downstream rotor's average velocity from
 each FLORIS rotor quadrature against a converged integral of the same wake over the rotor disk:
@@ -22,6 +24,12 @@ input (``inputs/farm_sbl6.yaml``, 9 m/s at 90 m); veer on and off (M-1, M-2); up
 +-20 deg; downstream rotor 5, 7, 10, 15 D behind, laterally offset -1.5 D to +1.5 D in steps of
 0.25 D. Prints the largest |error| per input, veer and quadrature (the README's table), the
 worst case, and the errors of an unwaked rotor (the ambient profile alone). ``--quick`` uses steps of 0.5 D and 5 and 10 D only.
+
+Multiple wakes: every turbine's power with the shipped settings (the farm input's wake settings:
+sosfs, crespo_hernandez, local_turbulence; 3 x 3 rotor cells) against the converged point-wise
+reference of tests/multiwake_reference.py (FLORIS's point-wise sosfs, wake-added turbulence and
+cubic mean on 4,096 equal-area points per rotor), for the layouts of MULTIWAKE_CASES in the
+SBL-6, SBL-4 and neutral atmospheres: the largest |P / P_ref - 1| over turbines and conditions.
 """
 
 from __future__ import annotations
@@ -43,6 +51,15 @@ except ImportError:
 
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
+
+sys.path.insert(0, str(REPOSITORY / "tests"))
+from multiwake_reference import (  # noqa: E402
+    FARM_3X3,
+    SIDE_BY_SIDE,
+    farm_config,
+    power_errors,
+    row,
+)
 
 INPUTS = {"CNBL disk": "cnbl.yaml", "SBL-4 disk": "sbl4.yaml", "SBL-6 disk": "sbl6.yaml",
           "NREL 5 MW, farm input": "farm_sbl6.yaml"}
@@ -124,11 +141,55 @@ def single_wake_errors(input_name, veer, distance, offset, reference, solver=Non
     return errors
 
 
+def _directions(directions, speed):
+    return dict(wind_directions=list(directions), wind_speeds=[speed] * len(directions),
+                turbulence_intensities=[0.06] * len(directions))
+
+
+_FRONT_YAW = np.array([[20.0, 20.0, 0.0], [-20.0, -20.0, 0.0], [20.0, -20.0, 0.0]])
+
+#: label -> (turbine, wind speed at hub height, layout in D, conditions or None: 270 deg).
+MULTIWAKE_CASES = {
+    "two rotors at y = +-0.6 D, target at 7 D (9 m/s)": ("nrel_5MW", 9.0, SIDE_BY_SIDE, None),
+    "the same, front yawed +-20 deg": (
+        "nrel_5MW", 9.0, SIDE_BY_SIDE, _directions([270.0] * 3, 9.0) | {"yaw_angles": _FRONT_YAW}),
+    "row of 5 at 4 D (9 m/s)": ("nrel_5MW", 9.0, row(4.0), None),
+    "row of 5 at 5 D (9 m/s)": ("nrel_5MW", 9.0, row(5.0), None),
+    "the 3 x 3 farm input, 260-280 deg, 9 m/s": (
+        "nrel_5MW", 9.0, FARM_3X3, _directions(np.arange(260.0, 281.0, 2.5), 9.0)),
+    "the 3 x 3 farm input, 260-280 deg, 11 m/s": (
+        "nrel_5MW", 11.0, FARM_3X3, _directions(np.arange(260.0, 281.0, 2.5), 11.0)),
+    "IEA 15 MW side by side (9 m/s at 150 m)": ("iea_15MW", 9.0, SIDE_BY_SIDE, None),
+    "IEA 15 MW row of 5 at 4 D (9 m/s at 150 m)": ("iea_15MW", 9.0, row(4.0), None),
+}
+
+
+def multiwake_table(rings: int = 32, angles: int = 128) -> None:
+    """Print the multi-wake convergence table (module docstring)."""
+    atmospheres = ("SBL-6", "SBL-4", "neutral")
+    print(f"Multiple wakes: largest |P / P_ref - 1| per turbine against the point-wise disk "
+          f"reference ({rings} x {angles} equal-area points per rotor), shipped settings\n")
+    print("| case | " + " | ".join(atmospheres) + " |")
+    print("|---|" + "---:|" * len(atmospheres))
+    for label, (turbine, speed, layout, conditions) in MULTIWAKE_CASES.items():
+        cells = []
+        for atmosphere in atmospheres:
+            errors = power_errors(farm_config(atmosphere, turbine, layout, speed), conditions,
+                                  rings=rings, angles=angles)
+            cells.append(f"{100 * errors.flat[np.argmax(np.abs(errors))]:+.2f} %")
+        print(f"| {label} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--reference", default="48x192")
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--multiwake", action="store_true")
     args = parser.parse_args(argv)
+    if args.multiwake:
+        warnings.simplefilter("ignore", RuntimeWarning)
+        multiwake_table()
+        return
     reference = disk_quadrature(*(int(v) for v in args.reference.split("x")))
     distances = (5.0, 10.0) if args.quick else (5.0, 7.0, 10.0, 15.0)
     offsets = np.arange(-1.5, 1.51, 0.5 if args.quick else 0.25)

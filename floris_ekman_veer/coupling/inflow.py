@@ -124,6 +124,7 @@ from floris.floris_model import FlorisModel  # noqa: E402
 import floris_ekman_veer.warnings as package_warnings  # noqa: E402
 from floris_ekman_veer.coupling.rotor import (  # noqa: E402
     TURBINE_MOMENTS,
+    WAKE_MODELS,
     turbine_grid_inflow,
     turbine_moments,
 )
@@ -546,6 +547,8 @@ def _with_core_atmosphere(method):
         token = _ACTIVE.set(atmosphere)
         # Which rotor average each turbine takes (coupling/rotor.py).
         moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
+        # How the solver combines wakes and adds turbulence (coupling/rotor.py).
+        wake_models = WAKE_MODELS.set(self.wake)
         try:
             # The package's per-wake warnings are said once, summarised, at the end of a solve.
             with package_warnings.run_scope(self.flow_field.wind_speeds,
@@ -555,6 +558,7 @@ def _with_core_atmosphere(method):
                     stack.enter_context(make(self))
                 result = method(self, *args, **kwargs)
         finally:
+            WAKE_MODELS.reset(wake_models)
             TURBINE_MOMENTS.reset(moments)
             _ACTIVE.reset(token)
         if rest is not None:

@@ -65,8 +65,10 @@ from floris_ekman_veer.coupling.names import (
     VELOCITY_MODEL_NAME,
 )
 from floris_ekman_veer.coupling.rotor import (
+    WAKE_MODELS,
+    WAKE_OVERLAP_VELOCITY,
     RotorCells,
-    cell_deficit,
+    RotorWakes,
     rotor_cells,
     rotor_geometry,
     row_interpolation,
@@ -83,7 +85,7 @@ from floris_ekman_veer.wake.deficit import (
     stream_tube_area_ratio,
 )
 from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
-from floris_ekman_veer.wake.fused import power_deficit_on_rows, rows_deficit_parameters
+from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
@@ -96,13 +98,18 @@ GLAUERT_THRUST_COEFFICIENT = 0.96
 #: model uses the same 0.1 m.
 ROTOR_PLANE_MARGIN = 0.1
 
-#: A rotor is integrated in a wake where the deficit, with the widest width the wake can have,
-#: exceeds this fraction of U_h somewhere on it; elsewhere the wake is 0 (a power change of at
-#: most 3e-5 of a turbine that sees no other wake, far less where wakes combine).
+#: A sub-point row of a rotor is integrated in a wake where the deficit, with the widest width
+#: the wake can have, exceeds this fraction of U_h somewhere on the row; elsewhere the wake is 0
+#: (a power change of at most 3e-5 of a turbine that sees no other wake, far less where wakes
+#: combine).
 NEGLIGIBLE_DEFICIT = 1e-5
 
-#: Pairs (rotor, wake) integrated at once: bounds the sub-point arrays to about 2 MB each.
+#: Rotors whose wake centre is evaluated at their sub-point rows at once.
 PAIR_CHUNK = 1024
+
+#: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
+#: about 0.3 MB each.
+ROW_CHUNK = 4096
 
 #: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
 #: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
@@ -258,8 +265,9 @@ class RotorAmbient:
     """The rotor cells of a turbine grid (coupling/rotor.py) and the ambient at their rows.
 
     Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
-    radius; per sub-point row (n_findex, n_turbines, rows): height and the ambient (U, V) in
-    FLORIS's frame (U is FLORIS's inflow component, V the lateral one).
+    radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
+    (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
+    FLORIS's inflow component, V the lateral one).
     """
 
     cells: RotorCells
@@ -268,22 +276,25 @@ class RotorAmbient:
     y: np.ndarray
     z: np.ndarray
     radius: np.ndarray
-    u_rows: np.ndarray
-    v_rows: np.ndarray
+    kind: np.ndarray
+    kind_heights: np.ndarray
+    kind_u: np.ndarray
+    kind_v: np.ndarray
     warned: set = field(factory=set)
 
     @classmethod
     def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
         cells = rotor_cells(grid.grid_resolution, *sub_quadrature(grid.grid_resolution))
         x, y, z, radius, _ = rotor_geometry(grid)
-        u, v = rows_profile(
+        kind, heights, u, v = rows_profile(
             lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
         )
-        return cls(cells, sorted_moments(grid), x, y, z, radius, u, v)
+        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v)
 
-    def row_heights(self, f=slice(None), j=slice(None)):
-        """Heights of the sub-point rows of rotors (f, j) (index arrays): (pairs, rows)."""
-        return self.z[f, j][..., None] + self.radius[f, j][..., None] * self.cells.row_z
+    def rows(self, f, j):
+        """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""
+        kind = self.kind[f, j]
+        return self.kind_heights[kind], self.kind_u[f, kind], self.kind_v[f, kind]
 
 
 @define(frozen=True)
@@ -333,7 +344,8 @@ class _EkmanWakeModel(BaseModel):
         """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant.
 
         ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
-        waked, with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
+        waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
+        coupling/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
         ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
         so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
@@ -357,12 +369,23 @@ class _EkmanWakeModel(BaseModel):
         )
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
+        ambient = Ambient.of(grid, flow_field)
+        wakes = None
+        if ambient.rotor is not None:
+            # A fresh superposition per solve (coupling/rotor.py); FLORIS's wake models only if
+            # they are the ones calling this model.
+            wake_models = WAKE_MODELS.get()
+            if wake_models is not None and wake_models.velocity_model is not self:
+                wake_models = None
+            wakes = RotorWakes.start(ambient.rotor.cells, *ambient.rotor.x.shape, wake_models,
+                                     ambient.floris_turbulence)
         return {
             "x": grid.x_sorted,
             "y": grid.y_sorted,
             "z": grid.z_sorted,
             "u_initial": flow_field.u_initial_sorted,
-            "ambient": Ambient.of(grid, flow_field),
+            "ambient": ambient,
+            "wakes": wakes,
         }
 
     def function(
@@ -383,6 +406,7 @@ class _EkmanWakeModel(BaseModel):
         z: np.ndarray,
         u_initial: np.ndarray,
         ambient: Ambient,
+        wakes: RotorWakes | None = None,
     ) -> np.ndarray:
         """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid.
 
@@ -395,7 +419,7 @@ class _EkmanWakeModel(BaseModel):
         if ambient.rotor is not None:
             return self._rotor_cell_deficit(
                 x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, 0.5 * rotor_diameter_i,
-                turbulence_intensity_i, u_initial, ambient,
+                turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
             )
         hub_speed, local_u, local_v = ambient.at_hub(hub_height_i)
         dx = x - x_i
@@ -407,8 +431,12 @@ class _EkmanWakeModel(BaseModel):
             ct=ct,
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
-            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence_intensity_i,
-                                    ambient.floris_turbulence),
+            # One expansion rate per wake, from its rotor's mean turbulence (FLORIS's cubature
+            # grids carry the turbulence per point).
+            k_w=self.expansion_rate(
+                abl, hub_height_i, hub_speed,
+                np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True),
+                ambient.floris_turbulence),
             local_u=local_u,
             local_v=local_v,
             friction_velocity=abl.friction_velocity,
@@ -430,13 +458,15 @@ class _EkmanWakeModel(BaseModel):
 
     def _rotor_cell_deficit(
         self, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
-        turbulence_intensity_i, u_initial, ambient,
+        turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
     ):
-        """d_k of every rotor cell of the grid in turbine i's wake (coupling/rotor.py).
+        """d_k of every rotor cell of the grid after turbine i's wake (coupling/rotor.py).
 
-        Only the rotors downstream of turbine i that its wake can reach (the deficit's Gaussian
-        above exp(-REACH^2/2) somewhere on the rotor, with the widest possible width) are
-        integrated; the others get 0.
+        Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
+        (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
+        width) are integrated; the wake is 0 elsewhere. The wake is superposed on the others at
+        the sub-points (``wakes``, :class:`RotorWakes`) and each reached cell returns the
+        increment FLORIS's combination turns into the combined cell deficit; the rest 0.
         """
         rotor = ambient.rotor
         cells = rotor.cells
@@ -448,72 +478,152 @@ class _EkmanWakeModel(BaseModel):
             return result.reshape(u_initial.shape)
         abl = ambient.abl
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
-        # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added turbulence
-        # is counted per point); its wake takes one expansion rate, from the rotor's mean.
-        turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
+        track = (self.wake_expansion == "local_turbulence" and wakes.rule is not None
+                 and wakes.turbulence_model is not None)
+        if track:
+            # The turbulence at turbine i with the overlaps as areas (RotorWakes).
+            source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
+                               axis=1)
+            turbulence = wakes.turbulence[np.arange(n_findex), source][:, None, None, None]
+        else:
+            # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added
+            # turbulence is counted per point); its wake takes one expansion rate, from the
+            # rotor's mean.
+            turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
         k_w = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                                   ambient.floris_turbulence)
-        rows = getattr(deflection_field_i, "rows", None)
-        if rows is None:
-            # Another deflection model: its centre at the point rows, interpolated in height.
-            centre = deflection_field_i[f, j, 0, :] @ row_interpolation(cells.n, cells.row_z)
-        else:
-            centre = rows[f, j]
-        lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
-        dz = rotor.row_heights(f, j) - hub_height_i[f, 0, 0, 0][:, None]
-        radius_j = rotor.radius[f, j][:, None]
-        gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
         pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
-        x_pair = dx[f, j]
-        width = self.width_bound(x_pair, pick(k_w), pick(radius_i), pick(ct), pick(yaw))
-        # The deficit C(x) exp(-gap / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
-        # 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
-        amplitude = self.amplitude_bound(x_pair, pick(k_w), pick(radius_i), pick(ct), pick(yaw))
-        reach = np.min(gap, axis=1) < 2.0 * width**2 * np.log(
-            np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT
-        )
-        f, j, x_pair = f[reach], j[reach], x_pair[reach]
-        lateral, dz, radius_j, centre = lateral[reach], dz[reach], radius_j[reach], centre[reach]
         per_pair = {
             "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
             "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
         }
-        per_pair = {k: pick(v)[:, None, None] for k, v in per_pair.items()}  # f: reached pairs
-        # In chunks of pairs, so that the sub-point arrays stay small (peak memory).
-        for start in range(0, f.size, PAIR_CHUNK):
-            chunk = slice(start, start + PAIR_CHUNK)
-            fc, jc = f[chunk], j[chunk]
-            pair = {k: v[chunk] for k, v in per_pair.items()}
-            u_rows, v_rows = rotor.u_rows[fc, jc][..., None], rotor.v_rows[fc, jc][..., None]
-            wake = _TurbineWake(
-                dx=x_pair[chunk, None, None],
-                dy=lateral[chunk, :, None] + radius_j[chunk, :, None] * cells.sub_y,
-                dz=dz[chunk, :, None],
-                yaw=pair["yaw"],
-                ct=pair["ct"],
-                radius=pair["radius"],
-                hub_speed=pair["hub_speed"],
-                k_w=pair["k_w"],
-                local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
-                local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
-                friction_velocity=pair["friction_velocity"],
-            )
-            self._check_resolution(wake, centre[chunk], radius_j[chunk], cells, rotor.warned)
-            # No flow (at and below z0): no wake.
-            ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-            moment = rotor.moment[fc, jc][:, None, None]
-            power_deficit = self.power_deficit(wake, ambient_u, cells.weight, moment)
-            result[fc, jc] = cell_deficit(
-                power_deficit, u_initial[fc, jc].reshape(fc.size, -1), moment[:, 0], cells
-            )
+        per_pair = {k: pick(v) for k, v in per_pair.items()}
+        x_pair = dx[f, j]
+        width = self.width_bound(x_pair, per_pair["k_w"], per_pair["radius"], per_pair["ct"],
+                                 per_pair["yaw"])
+        # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
+        # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
+        amplitude = self.amplitude_bound(x_pair, per_pair["k_w"], per_pair["radius"],
+                                         per_pair["ct"], per_pair["yaw"])
+        reach_squared = 2.0 * width**2 * np.log(
+            np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
+        rows_at = getattr(deflection_field_i, "rows_at", None)
+        if rows_at is not None and cells.n > 1:
+            # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
+            # widened by its spread plus R/4 on either side (the centre at the rows beyond
+            # +-R/2, twice the linear extrapolation, and between them) are not integrated and
+            # their rows not evaluated.
+            points = deflection_field_i[f, j, 0, :]
+            spread = np.max(points, axis=1) - np.min(points, axis=1)
+            margin = spread + 0.25 * rotor.radius[f, j]
+            offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
+            lateral_gap = np.maximum(np.maximum(offset - np.max(points, axis=1),
+                                                np.min(points, axis=1) - offset)
+                                     - margin - rotor.radius[f, j], 0.0)
+            vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
+                                      - rotor.radius[f, j], 0.0)
+            near = lateral_gap**2 + vertical_gap**2 < reach_squared
+            f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
+            per_pair = {k: v[near] for k, v in per_pair.items()}
+            if f.size == 0:
+                return result.reshape(u_initial.shape)
+        if rows_at is None:
+            # Another deflection model: its centre at the point rows, interpolated in height.
+            centre = deflection_field_i[f, j, 0, :] @ row_interpolation(cells.n, cells.row_z)
+        else:
+            # In chunks of rotors, so that the deflection's temporaries stay small.
+            centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
+                                     for k in range(0, f.size, PAIR_CHUNK)])
+        lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
+        dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
+        kind = rotor.kind[f, j]
+        radius_j = rotor.radius[f, j][:, None]
+        gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
+        # Row by row: only the rows the wake reaches are integrated.
+        p, r = np.nonzero(gap < reach_squared[:, None])  # (pair, row) entries
+        if p.size == 0:
+            return result.reshape(u_initial.shape)
+        reached = p[np.flatnonzero(np.diff(p, prepend=-1))]  # p is sorted
+        self._check_resolution(x_pair[reached], per_pair, reached, centre[reached],
+                               radius_j[reached], cells, rotor.warned)
+        flat = f * n_turbines + j
+        moment = rotor.moment[f, j]
+        n2 = cells.n**2
+        removed = np.zeros(f.size * n2)
+        overlap = np.zeros(f.size) if track else None
+        # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
+        # padding; few: all at once (the padding costs less than more calls).
+        widths = cells.row_width[r]
+        if p.size <= ROW_CHUNK:
+            groups = [np.arange(p.size)]
+        else:
+            order = np.argsort(widths, kind="stable")
+            groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
+        for group in groups:
+            width = int(np.max(widths[group]))
+            for start in range(0, group.size, ROW_CHUNK):
+                chunk = group[start:start + ROW_CHUNK]
+                pe, re = p[chunk], r[chunk]
+                fe = f[pe]
+                pair = {k: v[pe][:, None] for k, v in per_pair.items()}
+                u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
+                v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
+                dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
+                wake = _TurbineWake(
+                    dx=x_pair[pe][:, None],
+                    dy=dy,
+                    dz=dz[pe, re][:, None],
+                    yaw=pair["yaw"],
+                    ct=pair["ct"],
+                    radius=pair["radius"],
+                    hub_speed=pair["hub_speed"],
+                    k_w=pair["k_w"],
+                    local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
+                    local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
+                    friction_velocity=pair["friction_velocity"],
+                )
+                # No flow (at and below z0): no wake.
+                ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
+                du = self.sub_point_deficit(wake) * pair["hub_speed"]
+                removed += np.bincount(
+                    (pe[:, None] * n2 + cells.cell_grid[re, :width]).ravel(),
+                    weights=wakes.superpose(flat[pe], re, du, ambient_u,
+                                            moment[pe][:, None]).ravel(),
+                    minlength=removed.size)
+                if track:
+                    # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
+                    # rotor laterally, here as the area of the disk where it holds.
+                    inside = (du > WAKE_OVERLAP_VELOCITY) & (
+                        np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
+                    overlap += np.bincount(
+                        pe, weights=np.sum(cells.weight[re, :width] * inside, axis=1),
+                        minlength=f.size)
+        u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
+        result[f[reached], j[reached]] = wakes.cell_returns(
+            flat[reached], removed.reshape(f.size, n2)[reached], u_cell,
+            moment[reached][:, None])
+        if track:
+            self._add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
+                                 axial_induction_i, overlap[reached], ambient)
         return result.reshape(u_initial.shape)
 
-    def power_deficit(self, wake: _TurbineWake, ambient_u, weight, moment) -> np.ndarray:
-        """weight (U^m - (U - Delta u)^m) of the wake at the sub-points, m = ``moment`` (3 or 1;
-        coupling/rotor.py)."""
-        du = self.normalised_deficit(wake) * wake.hub_speed
-        removed = np.where(moment == 3.0, ambient_u**3 - (ambient_u - du) ** 3, du)
-        return np.where(ambient_u > 0, weight * removed, 0.0)
+    @staticmethod
+    def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient):
+        """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
+        the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it."""
+        column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+        x_j, x_source = ambient.rotor.x[f, j], column(x_i)
+        diameter = 2.0 * column(radius_i)
+        ambient_turbulence = column(ambient.floris_turbulence)
+        added = wakes.turbulence_model.function(
+            ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
+        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
+            x_j <= x_source + 15.0 * diameter)
+        wakes.add_turbulence(f, j, added, ambient_turbulence)
+
+    def sub_point_deficit(self, wake: _TurbineWake) -> np.ndarray:
+        """Delta u / U_h of the wake at the sub-points (each model's normalised deficit)."""
+        return self.normalised_deficit(wake)
 
     def amplitude_bound(self, x, k_w, radius, ct, yaw):
         """The largest deficit Delta u / U_h of the wake at x: C(x), Eq. (Cx)."""
@@ -552,13 +662,13 @@ class _EkmanWakeModel(BaseModel):
                 stacklevel=4,
             )
 
-    def _check_resolution(self, wake, centre, radius_j, cells, warned):
+    def _check_resolution(self, x, per_pair, reached, centre, radius_j, cells, warned):
         """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
         if "rows" in warned:
             return
-        width = wake.k_w[:, 0, 0] * wake.dx[:, 0, 0] + WIDTH_FACTOR * wake.radius[:, 0, 0] * np.sqrt(
-            stream_tube_area_ratio(wake.ct[:, 0, 0], wake.yaw[:, 0, 0])
-        ) * np.cos(wake.yaw[:, 0, 0])
+        k_w, radius, ct, yaw = (per_pair[k][reached] for k in ("k_w", "radius", "ct", "yaw"))
+        width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
+            stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
         height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
         shear = np.abs(centre[:, -1] - centre[:, 0]) / height
         thickness = width / np.sqrt(1.0 + shear**2)
@@ -604,16 +714,15 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
-    def power_deficit(self, wake: _TurbineWake, ambient_u, weight, moment) -> np.ndarray:
+    def sub_point_deficit(self, wake: _TurbineWake) -> np.ndarray:
         if self.polar_angle_centre != "wake_centre":
-            return super().power_deficit(wake, ambient_u, weight, moment)
+            return super().sub_point_deficit(wake)
         # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
         parameters = rows_deficit_parameters(
             wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw, wake.friction_velocity,
             wake.hub_speed, np.where(wake.local_u > 0, wake.local_u, 1.0), curl=self.curl,
         )
-        return power_deficit_on_rows(wake.dy, wake.dz, parameters, wake.hub_speed, ambient_u,
-                                     weight, moment)
+        return deficit_on_rows(wake.dy, wake.dz, parameters)
 
     def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0
@@ -680,30 +789,31 @@ class EkmanVeerVelocityDeflection(BaseModel):
             return self._offset(x - x_i, z, hub_height, radius, ct, yaw, hub_speed, local_u,
                                 local_v, ambient.abl.friction_velocity)
         # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
-        # heights and at the rows of the rotor cells (coupling/rotor.py), downstream of turbine i
-        # only (upstream there is no wake: 0).
+        # heights, downstream of turbine i only (upstream there is no wake: 0), and at the rows
+        # of the rotor cells (coupling/rotor.py) only for the rotors the velocity model
+        # integrates (RotorDeflection.rows_at).
         rotor = ambient.rotor
-        n_points = z.shape[-1]
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
-        u = np.concatenate([np.broadcast_to(ambient.u[:, :, 0, :], z[:, :, 0, :].shape),
-                            rotor.u_rows], axis=-1)
-        v = np.concatenate([np.broadcast_to(ambient.v[:, :, 0, :], z[:, :, 0, :].shape),
-                            rotor.v_rows], axis=-1)
-        heights = np.concatenate([z[:, :, 0, :], rotor.row_heights()], axis=-1)
-        offsets = np.zeros(heights.shape)
         dx = rotor.x - x_i[:, 0, 0]
+        per_condition = [np.broadcast_to(a, yaw.shape)[:, 0, 0, 0] for a in (
+            cos_a, sin_a, hub_height, radius, ct, yaw, hub_speed,
+            ambient.abl.friction_velocity)]
+
+        def centre(f, j, heights, u, v):
+            """The centre at ``heights`` (pairs, h) of rotors (f, j) downstream, from the ambient
+            (u, v) there in FLORIS's frame."""
+            cos_p, sin_p, *pair = (a[f][:, None] for a in per_condition)
+            return self._offset(dx[f, j][:, None], heights, *pair[:5],
+                                u * cos_p + v * sin_p, v * cos_p - u * sin_p, pair[5])
+
+        points = np.zeros(z[:, :, 0, :].shape)
         f, j = np.nonzero(dx > 0.0)
         if f.size:
-            column = lambda a: np.broadcast_to(a, yaw.shape)[f, 0, 0, 0][:, None]  # noqa: E731
-            cos_p, sin_p = column(cos_a), column(sin_a)
-            u_p, v_p = u[f, j], v[f, j]
-            offsets[f, j] = self._offset(
-                dx[f, j][:, None], heights[f, j], column(hub_height), column(radius),
-                column(ct), column(yaw), column(hub_speed), u_p * cos_p + v_p * sin_p,
-                v_p * cos_p - u_p * sin_p, column(ambient.abl.friction_velocity),
-            )
-        field_ = np.broadcast_to(offsets[:, :, None, :n_points], z.shape).view(RotorDeflection)
-        field_.rows = offsets[:, :, n_points:]
+            u = np.broadcast_to(ambient.u[:, :, 0, :], points.shape)
+            v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)
+            points[f, j] = centre(f, j, z[f, j, 0, :], u[f, j], v[f, j])
+        field_ = np.broadcast_to(points[:, :, None, :], z.shape).view(RotorDeflection)
+        field_.rows_at = lambda f, j: centre(f, j, *rotor.rows(f, j))  # noqa: E731
         return field_
 
     def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):
@@ -719,12 +829,13 @@ class EkmanVeerVelocityDeflection(BaseModel):
 
 
 class RotorDeflection(np.ndarray):
-    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying in ``rows`` the
-    centre at the rows of the rotor cells' sub-quadrature (n_findex, n_turbines, rows), for the
-    velocity model's rotor-cell average. Arithmetic on it gives plain arrays (FLORIS's own
-    velocity models read it as the point field it is)."""
+    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``rows_at(f, j)``:
+    the centre at the rows of the rotor cells' sub-quadrature of rotors (f, j) downstream
+    (index arrays; returns (pairs, rows)), for the velocity model's rotor-cell average, which
+    evaluates it only where the wake can reach. Arithmetic on it gives plain arrays (FLORIS's
+    own velocity models read it as the point field it is)."""
 
-    rows = None
+    rows_at = None
 
     def __array_wrap__(self, array, context=None, return_scalar=False):
         result = array.view(np.ndarray)

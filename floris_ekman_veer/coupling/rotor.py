@@ -10,14 +10,17 @@ one per point, each with a fine sub-quadrature, so that
 * the inflow hook sets ``u_initial`` at a point to the cubic mean of the ambient U over its cell,
   ``U_k = <U^3>_k^(1/3)`` (:func:`cell_mean`), and
 * the ``ekman_veer`` velocity models return at a point the deficit ``d_k`` whose cube removes
-  the wake's exact power deficit of the cell, ``U_k^3 (1 - (1 - d_k)^3) = n^2 sum_s w_s
-  (U_s^3 - (U_s - Delta u_s)^3)`` over the cell's sub-points s (:func:`cell_deficit`).
+  the exact power deficit of the cell, ``U_k^3 (1 - (1 - d_k)^3) = n^2 sum_s w_s
+  (U_s^3 - (U_s - Delta u_s)^3)`` over the cell's sub-points s (:func:`equivalent_deficit`),
+  with Delta u_s all wakes so far superposed point-wise at the sub-points by FLORIS's own rule
+  (:class:`RotorWakes`; each call returns the increment that FLORIS's combination of the point
+  values turns into the combined cell deficit).
 
 FLORIS's equal-weight cubic mean of ``U_k (1 - d_k)`` is then the sub-quadrature of the disk
-integral of u^3 (ambient and wake), for one wake exactly, and its thrust and power follow. For
-a turbine whose operation model takes the plain mean of u (the actuator disk) the same holds
-with the first moment in place of the third (:data:`TURBINE_MOMENTS`). Pure geometry and numpy:
-no FLORIS import.
+integral of u^3 (ambient and all wakes), and its thrust and power follow. For a turbine whose
+operation model takes the plain mean of u (the actuator disk) the same holds with the first
+moment in place of the third (:data:`TURBINE_MOMENTS`). Pure geometry and numpy (numexpr for
+the superposition): no FLORIS import.
 
 The cells: the points are grouped into rings of equal distance from the hub (the centre point of
 odd n alone); ring after ring (inwards out) takes an annulus whose area is its share of points
@@ -37,6 +40,7 @@ import contextvars
 import functools
 
 import attrs
+import numexpr as ne
 import numpy as np
 
 #: The moment m of the rotor average that each turbine's power and thrust take: FLORIS's power
@@ -50,6 +54,13 @@ PLAIN_MEAN_OPERATION_MODELS = frozenset({"actuator-disk"})
 TURBINE_MOMENTS: contextvars.ContextVar = contextvars.ContextVar(
     "rotor_average_moments", default=None
 )
+
+
+#: The wake models of the farm being solved (FLORIS's WakeModelManager, set by the inflow hook's
+#: Core wrappers): its combination model says how the cells' sub-points superpose the wakes and
+#: its turbulence model gives the wake-added turbulence (:class:`RotorWakes`); None: each call
+#: returns its own wake's cell deficits (FLORIS then combines the cells).
+WAKE_MODELS: contextvars.ContextVar = contextvars.ContextVar("rotor_wake_models", default=None)
 
 
 def turbine_moments(turbine_definitions) -> np.ndarray:
@@ -105,12 +116,19 @@ class RotorCells:
         return self.row_z.size
 
     @functools.cached_property
-    def cell_segments(self):
-        """(sub-points with weight, sorted by cell; start of each cell's segment)."""
-        used = np.flatnonzero(self.weight.ravel() > 0.0)
-        order = used[np.argsort(self.cell[used], kind="stable")]
-        starts = np.searchsorted(self.cell[order], np.arange(self.n**2))
-        return order, starts
+    def row_width(self) -> np.ndarray:
+        """(rows,) sub-points with weight in each row: the row's first ones (the rest pad)."""
+        return np.count_nonzero(self.weight > 0.0, axis=1)
+
+    @functools.cached_property
+    def row_start(self) -> np.ndarray:
+        """(rows,) position of each row's first sub-point among the sub-points with weight."""
+        return np.concatenate([[0], np.cumsum(self.row_width)[:-1]])
+
+    @functools.cached_property
+    def cell_grid(self) -> np.ndarray:
+        """(rows, columns) cell index of each sub-point."""
+        return self.cell.reshape(self.sub_y.shape)
 
 
 def grid_offsets(n: int) -> np.ndarray:
@@ -235,20 +253,13 @@ def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.n
     return mean.reshape(*u_rows.shape[:-1], cells.n, cells.n)
 
 
-def cell_deficit(power_deficit, u_cell, moment, cells: RotorCells) -> np.ndarray:
-    """d_k of each cell from the sub-points' weighted deficits of the moment m of u:
-    w_s (U_s^m - u_s^m) (m = 3: power; m = 1: the velocity deficit itself).
+def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
+    """d_k of each cell from the cell's removed moment n^2 sum_{s in k} w_s (U_s^m - u_s^m)
+    (m = 3: power; m = 1: the velocity deficit itself): U_k^m (1 - (1 - d_k)^m) = removed.
 
-    ``power_deficit``: (..., rows, columns), weights included; ``u_cell``: (..., n^2) the cells'
-    U_k; ``moment`` (..., 1). Returns (..., n^2): U_k^m (1 - (1 - d_k)^m) = n^2 sum_{s in k}
-    w_s (U_s^m - u_s^m). A cell without inflow (U_k = 0) has no wake.
+    ``removed``, ``u_cell`` (the cells' U_k): (..., n^2); ``moment`` (..., 1). A cell without
+    inflow (U_k = 0) has no wake.
     """
-    shape = power_deficit.shape[:-2]
-    # Sum per cell: the sub-points sorted by cell, summed by segments (faster than a matmul with
-    # the 0/1 membership on this tall, thin shape); padding points are left out.
-    order, starts = cells.cell_segments
-    removed = np.add.reduceat(power_deficit.reshape(*shape, -1)[..., order], starts, axis=-1)
-    removed *= cells.n**2
     cubic = moment == 3.0
     ambient = np.where(cubic, u_cell**3, u_cell)
     flowing = ambient > 0.0
@@ -260,10 +271,136 @@ def cell_deficit(power_deficit, u_cell, moment, cells: RotorCells) -> np.ndarray
     return np.where(cubic, 1.0 - np.cbrt(1.0 - fraction), fraction)
 
 
+#: FLORIS's combination models (class names) as the point-wise rules that superpose wake
+#: velocities du [m/s] at the cells' sub-points: sum of squares (sosfs), linear sum (fls), max.
+COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
+
+#: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
+#: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
+WAKE_OVERLAP_VELOCITY = 0.05
+
+_SUPERPOSED = {"sosfs": "sqrt(old**2 + du**2)", "fls": "old + du",
+               "max": "where(du > old, du, old)", None: "du"}
+# weight (u_old^m - u_new^m) with u = U - wake: the moment the new wake removes at a sub-point.
+_REMOVED = ("where(U > 0, weight * where(m > 2, (new - old) * ((U - old)**2 + (U - old) * "
+            "(U - new) + (U - new)**2), new - old), 0)")
+
+
+@attrs.define(eq=False)
+class RotorWakes:
+    """The wakes superposed so far at the cells' sub-points of every rotor, during one solve.
+
+    FLORIS's solver combines the values the velocity model returns at the grid's points; on
+    rotor cells, combining the cells' deficits would combine wakes that do not overlap inside
+    a cell as if they did (two bands side by side), and the sum of squares of cube-equivalent
+    deficits is not the sum of squares of the velocities. So the wakes are superposed here,
+    point-wise at the sub-points by FLORIS's own rule, and each call returns the increment that
+    FLORIS's combination of the cell values turns into the cell's exact share of the combined
+    wakes' moment (docs/coupling.md#rotor-average). The turbulence at each rotor is the
+    wake-added turbulence with the overlap as the area of the disk in the wake.
+
+    Attributes:
+        cells: the rotor cells.
+        rule: "sosfs", "fls", "max" (FLORIS's combination model), or None: unknown, each call
+            returns its own wake's cell deficits.
+        combined: (n_findex * n_turbines * sub-points with weight,) combined wake velocity
+            [m/s] at the sub-points, row by row (RotorCells.row_start).
+        removed: (n_findex * n_turbines, n^2) n^2 sum_{s in k} w_s (U_s^m - u_s^m) of the
+            combined wakes.
+        wake: (n_findex * n_turbines, n^2) the wake velocity U_k d_k FLORIS holds at each point.
+        turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
+            ambient one.
+        turbulence_model: FLORIS's wake-added turbulence model, or None.
+    """
+
+    cells: RotorCells
+    rule: str | None
+    combined: np.ndarray
+    removed: np.ndarray
+    wake: np.ndarray
+    turbulence: np.ndarray
+    turbulence_model: object = None
+
+    @classmethod
+    def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,
+              ambient_turbulence) -> RotorWakes:
+        """An empty farm for ``wake_models`` (FLORIS's WakeModelManager or None)."""
+        rule = None
+        turbulence_model = None
+        if wake_models is not None:
+            rule = COMBINATION_RULES.get(type(wake_models.combination_model).__name__)
+            turbulence_model = wake_models.turbulence_model
+        pairs = n_findex * n_turbines
+        # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
+        # quadrature error, for half the memory.
+        combined = np.zeros(pairs * int(cells.row_width.sum()) if rule else 0, dtype=np.float32)
+        turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
+                                     (n_findex, n_turbines)).copy()
+        return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
+                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model)
+
+    def superpose(self, pair, row, du, ambient_u, moment) -> np.ndarray:
+        """Add one wake at sub-point rows: ``pair`` (entries,) flat rotor index (condition *
+        n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the wake's velocity
+        deficit [m/s] at the row's first w sub-points (w at least each row's width; beyond it,
+        the zero-weight padding), ``ambient_u`` (entries, 1) U at
+        the row (0 where there is no flow), ``moment`` (entries, 1). Returns (entries, w) the
+        moment the wake removes at each sub-point, weight (u_before^m - u_after^m)."""
+        cells = self.cells
+        width = du.shape[1]
+        if self.rule is None:
+            old = np.zeros_like(du)
+        else:
+            columns = np.arange(width)
+            flat = (pair * int(cells.row_width.sum()) + cells.row_start[row])[:, None] + columns
+            # Rows narrower than ``width`` (padding with zero weight) keep their storage.
+            used = columns < cells.row_width[row][:, None]
+            if used.all():
+                old = self.combined[flat].astype(float)
+            else:
+                flat = flat[used]
+                old = np.zeros(du.shape)
+                old[used] = self.combined[flat]
+        new = ne.evaluate(_SUPERPOSED[self.rule], local_dict={"old": old, "du": du})
+        if self.rule is not None:
+            self.combined[flat] = new if used.all() else new[used]
+        return ne.evaluate(_REMOVED, local_dict={
+            "old": old, "new": new, "U": ambient_u, "weight": cells.weight[row, :width],
+            "m": moment})
+
+    def cell_returns(self, pair, removed, u_cell, moment) -> np.ndarray:
+        """What the velocity model returns at the cells of rotors ``pair`` (flat indices, each
+        once) after its wake was superposed, removing ``removed`` (pairs, n^2) of the cells'
+        moment (sum_{s in k} w_s (u_before^m - u_after^m)): the deficit d whose combination by
+        FLORIS's rule with the points' current wake velocity gives U_k d_k of the combined
+        wakes; ``u_cell`` (pairs, n^2) the cells' U_k, ``moment`` (pairs, 1). Returns
+        (pairs, n^2)."""
+        removed = self.cells.n**2 * removed
+        if self.rule is not None:
+            removed += self.removed[pair]
+            self.removed[pair] = removed
+        total = u_cell * equivalent_deficit(removed, u_cell, moment)
+        if self.rule == "sosfs":
+            increment = np.sqrt(np.maximum(total**2 - self.wake[pair] ** 2, 0.0))
+        elif self.rule == "fls":
+            increment = total - self.wake[pair]
+        else:  # max, or each wake alone
+            increment = total
+        if self.rule is not None:
+            self.wake[pair] = total
+        flowing = u_cell > 0.0
+        return np.where(flowing, increment / np.where(flowing, u_cell, 1.0), 0.0)
+
+    def add_turbulence(self, f, j, added, ambient) -> None:
+        """FLORIS's combination of wake-added turbulence at rotors (f, j):
+        TI = max(TI, sqrt(added^2 + TI_0^2))."""
+        self.turbulence[f, j] = np.maximum(self.turbulence[f, j], np.hypot(added, ambient))
+
+
 #: Sub-quadrature of the wake cells per point of FLORIS's n x n grid: ROWS_PER_POINT n strips
 #: and NODES_PER_INTERVAL points on each cell's stretch of every strip, so that a finer turbine
 #: grid (``solver.turbine_grid_points``) also refines the cells' quadrature.
-ROWS_PER_POINT, NODES_PER_INTERVAL = 6, 2
+ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
 
 
 def sub_quadrature(n: int) -> tuple[int, int]:
@@ -286,21 +423,29 @@ def rotor_geometry(grid):
 
 
 def rows_profile(profile, grid, cells: RotorCells):
-    """A height profile at the sub-point rows of every rotor: (n_findex, n_turbines, rows) per
-    output of ``profile(z)``, ``z`` shaped (1, 1, 1, heights); evaluated once per distinct row
-    height of the farm (one hub height and diameter: ``rows`` heights, whatever n_findex)."""
+    """A height profile at the sub-point rows of every kind of rotor (hub height, radius) of
+    the farm, evaluated once per distinct row height (one hub height and diameter: ``rows``
+    heights, whatever n_findex), so that the work and memory do not grow with the turbines.
+
+    ``profile(z)``, ``z`` shaped (1, 1, 1, heights), returns arrays broadcasting to
+    (n_findex, 1, 1, heights). Returns ``kind`` (n_findex, n_turbines), the kind of each sorted
+    turbine, ``heights`` (kinds, rows) the rows' heights, and per output of ``profile`` its
+    values (n_findex, kinds, rows).
+    """
     _, _, _, _, order = rotor_geometry(grid)
     coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
     radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)
-    heights = coordinates[:, 2, None] + radius[:, None] * cells.row_z  # (n_turbines, rows)
+    kinds, kind_of = np.unique(np.stack([coordinates[:, 2], radius], axis=1), axis=0,
+                               return_inverse=True)
+    heights = kinds[:, :1] + kinds[:, 1:] * cells.row_z  # (kinds, rows)
     distinct, inverse = np.unique(heights, return_inverse=True)
     inverse = inverse.reshape(heights.shape)
     n_findex = order.shape[0]
     out = []
     for values in profile(distinct.reshape(1, 1, 1, -1)):
         values = np.broadcast_to(values, (n_findex, 1, 1, distinct.size)).reshape(n_findex, -1)
-        out.append(values[:, inverse][np.arange(n_findex)[:, None], order])
-    return out
+        out.append(values[:, inverse])
+    return kind_of.ravel()[order], heights, *out
 
 
 def row_interpolation(n: int, row_z: np.ndarray) -> np.ndarray:

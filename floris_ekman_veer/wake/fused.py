@@ -28,10 +28,9 @@ def curl_coefficients(t_hat, alpha=CURL_ALPHA):
     a2 = alpha (tanh(t^2/4alpha)/2 - 5/48 tanh(t^4/16alpha)), a3 = -alpha/4 tanh(t^3/8alpha),
     a4 = 7 alpha/48 tanh(t^4/16alpha).
     """
-    t_hat = np.asarray(t_hat, dtype=float)
-    tanh2 = np.tanh(t_hat**2 / (4.0 * alpha))
-    tanh3 = np.tanh(t_hat**3 / (8.0 * alpha))
-    tanh4 = np.tanh(t_hat**4 / (16.0 * alpha))
+    t = np.asarray(t_hat, dtype=float)
+    tanh2, tanh3, tanh4 = (ne.evaluate(f"tanh(t**{k} / ({2.0**k} * alpha))",
+                                       local_dict={"t": t, "alpha": alpha}) for k in (2, 3, 4))
     return (
         alpha * (0.5 * tanh2 - 5.0 / 48.0 * tanh4),
         -0.25 * alpha * tanh3,
@@ -78,16 +77,3 @@ def deficit_on_rows(dy, dz, parameters):
     :func:`rows_deficit_parameters` (two numexpr passes: cos(theta), then the deficit)."""
     c = ne.evaluate(_COSINE, local_dict={"dy": dy, "dz": dz})
     return ne.evaluate(_DEFICIT, local_dict={"dy": dy, "dz": dz, "c": c, **parameters})
-
-
-def power_deficit_on_rows(dy, dz, parameters, hub_speed, ambient, weight, moment=3.0):
-    """weight (U^m - (U - Delta u)^m) at points (dy, dz), m = ``moment`` (3: the power-deficit
-    density of the wake; 1: Delta u itself), on the inflow U (``ambient``, per height; 0 where
-    there is no flow), times the quadrature weights. Two numexpr passes over the points."""
-    du = deficit_on_rows(dy, dz, parameters)
-    return ne.evaluate(
-        "where(U > 0, weight * hub_speed * du * where(m > 2, 3 * U**2 - 3 * U * hub_speed * du"
-        " + (hub_speed * du)**2, 1), 0)",
-        local_dict={"du": du, "U": ambient, "weight": weight, "hub_speed": hub_speed,
-                    "m": np.asarray(moment, dtype=float)},
-    )
