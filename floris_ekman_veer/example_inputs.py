@@ -35,11 +35,19 @@ def example_inputs() -> list[str]:
 
 def example_input(name: str) -> Path:
     """The path of the package's FLORIS input ``name`` (e.g. ``"farm_sbl6"``, ``"sbl6"``,
-    ``"cnbl"``, ``"turbines/actuator_disk_les"``; ``.yaml`` optional). ValueError for a name
+    ``"cnbl"``, ``"turbines/actuator_disk_les"``; ``.yaml`` optional; a data file by its full
+    name, e.g. ``"site/synthetic_mast.csv"``). ValueError for a name
     that is not one of :func:`example_inputs`."""
     if not isinstance(name, str):
         raise ValueError(f"example_input name must be a string, one of {example_inputs()}; "
                          f"got {name!r}")
+    suffix = Path(name).suffix
+    if suffix and suffix != ".yaml":
+        # Data files beside the inputs (the synthetic mast records, site/synthetic_mast.csv).
+        path = inputs_directory() / name
+        if not path.is_file():
+            raise ValueError(f"example_input: no file {name!r} among the package's inputs")
+        return path
     stem = name[:-5] if name.endswith(".yaml") else name
     path = inputs_directory() / f"{stem}.yaml"
     if stem not in example_inputs() or not path.is_file():

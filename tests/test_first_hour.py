@@ -228,6 +228,11 @@ def test_example_input_names_every_input_and_runs_from_any_directory(tmp_path, m
         assert floris_ekman_veer.example_input(name + ".yaml") == floris_ekman_veer.example_input(name)
     with pytest.raises(ValueError, match=r"no input named 'farm'; the inputs are \[.*'farm_sbl6'"):
         floris_ekman_veer.example_input("farm")
+    mast = floris_ekman_veer.example_input("site/synthetic_mast.csv")
+    assert mast == REPO / "inputs" / "site" / "synthetic_mast.csv"
+    assert mast.read_text().startswith("# SYNTHETIC")
+    with pytest.raises(ValueError, match=r"no file 'site/none.csv' among the package's inputs"):
+        floris_ekman_veer.example_input("site/none.csv")
     monkeypatch.chdir(tmp_path)
     fmodel = FlorisModel(floris_ekman_veer.example_input("sbl6"))  # includes turbines/...
     fmodel.run()

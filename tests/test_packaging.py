@@ -25,6 +25,8 @@ path = f.example_input("farm_sbl6")
 print(path)
 assert Path(path).is_file() and "site-packages" in str(path), path
 assert sorted(f.example_inputs()) == sorted(NAMES), f.example_inputs()
+mast = f.example_input("site/synthetic_mast.csv")  # the synthetic mast records ship too
+assert "site-packages" in str(mast) and mast.read_text().startswith("# SYNTHETIC"), mast
 from floris import FlorisModel
 fmodel = FlorisModel(f.example_input("sbl6"))  # with its !include turbines/...
 fmodel.run()

@@ -13,7 +13,9 @@ result of running each distinct atmosphere on its own (tests/test_optimization.p
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import io
 import inspect
 import warnings
 from collections.abc import Mapping
@@ -112,16 +114,22 @@ def optimize_yaw(
                                    dtype=float), shape)
         for name in ("minimum_yaw_angle", "maximum_yaw_angle")
     )
+    def run_within(lower, upper):
+        # The restricted bounds exclude the zero-yaw baseline by design; FLORIS prints an
+        # "INFO: yaw_angles_baseline exceed ... constraints" line for each such run.
+        with contextlib.redirect_stdout(io.StringIO()):
+            return run(**_with_bounds(optimizer_kwargs, lower, upper))
+
     candidates = [first]
     if np.any((lower < 0.0) & (upper > 0.0)):
         for bounds in ((lower, np.minimum(upper, 0.0)), (np.maximum(lower, 0.0), upper)):
-            candidates.append(run(**_with_bounds(optimizer_kwargs, *bounds)))
+            candidates.append(run_within(*bounds))
     width = REFINE_FRACTION * (upper - lower)
     refined = []
     for candidate in candidates:
         centre = np.vstack(candidate["yaw_angles_opt"].to_numpy())
-        refined.append(run(**_with_bounds(optimizer_kwargs, np.maximum(centre - width, lower),
-                                          np.minimum(centre + width, upper))))
+        refined.append(run_within(np.maximum(centre - width, lower),
+                                  np.minimum(centre + width, upper)))
     return _best_of(candidates + refined)
 
 
