@@ -544,23 +544,21 @@ def _with_core_atmosphere(method):
             input_checks.check_operation(self)
             if points:
                 input_checks.check_points(*args, **kwargs)
-        token = _ACTIVE.set(atmosphere)
-        # Which rotor average each turbine takes (coupling/rotor.py).
-        moments = TURBINE_MOMENTS.set(turbine_moments(self.farm.turbine_definitions))
-        # How the solver combines wakes and adds turbulence (coupling/rotor.py).
-        wake_models = WAKE_MODELS.set(self.wake)
-        try:
+        with contextlib.ExitStack() as stack:
+            # The atmosphere, which rotor average each turbine takes, and how the solver
+            # combines wakes and adds turbulence (coupling/rotor.py), for the solve only.
+            for variable, value in ((_ACTIVE, atmosphere),
+                                    (TURBINE_MOMENTS,
+                                     turbine_moments(self.farm.turbine_definitions)),
+                                    (WAKE_MODELS, self.wake)):
+                stack.callback(variable.reset, variable.set(value))
             # The package's per-wake warnings are said once, summarised, at the end of a solve.
-            with package_warnings.run_scope(self.flow_field.wind_speeds,
-                                            self.flow_field.reference_wind_height), \
-                    _at_rest(self, atmosphere) as rest, contextlib.ExitStack() as stack:
-                for make in CORE_CONTEXTS:
-                    stack.enter_context(make(self))
-                result = method(self, *args, **kwargs)
-        finally:
-            WAKE_MODELS.reset(wake_models)
-            TURBINE_MOMENTS.reset(moments)
-            _ACTIVE.reset(token)
+            stack.enter_context(package_warnings.run_scope(self.flow_field.wind_speeds,
+                                                           self.flow_field.reference_wind_height))
+            rest = stack.enter_context(_at_rest(self, atmosphere))
+            for make in CORE_CONTEXTS:
+                stack.enter_context(make(self))
+            result = method(self, *args, **kwargs)
         if rest is not None:
             result = _still(self.flow_field, rest, result)
         if full_flow and input_checks.uses_wake_models(self):
