@@ -1,0 +1,67 @@
+"""From a validation case to the atmosphere every model runs on (docs/validation.md#the-atmosphere-of-a-case).
+
+Two readings, both neutral (the references are near-neutral) with the paper's free atmosphere
+(N_inf = 6.1e-3 1/s, Theta0 = 265 K) at the site's latitude, driven by the case's hub-height
+wind speed:
+
+``site``
+    The paper's pure ABL with the site's roughness (open sea 2e-4 m, farmland 0.03 m): I_u(z_h)
+    is what Eq. (Iu_model) gives, whatever was measured.
+``matched``
+    The decision this study makes to bring the measured turbulence in: the roughness length z0 of
+    the neutral Ekman-surface-layer ABL whose I_u(z_h) (Eq. Iu_model) equals the case's measured
+    streamwise turbulence intensity (TI_total / 0.8 for the single wakes). z0 is an effective
+    parameter here, not the terrain's: it stands for everything that made the measured
+    turbulence (upwind terrain, unresolved stability). The paper's constants (A1, B1, alpha',
+    the k_w floor) are left as they are; k_w then follows from the matched I_u through
+    Eq. (kw_CNBL_SBL_model).
+
+FLORIS's own models run on the same inflow (the atmosphere's U(z)) with FLORIS's ambient
+turbulence intensity = I_u(z_h) of the same atmosphere, so every model sees one turbulence level.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq
+
+from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+#: The two atmospheres of a case (see the module docstring).
+ATMOSPHERES = ("site", "matched")
+#: Search range of the matched roughness length [m].
+ROUGHNESS_RANGE = (1.0e-6, 5.0)
+
+
+def hub_turbulence(case, roughness_length: float) -> float:
+    """I_u(z_h) (Eq. Iu_model) of the neutral ABL with ``roughness_length`` and the case's
+    hub-height speed and latitude."""
+    abl = EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, latitude=case.latitude,
+                                       roughness_length=roughness_length)
+    return float(abl.turbulence_intensity(case.hub_height, reference_height=case.hub_height))
+
+
+def matched_roughness(case) -> float:
+    """z0 [m] of the neutral ABL whose I_u(z_h) is the case's measured streamwise TI.
+
+    ValueError if no z0 in :data:`ROUGHNESS_RANGE` reaches it (I_u grows monotonically with z0).
+    """
+    target = case.streamwise_turbulence
+    low, high = (np.log(z) for z in ROUGHNESS_RANGE)
+
+    def mismatch(log_z0):
+        return hub_turbulence(case, float(np.exp(log_z0))) - target
+
+    if mismatch(low) > 0 or mismatch(high) < 0:
+        raise ValueError(f"{case.name}: no neutral roughness length in {ROUGHNESS_RANGE} m gives "
+                         f"I_u(z_h) = {target:.4g}")
+    return float(np.exp(brentq(mismatch, low, high, xtol=1e-12, rtol=1e-12)))
+
+
+def atmosphere(case, reading: str) -> dict:
+    """The ``ekman_veer.atmosphere`` input block of ``case`` for ``reading`` (``site`` or
+    ``matched``)."""
+    if reading not in ATMOSPHERES:
+        raise ValueError(f"reading must be one of {ATMOSPHERES}, got {reading!r}")
+    z0 = case.site_roughness if reading == "site" else matched_roughness(case)
+    return {"latitude": float(case.latitude), "roughness_length": float(z0)}
