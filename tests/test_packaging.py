@@ -31,6 +31,9 @@ from floris import FlorisModel
 fmodel = FlorisModel(f.example_input("sbl6"))  # with its !include turbines/...
 fmodel.run()
 assert (fmodel.get_turbine_powers() > 0).all()
+from floris_ekman_veer.validation.cases import DATA, HORNS_REV  # the validation data ship
+assert "site-packages" in str(DATA) and (DATA / "PyWake-LICENSE.txt").is_file(), DATA
+assert HORNS_REV.layout[0].size == 80 and len(list(DATA.glob("*.dat"))) == 52
 """
 
 
