@@ -39,6 +39,7 @@ from floris_ekman_veer.validation.atmospheres import (  # noqa: E402
     ATMOSPHERES,
     atmosphere,
     hub_turbulence,
+    wake_scales,
 )
 from floris_ekman_veer.validation.cases import HORNS_REV, SINGLE_WAKE_CASES  # noqa: E402
 from floris_ekman_veer.validation.metrics import (  # noqa: E402
@@ -58,6 +59,7 @@ from floris_ekman_veer.validation.models import (  # noqa: E402
     horns_rev_rows,
 )
 
+LABEL = {"measured": "measured", "les": "LES"}
 #: Spacing of the wind-direction samples of the uncertainty average [deg].
 SAMPLE_STEP = 1.0
 #: Arc resolution [deg].
@@ -137,7 +139,7 @@ def distance_table(errors, reading):
     for case in cases:
         arcs = [(e["x/D"], e["reference"]) for e in errors[(case, reading, models[0])]]
         for x, reference in arcs:
-            row = [case, f"{x:g}", reference]
+            row = [case, f"{x:g}", LABEL[reference]]
             for model in models:
                 (e,) = [e for e in errors[(case, reading, model)]
                         if e["x/D"] == x and e["reference"] == reference]
@@ -179,14 +181,22 @@ def efficiency_table(effs):
 
 
 def atmosphere_table():
+    """Per case: the measured I_u, and for each atmosphere z0, I_u(z_h), k_w and x0/D."""
     rows = []
     for case in list(SINGLE_WAKE_CASES.values()) + [HORNS_REV]:
-        site, matched = (atmosphere(case, r)["roughness_length"] for r in ATMOSPHERES)
-        rows.append([case.name, f"{case.streamwise_turbulence:.3f}", f"{site:g}",
-                     f"{hub_turbulence(case, site):.3f}", f"{matched:.3g}",
-                     f"{hub_turbulence(case, matched):.3f}"])
-    return markdown(["case", "measured I_u(z_h)", "site z0 [m]", "site I_u(z_h)",
-                     "matched z0 [m]", "matched I_u(z_h)"], rows)
+        ct = getattr(case, "thrust_coefficient", None)
+        if ct is None:  # Horns Rev: the V80's C_T at its wind speed
+            ct = float(np.interp(case.wind_speed, *HORNS_REV.v80_table[:, [0, 2]].T))
+        row = [case.name, f"{case.streamwise_turbulence:.3f}"]
+        for reading in ATMOSPHERES:
+            z0 = atmosphere(case, reading)["roughness_length"]
+            k_w, x0 = wake_scales(case, z0, ct)
+            row += [f"{z0:.3g}", f"{hub_turbulence(case, z0):.3f}", f"{k_w:.4f}", f"{x0:.2f}"]
+        rows.append(row)
+    header = ["case", "measured I_u(z_h)"]
+    for reading in ATMOSPHERES:
+        header += [f"{reading} z0 [m]", f"{reading} I_u(z_h)", f"{reading} k_w", f"{reading} x0/D"]
+    return markdown(header, rows)
 
 
 def tables(errors, rows, effs) -> str:
@@ -194,7 +204,7 @@ def tables(errors, rows, effs) -> str:
              "## Atmospheres", "", atmosphere_table(), ""]
     for reading in ATMOSPHERES:
         for reference in ("measured", "les"):
-            parts += [f"## Single wakes, {reading} atmosphere, against the {reference} arcs: "
+            parts += [f"## Single wakes, {reading} atmosphere, against the {LABEL[reference]} arcs: "
                       "RMSE (bias) of U/U0", "", case_table(errors, reading, reference), ""]
     for reading in ATMOSPHERES:
         parts += [f"## Single wakes by downstream distance, {reading} atmosphere", "",

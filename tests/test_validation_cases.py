@@ -226,3 +226,14 @@ def test_reference_simulations_against_measurements_are_the_published_files():
     error = model - arc.measured[:, 1]
     assert (row["rmse"], row["bias"]) == pytest.approx((np.sqrt(np.mean(error**2)), error.mean()),
                                                       rel=1e-12)
+
+
+def test_docs_tables_that_need_no_wake_model_are_the_scripts():
+    """docs/validation.md carries examples/validate.py's atmosphere table and the published
+    RANS's row errors as the script writes them (the model tables come from the same script;
+    the regression baselines above pin the models)."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "validation.md").read_text()
+    assert validate.atmosphere_table() in text
+    rans = cases.HORNS_REV.rans_rows
+    cells = [validate._cell(*metrics.row_errors(rans[:, col])) for _ in range(2) for col in (2, 1)]
+    assert "| EllipSys3D RANS (published) | " + " | ".join(cells) + " |" in text

@@ -26,6 +26,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.wake.deficit import potential_core_length
 
 #: The two atmospheres of a case (see the module docstring).
 ATMOSPHERES = ("site", "matched")
@@ -33,12 +34,24 @@ ATMOSPHERES = ("site", "matched")
 ROUGHNESS_RANGE = (1.0e-6, 5.0)
 
 
+def _abl(case, roughness_length: float) -> EkmanABL:
+    return EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, latitude=case.latitude,
+                                        roughness_length=roughness_length)
+
+
 def hub_turbulence(case, roughness_length: float) -> float:
     """I_u(z_h) (Eq. Iu_model) of the neutral ABL with ``roughness_length`` and the case's
     hub-height speed and latitude."""
-    abl = EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, latitude=case.latitude,
-                                       roughness_length=roughness_length)
+    abl = _abl(case, roughness_length)
     return float(abl.turbulence_intensity(case.hub_height, reference_height=case.hub_height))
+
+
+def wake_scales(case, roughness_length: float, thrust_coefficient: float) -> tuple[float, float]:
+    """(k_w, x0/D) of an unwaked turbine of the case: Eqs. (kw_CNBL_SBL_model), (x0_transition)
+    with the paper's constants; arcs closer than x0 lie in the potential core."""
+    k_w = float(_abl(case, roughness_length).wake_expansion_rate(case.hub_height))
+    radius = 0.5 * case.rotor_diameter
+    return k_w, float(potential_core_length(k_w, radius, thrust_coefficient, 0.0)) / case.rotor_diameter
 
 
 def matched_roughness(case) -> float:
