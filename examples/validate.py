@@ -16,7 +16,7 @@ bias per case and model, single wakes by downstream distance, Horns Rev by row, 
 efficiency against the LES) and the figures ``validation_arcs_<case>.png`` (U/U0 on the arcs with
 the measurements' standard errors, the LES's band and the RANS), ``validation_horns_rev_rows.png``
 and ``validation_horns_rev_efficiency.png``. With ``--gallery docs`` also the small PNGs of
-docs/validation.md. Prints the tables. Takes about 3 minutes on two cores.
+docs/validation.md. Prints the tables. Takes 4 to 6 minutes on two (loaded) cores.
 """
 
 from __future__ import annotations
@@ -324,7 +324,7 @@ def main(argv=None) -> None:
         main_models = ["M-1", "M-3", "GCH", "cc", "TurbOPark"]
         for name in SINGLE_WAKE_CASES:
             distances = (2.0, 3.0, 5.0) if name == "Nordtank-500" else None
-            written.append(arcs_figure(profiles, name, args.gallery, distances, dpi=60,
+            written.append(arcs_figure(profiles, name, args.gallery, distances, dpi=80,
                                        models=main_models))
         written += [rows_figure(rows, args.gallery, dpi=70), efficiency_figure(effs, args.gallery, dpi=70)]
     report(written, start)
