@@ -64,8 +64,6 @@ WAKE_MODELS = {
 }
 #: Models run on the single wakes ("M-1, ambient k_w" is M-1 there).
 SINGLE_WAKE_MODELS = tuple(m for m in WAKE_MODELS if m != "M-1, ambient k_w")
-#: The package's own models.
-PACKAGE_MODELS = ("M-1", "M-1, ambient k_w", "M-2", "M-3")
 
 
 def floris_input(case, reading: str, model: str, turbine: dict, layout) -> dict:
