@@ -8,10 +8,10 @@ SBL-5 and SBL-6 (Section 4.3; SBL-1..3 enter only the turbulence-intensity compa
 friction Rossby numbers Ro = u*/(f z0) of 3.39e4 to 6.02e4. A condition is *inside the envelope*
 only where all three hold, each with the paper's own cases inside it as the model computes them:
 
-- its stability is one the wake validation covers: near-neutral (|mu| below half of SBL-1's
-  5.62) or between SBL-4 and SBL-6 (59.25 <= mu <= 169: Table 1's SBL-4 to SBL-6 as the model
-  closes its cooling rate); convective layers (mu < 0 beyond the near-neutral band) are beyond
-  the paper (docs/atmosphere.md#convective-boundary-layer);
+- its stability is one the wake validation covers: near-neutral (|mu| < 2.81, half of SBL-1's
+  5.62) or SBL-4 to SBL-6 (55.4 <= mu <= 169, so that both Table 1's mu and the cooling-rate
+  closure's of each of these cases are inside, and those of SBL-3 are not); convective layers
+  (mu <= -2.81) are beyond the paper (docs/atmosphere.md#convective-boundary-layer);
 - h / rotor top >= 1.33 (the LES's 1.45 with the h the model gives SBL-6, 199 m);
 - Ro within the LES's range widened to the model's u* of the paper's cases (3.39e4 to 6.27e4),
   or a ``rossby_range`` the caller documents.
@@ -73,16 +73,22 @@ def _paper_cases():
 
 
 _MODEL_CASES = _paper_cases()
-#: |mu| below this is near-neutral (the CNBL class): half of SBL-1's 5.62.
-MU_NEAR_NEUTRAL = 0.5 * TABLE1["SBL-1"][0]
-#: The lower stability parameter of the validated stable wakes: SBL-4, the smaller of Table 1's
-#: 59.25 and the closure's 72.7.
-MU_SBL4 = min(TABLE1["SBL-4"][0], float(_MODEL_CASES.stability_parameter[4]))
+#: Each case's two values of mu: Table 1's and the cooling-rate closure's (CNBL 0 and 0 ...
+#: SBL-3 39.84 and 51.56, SBL-4 59.25 and 72.71, ... SBL-6 148.49 and 169.02).
+_CASE_MU = np.array([[case[0] for case in TABLE1.values()],
+                     np.asarray(_MODEL_CASES.stability_parameter, dtype=float)])
+#: Class edges in mu: midway between the larger mu of a case and the smaller of the next, so that
+#: both readings of every case fall in its own class (2.81, 14.4, 34.2, 55.4, 75.5, 120.7).
+CLASS_EDGES = 0.5 * (_CASE_MU.max(axis=0)[:-1] + _CASE_MU.min(axis=0)[1:])
+#: |mu| below this is near-neutral (the CNBL class): the CNBL/SBL-1 edge, half of SBL-1's 5.62.
+MU_NEAR_NEUTRAL = float(CLASS_EDGES[0])
+#: The lower stability parameter of the validated stable wakes: the SBL-3/SBL-4 edge (55.4).
+MU_SBL4 = float(CLASS_EDGES[list(TABLE1).index("SBL-4") - 1])
 #: h / rotor top of the LES (218/150 = 1.45) and of the model's SBL-6 (199/150 = 1.33): the smaller.
 MIN_H_OVER_ROTOR_TOP = min(TABLE1["SBL-6"][3], float(_MODEL_CASES.boundary_layer_height[-1])) / (
     LES_ROTOR_TOP)
 #: Friction Rossby numbers of Table 1 (3.39e4-6.02e4) widened to the model's u* of the same cases
-#: (3.48e4-6.27e4): 3.39e4 to 6.27e4.
+#: (3.48e4-6.27e4): 3.39e4 to 6.27e4 (compared with a relative tolerance of 1e-9).
 ROSSBY_RANGE = (
     min(min(c[1] for c in TABLE1.values()), float(np.min(_MODEL_CASES.friction_rossby_number))),
     max(max(c[1] for c in TABLE1.values()), float(np.max(_MODEL_CASES.friction_rossby_number))),
@@ -90,13 +96,10 @@ ROSSBY_RANGE = (
 
 
 def stability_class(mu) -> np.ndarray:
-    """The paper's case nearest in mu (bins at the midpoints of Table 1's mu): "convective" for
+    """The paper's case a stability parameter belongs to (:data:`CLASS_EDGES`): "convective" for
     mu <= -MU_NEAR_NEUTRAL, "CNBL", "SBL-1".."SBL-6", and "beyond SBL-6" above MU_ENVELOPE."""
     mu = np.asarray(mu, dtype=float)
-    names = list(TABLE1)
-    values = np.array([case[0] for case in TABLE1.values()])
-    edges = 0.5 * (values[1:] + values[:-1])
-    label = np.array(names, dtype=object)[np.searchsorted(edges, mu, side="right")]
+    label = np.array(list(TABLE1), dtype=object)[np.searchsorted(CLASS_EDGES, mu, side="right")]
     label = np.where(mu <= -MU_NEAR_NEUTRAL, "convective", label)
     return np.where(mu > MU_ENVELOPE * (1 + 1e-12), "beyond SBL-6", label)
 
@@ -158,7 +161,7 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     above = h >= top
     validated = wake_validated_stability(mu)
     deep = h / top >= MIN_H_OVER_ROTOR_TOP * (1 - 1e-12)
-    in_range = (rossby >= low) & (rossby <= high)
+    in_range = (rossby >= low * (1 - 1e-9)) & (rossby <= high * (1 + 1e-9))
     return pd.DataFrame({
         "wind_direction": np.asarray(flow_field.wind_directions, dtype=float),
         "wind_speed": np.asarray(flow_field.wind_speeds, dtype=float),
