@@ -247,7 +247,7 @@ def test_mixed_signs_solve_together_as_apart():
 
 def test_convective_turbulence_by_hand():
     """I_u = [A1 ln(z_i/z) + B1 + (12 - 0.5 z_i/L)^(2/3) - 12^(2/3)]^(1/2) u*/U_h and
-    k_w = [0.021^6 + (0.33 I_u)^6]^(1/6): Eq. (kw) kept with the Panofsky et al. (1977) variance."""
+    k_w = [0.021^6 + (0.33 I_u)^6]^(1/6): Eq. (kw_CNBL_SBL_model) kept with the Panofsky et al. (1977) variance."""
     abl = EkmanABL.from_reference_wind(6.0, 90.0, obukhov_length=-30.0, mixed_layer_height=1400.0,
                                        **SITE)
     u_star = abl.friction_velocity
