@@ -4,7 +4,8 @@ docs/yaw_steering.md#the-validated-envelope).
 
 ``inputs/farm_day.yaml`` is a convective afternoon named by its surface heat flux (+150 W/m^2)
 and mixed-layer depth (1500 m); ``inputs/farm_night.yaml`` a stable night named by its Obukhov
-length (100 m). For each, at 3-25 m/s at 90 m, this prints the boundary-layer height, the
+length (100 m); ``inputs/farm_sbl6.yaml`` fixes Table 1's SBL-6 mu. For each, at 3-25 m/s at
+90 m, this prints the boundary-layer height, the
 Obukhov length, the implied surface sensible heat flux, the friction Rossby number, the
 stability class, the veer across the NREL 5 MW rotor, I_u(90 m) and whether the condition lies
 inside the paper's validated envelope (floris_ekman_veer.validity_report), then the farm power
@@ -114,7 +115,7 @@ def main():
     columns = ["wind_speed", "boundary_layer_height", "obukhov_length", "sensible_heat_flux",
                "friction_rossby_number", "stability_class", "veer_across_rotor_deg",
                "turbulence_intensity", "inside_envelope"]
-    for name in ("farm_day", "farm_night"):
+    for name in ("farm_day", "farm_night", "farm_sbl6"):
         report = table(name)
         print(f"\n{name}:")
         with np.printoptions(precision=3):
