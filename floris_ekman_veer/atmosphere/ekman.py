@@ -353,6 +353,9 @@ class EkmanABL:
     dimensionless ``h_hat`` = h f_c/u* with the GDL coefficients ``gdl_a``, ``gdl_b`` (A, B).
     """
 
+    #: The entrainment ratio A_e of the heating-rate closure (`ENTRAINMENT_RATIO`).
+    entrainment_ratio = ENTRAINMENT_RATIO
+
     def __init__(
         self,
         *,
