@@ -292,7 +292,8 @@ def main(argv=None) -> None:
     print(f"\n3-turbine NREL 5 MW row, wind along the row: optimal yaw [deg] over +-{YAW_LIMIT:g} "
           "deg (both signs), farm power gain [%], the best gain with each sign alone, and the "
           f"front rotor's own P(+{ASYMMETRY_YAW:g})/P(-{ASYMMETRY_YAW:g}). "
-          "inside_envelope False: h below the rotor top, extrapolated, not validated.")
+          "inside_envelope False: outside the paper's validated envelope (stability, h / rotor "
+          "top or u*/(f z0); the validity lines say which), extrapolated, not validated.")
     print(yaw.to_string(index=False, float_format="%.3f"))
     table = yaw.pivot_table(index=["atmosphere", "model"], columns=["spacing_D", "wind_speed"],
                             values="gain_percent")
