@@ -5,7 +5,7 @@ Run it from anywhere (after ``pip install .``, or from a checkout):
     python examples/yaw_study.py [--output DIR] [--gallery DIR]
 
 Three atmospheres, each named by a forcing fixed across wind speeds and read from the project's
-inputs: the neutral day (CNBL, ``inputs/farm_day.yaml``), the paper's SBL-4 cooling rate
+inputs: the neutral day (CNBL, ``inputs/cnbl.yaml``'s atmosphere), the paper's SBL-4 cooling rate
 (-0.375 K/h, ``inputs/sbl4.yaml``) and the shipped stable night (Obukhov length 100 m,
 ``inputs/farm_night.yaml``). One line per atmosphere says which conditions lie inside the
 paper's validated envelope (``floris_ekman_veer.validity_report``): SBL-4 at 8 m/s has h below
@@ -19,8 +19,8 @@ the NREL 5 MW rotor top, and its rows are flagged.
    ``wind_veer = 0`` (the comparison) and GCH with the fair scalar wind_veer of
    ``comparison.fair_builtin_set_kwargs`` (flagged: gauss's cos(wind_veer) narrowing, not
    steering, drives its gains at tens of degrees of veer).
-2. With ``--energy``: the 3 x 3 farm of ``inputs/farm_day.yaml`` over a wind rose with stable
-   nights and neutral days (``floris_ekman_veer.annual_energy``): AEP per class with and without
+2. With ``--energy``: the 3 x 3 farm of ``inputs/farm_day.yaml`` (its layout and turbines) over
+   a wind rose with stable nights and neutral days (``floris_ekman_veer.annual_energy``): AEP per class with and without
    wake steering.
 
 Figures (PNG) go to DIR (default ./output); tables are printed. ``run_study(reduced=True)`` is the
@@ -57,6 +57,8 @@ from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # no
 
 DAY_INPUT = REPOSITORY / "inputs" / "farm_day.yaml"
 NIGHT_INPUT = REPOSITORY / "inputs" / "farm_night.yaml"
+#: The neutral day's atmosphere (CNBL: cooling rate 0; farm_day.yaml is a convective day).
+CNBL_INPUT = REPOSITORY / "inputs" / "cnbl.yaml"
 SBL4_INPUT = REPOSITORY / "inputs" / "sbl4.yaml"
 #: name -> (label printed, FLORIS configuration): GCH with wind_veer = 0 is the comparison.
 MODELS = {
@@ -92,7 +94,7 @@ def _block(path):
 
 def atmospheres() -> dict[str, dict]:
     """The neutral day, SBL-4 and the shipped night, from the inputs."""
-    return {"CNBL": _block(DAY_INPUT), "SBL-4": _block(SBL4_INPUT),
+    return {"CNBL": _block(CNBL_INPUT), "SBL-4": _block(SBL4_INPUT),
             "night L=100 m": _block(NIGHT_INPUT)}
 
 
@@ -290,7 +292,8 @@ def main(argv=None) -> None:
     print(f"\n3-turbine NREL 5 MW row, wind along the row: optimal yaw [deg] over +-{YAW_LIMIT:g} "
           "deg (both signs), farm power gain [%], the best gain with each sign alone, and the "
           f"front rotor's own P(+{ASYMMETRY_YAW:g})/P(-{ASYMMETRY_YAW:g}). "
-          "inside_envelope False: h below the rotor top, extrapolated, not validated.")
+          "inside_envelope False: outside the paper's validated envelope (stability, h / rotor "
+          "top or u*/(f z0); the validity lines say which), extrapolated, not validated.")
     print(yaw.to_string(index=False, float_format="%.3f"))
     table = yaw.pivot_table(index=["atmosphere", "model"], columns=["spacing_D", "wind_speed"],
                             values="gain_percent")

@@ -17,7 +17,7 @@ inputs, installed with it. Every warning class of the package is importable from
 ``floris_ekman_veer.silence_warnings()`` silences them in this process and its workers
 (docs/user_guide.md#warnings).
 ``floris_ekman_veer.validity_report(fmodel)`` says per condition whether the atmosphere lies inside
-the paper's validated CNBL..SBL-6 envelope (docs/yaw_steering.md#the-validated-envelope).
+the paper's validated envelope (docs/yaw_steering.md#the-validated-envelope).
 """
 
 from floris_ekman_veer._version import __version__

@@ -708,21 +708,27 @@ BASE = dict(geostrophic_wind=10.0, latitude=45.0, roughness_length=0.1)
      r"give at most one stability input .*cooling_rate.*stability_parameter"),
     (dict(surface_heat_flux=-0.01, obukhov_length=100.0),
      r"give at most one stability input .*obukhov_length.*surface_heat_flux"),
-    (dict(cooling_rate=0.5),
-     r"cooling_rate must be -10 to 0 K/h.*unstable \(convective\) conditions are not covered"),
+    (dict(cooling_rate=15.0),
+     r"cooling_rate must be -10 to 10 K/h.*positive: heating, a convective layer\); got 15"),
     # unit mistakes: K/day for K/h, Celsius for kelvin, K/km for K/m
-    (dict(cooling_rate=-100.0), r"cooling_rate must be -10 to 0 K/h, surface cooling in kelvin "
-                                r"per hour.*; got -100"),
+    (dict(cooling_rate=-100.0), r"cooling_rate must be -10 to 10 K/h, the surface's rate of "
+                                r"temperature change in kelvin per hour.*; got -100"),
     (dict(reference_potential_temperature=15.0),
      r"reference_potential_temperature must be 200 to 350 K \(a potential temperature in "
      r"kelvin, not degrees Celsius\); got 15"),
     (dict(reference_potential_temperature=400.0), r"reference_potential_temperature must be 200 to 350 K"),
-    (dict(stability_parameter=-1.0),
-     r"stability_parameter must be >= 0.*unstable \(convective\) conditions are not covered"),
-    (dict(surface_heat_flux=0.02),
-     r"surface_heat_flux must be <= 0 K m/s.*unstable \(convective\) conditions are not cov"),
-    (dict(obukhov_length=-50.0),
-     r"obukhov_length must be > 0 m.*unstable \(convective\) conditions are not covered"),
+    (dict(stability_parameter=np.nan), r"stability_parameter must be finite; .*got nan"),
+    # a heat flux in W/m^2 given as the kinematic flux (K m/s)
+    (dict(surface_heat_flux=150.0),
+     r"surface_heat_flux must be finite and <= 0.5 K m/s.*for W/m\^2 use sensible_heat_flux\)"
+     r"; got 150"),
+    (dict(obukhov_length=0.0), r"obukhov_length must be > 0 m stable, < 0 m convective.*; got 0"),
+    (dict(sensible_heat_flux=1500.0),
+     r"sensible_heat_flux must be -300 to 800 W/m\^2, the upward surface sensible heat flux"
+     r".*; got 1500"),
+    (dict(obukhov_length=-50.0, mixed_layer_height=5.0),
+     r"mixed_layer_height must be >= 10 m and finite, the convective mixed-layer depth z_i"
+     r".*; got 5"),
     (dict(brunt_vaisala_frequency=0.01, lapse_rate=0.003),
      r"give at most one of brunt_vaisala_frequency \[1/s\] or lapse_rate \[K/m\]"),
     (dict(brunt_vaisala_frequency=-0.01), r"brunt_vaisala_frequency must be >= 0 1/s"),

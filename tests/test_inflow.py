@@ -487,8 +487,8 @@ def test_worker_dict_prepares_the_unpickling_process(monkeypatch):
         ({"geostrophic_wind": 12.0}, "geostrophic_wind is not allowed"),
         ({"roughness_length": "rough"}, "atmosphere.roughness_length must be a real number"),
         ({"cooling_rate": [[-0.1, -0.2]]}, "atmosphere.cooling_rate must be a number or a 1-D list"),
-        ({"cooling_rate": float("nan")}, r"atmosphere.cooling_rate must be -10 to 0 K/h.*got nan"),
-        ({"cooling_rate": 1.0}, r"ekman_veer.atmosphere.cooling_rate must be -10 to 0 K/h.*got 1"),  # heating
+        ({"cooling_rate": float("nan")}, r"atmosphere.cooling_rate must be -10 to 10 K/h.*got nan"),
+        ({"cooling_rate": 11.0}, r"ekman_veer.atmosphere.cooling_rate must be -10 to 10 K/h.*got 11"),
         ({"roughness_length": None}, "missing required key.*roughness_length"),
     ],
 )

@@ -32,6 +32,7 @@ from floris_ekman_veer._validation import finite_real, real_array, require_at
 from floris_ekman_veer.atmosphere.turbulence import (
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
+    convective_variance,
     streamwise_turbulence_intensity,
     wake_expansion_rate,
 )
@@ -50,7 +51,27 @@ PAPER_BRUNT_VAISALA_FREQUENCY = 6.1e-3
 #: Paper's reference potential temperature Theta_0 [K] (Table 1 caption).
 PAPER_POTENTIAL_TEMPERATURE = 265.0
 
-_STABLE_ONLY = "unstable (convective) conditions are not covered by this model"
+#: Businger-Dyer unstable surface layer phi_m = (1 - gamma z/L)^(-1/4): gamma = 16 (Dyer 1974;
+#: Businger et al. 1971's form), or 19.3 (Hogstrom 1988) through ``businger_dyer_gamma``
+#: (docs/atmosphere.md#convective-boundary-layer).
+BUSINGER_DYER_GAMMA = 16.0
+HOGSTROM_GAMMA = 19.3
+#: Entrainment heat flux at z_i as a fraction of the surface flux, -A_e Q0 (Tennekes 1973):
+#: a mixed layer of depth z_i warms at (1 + A_e) Q0 / z_i.
+ENTRAINMENT_RATIO = 0.2
+#: Specific heat of dry air c_p [J/(kg K)], gas constant R_d [J/(kg K)] and the reference
+#: pressure [Pa] of the potential temperature: rho c_p = c_p p0 / (R_d Theta0) turns a sensible
+#: heat flux H [W/m^2] into the kinematic flux Q0 = H/(rho c_p) [K m/s].
+SPECIFIC_HEAT_AIR = 1005.0
+GAS_CONSTANT_DRY_AIR = 287.05
+REFERENCE_PRESSURE = 1.0e5
+#: Sensible heat flux bounds [W/m^2]: beyond the strongest nocturnal (about -100) and desert
+#: afternoon (about +600) surface fluxes; they catch kW/m^2 and other unit mistakes.
+SENSIBLE_HEAT_FLUX_RANGE = (-300.0, 800.0)
+#: Kinematic heat flux bound [K m/s] for heating: about 600 W/m^2 (a W/m^2 value given as K m/s
+#: would be far above it).
+MAX_KINEMATIC_HEAT_FLUX = 0.5
+_EITHER_SIGN = "negative for convective (unstable) layers"
 #: Physical bounds of the thermal inputs (docs/atmosphere.md#input-ranges): they catch unit
 #: mistakes (a potential temperature in degrees Celsius, a lapse rate in K/km, a cooling rate in
 #: K/day) that the model would otherwise solve into boundary layers millimetres deep.
@@ -89,18 +110,38 @@ VALID_RANGES = {
         f"0 to {MAX_LAPSE_RATE:g} K/m (a neutral or stably stratified free atmosphere; in K/m, "
         "not K/km)"
     ),
-    "stability_parameter": f">= 0 and finite ({_STABLE_ONLY})",
+    "stability_parameter": f"finite; >= 0 stable or neutral, < 0 convective ({_EITHER_SIGN})",
     "cooling_rate": (
-        f"{MIN_COOLING_RATE:g} to 0 K/h, surface cooling in kelvin per hour ({_STABLE_ONLY})"
+        f"{MIN_COOLING_RATE:g} to {-MIN_COOLING_RATE:g} K/h, the surface's rate of temperature "
+        "change in kelvin per hour (negative: cooling, a stable layer; positive: heating, a "
+        "convective layer)"
     ),
-    "surface_heat_flux": f"<= 0 K m/s and finite, downward heat flux ({_STABLE_ONLY})",
-    "obukhov_length": f"> 0 m, stable; inf for neutral ({_STABLE_ONLY})",
+    "surface_heat_flux": (
+        f"finite and <= {MAX_KINEMATIC_HEAT_FLUX:g} K m/s, the kinematic upward heat flux "
+        f"(negative: stable; positive: convective; {MAX_KINEMATIC_HEAT_FLUX:g} K m/s is about "
+        "600 W/m^2 — for W/m^2 use sensible_heat_flux)"
+    ),
+    "sensible_heat_flux": (
+        f"{SENSIBLE_HEAT_FLUX_RANGE[0]:g} to {SENSIBLE_HEAT_FLUX_RANGE[1]:g} W/m^2, the upward "
+        "surface sensible heat flux (negative at night: stable; positive by day: convective)"
+    ),
+    "obukhov_length": (
+        "> 0 m stable, < 0 m convective (unstable), inf or -inf neutral; not 0 and not NaN"
+    ),
+    "mixed_layer_height": (
+        f">= {10.0:g} m and finite, the convective mixed-layer depth z_i (used where the layer "
+        "is convective; default: the neutral height of Eq. h_hat_model)"
+    ),
     **{name: "> 0 and finite (a model constant)"
-       for name in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns")},
+       for name in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns",
+                    "businger_dyer_gamma")},
     "matching_fraction": "in (0, 1)",
 }
 
-_STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
+_STABILITY_INPUTS = (
+    "stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
+    "sensible_heat_flux",
+)
 _SOLVER_TOLERANCE = 1e-14
 _SOLVER_MAX_ITERATIONS = 200
 
@@ -155,6 +196,42 @@ def boundary_layer_height_hat(stability_parameter, zilitinkevich_number, c_tn, c
     return (1.0 / c_tn**2 + zilitinkevich_number / c_cn**2 + stability_parameter / c_ns**2) ** -0.5
 
 
+def air_heat_capacity(reference_potential_temperature):
+    """rho c_p [J/(m^3 K)] of dry air at the potential temperature's reference pressure:
+    c_p p0/(R_d Theta0) (1321 at the paper's 265 K, 1216 at 288 K)."""
+    return SPECIFIC_HEAT_AIR * REFERENCE_PRESSURE / (
+        GAS_CONSTANT_DRY_AIR * np.asarray(reference_potential_temperature, dtype=float)
+    )
+
+
+def unstable_phi_m(zeta, gamma=BUSINGER_DYER_GAMMA):
+    """phi_m(z/L) = (1 - gamma z/L)^(-1/4) for z/L <= 0: the Businger-Dyer dimensionless shear
+    (Businger et al. 1971; Dyer 1974, gamma = 16; Hogstrom 1988, gamma = 19.3)."""
+    return (1.0 - gamma * np.minimum(zeta, 0.0)) ** -0.25
+
+
+def unstable_psi_m(zeta, gamma=BUSINGER_DYER_GAMMA):
+    """psi_m(z/L) = int_0^zeta (1 - phi_m)/zeta' dzeta' for z/L <= 0, Paulson (1970)'s integral of
+    the Businger-Dyer phi_m: 2 ln((1+x)/2) + ln((1+x^2)/2) - 2 atan(x) + pi/2, x = 1/phi_m."""
+    x = (1.0 - gamma * np.minimum(zeta, 0.0)) ** 0.25
+    return (
+        2.0 * np.log(0.5 * (1.0 + x)) + np.log(0.5 * (1.0 + x * x)) - 2.0 * np.arctan(x)
+        + 0.5 * np.pi
+    )
+
+
+def stability_term(mu, xi, xi0, kappa, gamma=BUSINGER_DYER_GAMMA):
+    """The stability part of the surface-layer U/u*, -(psi_m(z/L) - psi_m(z0/L))/kappa with
+    z/L = kappa mu xi: 5 mu (xi - xi0) for mu >= 0 (the paper's Eq. U_vel, psi_m = -5 z/L) and
+    the Businger-Dyer psi_m of `unstable_psi_m` for mu < 0 (docs/atmosphere.md#convective-boundary-layer)."""
+    mu = np.asarray(mu, dtype=float)
+    unstable = mu < 0
+    stable = 5.0 * np.maximum(mu, 0.0) * (xi - xi0)
+    k_mu = kappa * np.minimum(mu, 0.0)
+    convective = -(unstable_psi_m(k_mu * xi, gamma) - unstable_psi_m(k_mu * xi0, gamma)) / kappa
+    return np.where(unstable, convective, stable)
+
+
 def stress_shape(xi_over_h, h_hat, c_g, decay):
     """g and g' of Eq. (eqn:avoidnumbers1): g = c_g (1 - exp(-xi/(Gamma h_hat)))."""
     e = np.exp(-xi_over_h / decay)
@@ -162,17 +239,21 @@ def stress_shape(xi_over_h, h_hat, c_g, decay):
 
 
 def gdl_coefficients(
-    stability_parameter, zilitinkevich_number, h_hat, rossby_number, kappa, c_g, decay, matching
+    stability_parameter, zilitinkevich_number, h_hat, rossby_number, kappa, c_g, decay, matching,
+    gamma=BUSINGER_DYER_GAMMA,
 ):
     """GDL coefficients A and B, Eqs. (A_model_GDL) and (B_model_GDL).
 
     ``rossby_number`` is the surface Rossby number u*/(|f_c| z0) = 1/xi0_hat. The paper
-    prints 0.2 and 0.8 = 1 - 0.2; ``matching`` is that fraction.
+    prints 0.2 and 0.8 = 1 - 0.2; ``matching`` is that fraction. For mu < 0 the paper's
+    5 mu (0.2 h_hat - xi0) is the Businger-Dyer `stability_term` at the matching height, the
+    same matching of the surface layer to the Ekman layer (docs/atmosphere.md#convective-boundary-layer).
     """
     g_m, dg_m = stress_shape(matching, h_hat, c_g, decay)
-    most_slope = 5.0 * stability_parameter + 0.3 * zilitinkevich_number
+    xi_m, xi0 = matching * h_hat, 1.0 / rossby_number
     a = -np.log(matching * h_hat) - kappa * (
-        most_slope * (matching * h_hat - 1.0 / rossby_number)
+        stability_term(stability_parameter, xi_m, xi0, kappa, gamma)
+        + 0.3 * zilitinkevich_number * (xi_m - xi0)
         + dg_m * (1.0 - matching) ** 1.5
         - g_m * (1.5 / h_hat) * (1.0 - matching) ** 0.5
     )
@@ -249,16 +330,21 @@ class EkmanABL:
       hemisphere) or ``latitude`` [deg, negative = south]; |latitude| >= 1 degree, i.e.
       |f_c| >= 2 Omega sin(1 deg): the model has no solution at the equator.
     - ``roughness_length`` z0 [m], > 0.
-    - Stability, at most one of: ``stability_parameter`` mu = u*/(kappa f_c L) >= 0;
-      ``cooling_rate`` C_r [K/h] <= 0 with Q0 = C_r h (paper Section 2.5);
-      ``surface_heat_flux`` Q0 [K m/s] <= 0; ``obukhov_length`` L [m] > 0 (inf = neutral).
-      Default: neutral (mu = 0). Unstable (heating) input is outside this model and raises.
+    - Stability, at most one of, of either sign (negative mu or L, positive heat flux or
+      heating rate: a convective layer, docs/atmosphere.md#convective-boundary-layer):
+      ``stability_parameter`` mu = u*/(kappa f_c L); ``cooling_rate`` C_r [K/h] with
+      Q0 = C_r h when cooling (paper Section 2.5), Q0 = C_r z_i/(1 + A_e) when heating;
+      ``surface_heat_flux`` Q0 [K m/s]; ``sensible_heat_flux`` H [W/m^2] = rho c_p Q0;
+      ``obukhov_length`` L [m] (+-inf = neutral). Default: neutral (mu = 0).
+    - ``mixed_layer_height`` z_i [m], the depth of a convective layer (used where mu < 0;
+      default the neutral height of Eq. h_hat_model at the same u*).
     - Free atmosphere, at most one of ``brunt_vaisala_frequency`` N [1/s] >= 0 or
       ``lapse_rate`` dTheta/dz [K/m] >= 0 (N = sqrt(g/Theta0 gamma)); default the paper's
       N_inf = 6.1e-3 1/s. Enters through the Zilitinkevich number mu_N = N/|f_c|.
     - ``reference_potential_temperature`` Theta0 [K], default the paper's 265 K.
     - Model constants: ``von_karman`` 0.41, ``c_g`` 1.43, ``stress_decay`` (Gamma) 0.83,
-      ``c_tn`` 0.5, ``c_cn`` 1.6, ``c_ns`` 0.78, ``matching_fraction`` 0.2.
+      ``c_tn`` 0.5, ``c_cn`` 1.6, ``c_ns`` 0.78, ``matching_fraction`` 0.2, and, beyond the
+      paper, ``businger_dyer_gamma`` 16 (Dyer 1974; 19.3 for Hogstrom 1988).
 
     Solved attributes: ``friction_velocity`` [m/s], ``boundary_layer_height`` [m],
     ``cross_isobaric_angle`` [deg, signed, surface-stress frame], ``stability_parameter``
@@ -266,6 +352,9 @@ class EkmanABL:
     ``geostrophic_components`` (U_g, V_g), ``coriolis_parameter`` (signed), and the
     dimensionless ``h_hat`` = h f_c/u* with the GDL coefficients ``gdl_a``, ``gdl_b`` (A, B).
     """
+
+    #: The entrainment ratio A_e of the heating-rate closure (`ENTRAINMENT_RATIO`).
+    entrainment_ratio = ENTRAINMENT_RATIO
 
     def __init__(
         self,
@@ -278,6 +367,8 @@ class EkmanABL:
         cooling_rate=None,
         surface_heat_flux=None,
         obukhov_length=None,
+        sensible_heat_flux=None,
+        mixed_layer_height=None,
         brunt_vaisala_frequency=None,
         lapse_rate=None,
         reference_potential_temperature=PAPER_POTENTIAL_TEMPERATURE,
@@ -288,8 +379,12 @@ class EkmanABL:
         c_cn=1.6,
         c_ns=0.78,
         matching_fraction=0.2,
+        businger_dyer_gamma=BUSINGER_DYER_GAMMA,
     ):
         self._set_constants(von_karman, c_g, stress_decay, c_tn, c_cn, c_ns, matching_fraction)
+        self.businger_dyer_gamma = float(_checked(
+            "businger_dyer_gamma", businger_dyer_gamma, lambda v: (v > 0) & (np.ndim(v) == 0)
+        ))
         self._set_coriolis(coriolis_parameter, latitude)
         self.roughness_length = _checked("roughness_length", roughness_length, lambda z0: z0 > 0)
         self.reference_potential_temperature = _checked(
@@ -298,7 +393,12 @@ class EkmanABL:
         )
         self._set_free_atmosphere(brunt_vaisala_frequency, lapse_rate)
         self._set_stability_closure(
-            stability_parameter, cooling_rate, surface_heat_flux, obukhov_length
+            stability_parameter, cooling_rate, surface_heat_flux, obukhov_length,
+            sensible_heat_flux,
+        )
+        self.mixed_layer_height = None if mixed_layer_height is None else _checked(
+            "mixed_layer_height", mixed_layer_height,
+            lambda z: z >= MIN_BOUNDARY_LAYER_HEIGHT,
         )
         given = {
             "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
@@ -308,6 +408,8 @@ class EkmanABL:
                 self.brunt_vaisala_frequency,
             self.stability_input: self._stability_value,
         }
+        if self.mixed_layer_height is not None:
+            given["mixed_layer_height"] = self.mixed_layer_height
         if geostrophic_wind is _INPUTS_ONLY:
             require_broadcastable(given)
             return
@@ -375,30 +477,44 @@ class EkmanABL:
         self.brunt_vaisala_frequency = n_inf
         self.zilitinkevich_number = n_inf / self._f
 
-    def _set_stability_closure(self, mu, cooling_rate, heat_flux, obukhov_length):
+    def _set_stability_closure(self, mu, cooling_rate, heat_flux, obukhov_length, sensible):
         given = {
             name: value
-            for name, value in zip(_STABILITY_INPUTS, (mu, cooling_rate, heat_flux, obukhov_length))
+            for name, value in zip(
+                _STABILITY_INPUTS, (mu, cooling_rate, heat_flux, obukhov_length, sensible)
+            )
             if value is not None
         }
         if len(given) > 1:
             raise ValueError(
                 "give at most one stability input among stability_parameter, cooling_rate, "
-                f"surface_heat_flux, obukhov_length; got {sorted(given)}"
+                f"surface_heat_flux, obukhov_length, sensible_heat_flux; got {sorted(given)}"
             )
         self.stability_input = name = next(iter(given), "stability_parameter")
         value = real_array(name, given.get(name, 0.0), VALID_RANGES[name])
-        # L = +inf is the neutral limit of the Obukhov length; everything else must be finite.
+        # L = +-inf is the neutral limit of the Obukhov length; everything else must be finite.
         ok = {
-            "stability_parameter": lambda v: np.isfinite(v) & (v >= 0),
-            "cooling_rate": lambda v: np.isfinite(v) & (v <= 0) & (v >= MIN_COOLING_RATE),
-            "surface_heat_flux": lambda v: np.isfinite(v) & (v <= 0),
-            "obukhov_length": lambda v: (v > 0) & ~np.isnan(v),
+            "stability_parameter": np.isfinite,
+            "cooling_rate": lambda v: np.isfinite(v) & (np.abs(v) <= -MIN_COOLING_RATE),
+            "surface_heat_flux": lambda v: np.isfinite(v) & (v <= MAX_KINEMATIC_HEAT_FLUX),
+            "obukhov_length": lambda v: (v != 0) & ~np.isnan(v),
+            "sensible_heat_flux": lambda v: (
+                (v >= SENSIBLE_HEAT_FLUX_RANGE[0]) & (v <= SENSIBLE_HEAT_FLUX_RANGE[1])
+            ),
         }[name]
         require_at(ok(value), name, VALID_RANGES[name], value)
         self._stability_value = value
 
     # ----------------------------------------------------------------------------- solver
+    def _neutral_h_hat(self, p):
+        """h_hat of Eq. (h_hat_model) at mu = 0."""
+        return boundary_layer_height_hat(0.0, p["mu_n"], self.c_tn, self.c_cn, self.c_ns)
+
+    def _convective_h_hat(self, u_star, p):
+        """z_i f/u* of a convective layer: the given mixed_layer_height, else the neutral height
+        of Eq. (h_hat_model) (docs/atmosphere.md#convective-boundary-layer)."""
+        return np.where(np.isnan(p["zi"]), self._neutral_h_hat(p), p["zi"] * p["f"] / u_star)
+
     def _closure_mu(self, u_star, p):
         """mu as a function of u* for the chosen stability input (docs/atmosphere.md#stability-closures)."""
         value, f, theta0 = p["value"], p["f"], p["theta0"]
@@ -406,20 +522,32 @@ class EkmanABL:
             return value + 0.0 * u_star
         if self.stability_input == "surface_heat_flux":
             return -(GRAVITY / theta0) * value / (f * u_star**2)
+        if self.stability_input == "sensible_heat_flux":
+            return -(GRAVITY / theta0) * value / (air_heat_capacity(theta0) * f * u_star**2)
         if self.stability_input == "obukhov_length":
             return u_star / (self.von_karman * f * value)
         a0 = 1.0 / self.c_tn**2 + p["mu_n"] / self.c_cn**2
-        return stability_from_cooling_rate(value / 3600.0, u_star, f, theta0, a0, self.c_ns)
+        cooling = stability_from_cooling_rate(
+            np.minimum(value, 0.0) / 3600.0, u_star, f, theta0, a0, self.c_ns
+        )
+        # Heating: the mixed layer warms at C_r, Q0 = C_r z_i / (1 + A_e) (Tennekes 1973).
+        z_i = self._convective_h_hat(u_star, p) * u_star / f
+        heat_flux = np.maximum(value, 0.0) / 3600.0 * z_i / (1.0 + ENTRAINMENT_RATIO)
+        return np.where(value > 0, -(GRAVITY / theta0) * heat_flux / (f * u_star**2), cooling)
 
     def _state(self, log_u_star, p):
         """ABL state for trial ln u* and condition parameters p: (u*, mu, h_hat, A, B, ln Ro - A)."""
         u_star = np.exp(log_u_star)
         mu = self._closure_mu(u_star, p)
-        h_hat = boundary_layer_height_hat(mu, p["mu_n"], self.c_tn, self.c_cn, self.c_ns)
+        h_hat = np.where(
+            mu < 0, self._convective_h_hat(u_star, p),
+            boundary_layer_height_hat(np.maximum(mu, 0.0), p["mu_n"], self.c_tn, self.c_cn,
+                                      self.c_ns),
+        )
         rossby = u_star / (p["f"] * p["z0"])
         a, b = gdl_coefficients(
             mu, p["mu_n"], h_hat, rossby, self.von_karman, self.c_g,
-            self.stress_decay, self.matching_fraction,
+            self.stress_decay, self.matching_fraction, self.businger_dyer_gamma,
         )
         return u_star, mu, h_hat, a, b, np.log(rossby) - a
 
@@ -451,6 +579,7 @@ class EkmanABL:
             g=geostrophic_wind, f=self._f, z0=self.roughness_length,
             value=self._stability_value, mu_n=self.zilitinkevich_number,
             theta0=self.reference_potential_temperature,
+            zi=np.nan if self.mixed_layer_height is None else self.mixed_layer_height,
         )
         shape = np.broadcast_shapes(shape, *(np.shape(v) for v in params.values()))
         return {k: np.broadcast_to(v, shape) for k, v in params.items()}, shape
@@ -514,6 +643,33 @@ class EkmanABL:
         v_g = -self._hemisphere * u_star * b / kappa
         self.geostrophic_components = (u_g[()], v_g[()])
         self.cross_isobaric_angle = np.rad2deg(np.arctan2(v_g, u_g))[()]
+        self.convective_variance = convective_variance(
+            self.boundary_layer_height, self.obukhov_length
+        )[()]
+
+    # ----------------------------------------------------------------------------- stability
+    @property
+    def obukhov_length(self):
+        """L [m] = u*/(kappa f mu): > 0 stable, < 0 convective, inf neutral."""
+        mu = np.asarray(self.stability_parameter, dtype=float)
+        with np.errstate(divide="ignore", over="ignore"):
+            return (self.friction_velocity / (self.von_karman * self._f * mu))[()]
+
+    @property
+    def surface_heat_flux(self):
+        """The kinematic surface heat flux Q0 = -u*^3/(kappa (g/Theta0) L) [K m/s] (upward > 0)."""
+        return (-np.asarray(self.stability_parameter, dtype=float) * self._f
+                * self.friction_velocity**2 * self.reference_potential_temperature / GRAVITY)[()]
+
+    @property
+    def sensible_heat_flux(self):
+        """The surface sensible heat flux H = rho c_p Q0 [W/m^2] (upward > 0; `air_heat_capacity`)."""
+        return (self.surface_heat_flux * air_heat_capacity(self.reference_potential_temperature))[()]
+
+    @property
+    def friction_rossby_number(self):
+        """Ro = u*/(|f_c| z0), the paper's Table 1 friction Rossby number."""
+        return (self.friction_velocity / (self._f * self.roughness_length))[()]
 
     # ----------------------------------------------------------------------------- profiles
     @property
@@ -522,12 +678,27 @@ class EkmanABL:
 
         The height where the tangent of the surface-layer law U(z) passes through the ground,
         z_s = z0 exp(1 + kappa (5 mu + 0.3 mu_N) z0 f_c/u*) (about e z0), capped at the matching
-        height matching_fraction * h (reached only by a boundary layer near collapse).
+        height matching_fraction * h (reached only by a boundary layer near collapse). In a
+        convective layer the tangent condition ln(z_s/z0) = phi_m(z_s/L) + psi_m(z_s/L)
+        - psi_m(z0/L) + 0.3 kappa mu_N z0 f_c/u* is solved by fixed-point steps from e z0.
         """
-        most_slope = 5.0 * self.stability_parameter + 0.3 * self.zilitinkevich_number
+        mu = np.asarray(self.stability_parameter, dtype=float)
+        most_slope = 5.0 * np.maximum(mu, 0.0) + 0.3 * self.zilitinkevich_number
         xi0 = self.roughness_length * self._f / self.friction_velocity
         # (exponent capped where z_s would be > e^50 z0: far above the matching height anyway)
         tangent = self.roughness_length * np.exp(np.minimum(1.0 + self.von_karman * most_slope * xi0, 50.0))
+        if np.any(mu < 0):
+            # phi_m + psi_m varies slowly (1 at neutral), so these steps contract fast.
+            inverse_l = self.von_karman * np.minimum(mu, 0.0) * self._f / self.friction_velocity
+            gamma, z0 = self.businger_dyer_gamma, self.roughness_length
+            offset = 0.3 * self.von_karman * self.zilitinkevich_number * xi0 - unstable_psi_m(
+                z0 * inverse_l, gamma)
+            z_s = tangent
+            for _ in range(30):
+                zeta = z_s * inverse_l
+                z_s = z0 * np.exp(np.minimum(
+                    unstable_phi_m(zeta, gamma) + unstable_psi_m(zeta, gamma) + offset, 50.0))
+            tangent = np.where(mu < 0, z_s, tangent)
         return np.minimum(tangent, self.matching_fraction * self.boundary_layer_height)
 
     def _heights(self, z, name, ok=lambda z: z >= 0, valid=">= 0 m (at or above the ground)"):
@@ -569,8 +740,12 @@ class EkmanABL:
         stress = (1.0 - eta) ** 1.5
         u_g = self.geostrophic_components[0]
         ekman_u = -dg * stress + 1.5 * g / h_hat * np.sqrt(1.0 - eta) + u_g / u_star
-        most_slope = 5.0 * self.stability_parameter + 0.3 * self.zilitinkevich_number
-        surface_u = np.log(xi / xi0) / self.von_karman + most_slope * (xi - xi0)
+        surface_u = (
+            np.log(xi / xi0) / self.von_karman
+            + stability_term(self.stability_parameter, xi, xi0, self.von_karman,
+                             self.businger_dyer_gamma)
+            + 0.3 * self.zilitinkevich_number * (xi - xi0)
+        )
         u = np.where(eta <= self.matching_fraction, surface_u, ekman_u) * u_star
 
         one_minus_g2 = 1.0 - g**2
@@ -633,7 +808,8 @@ class EkmanABL:
                 *self._velocity(self._log_layer_heights(reference_height, "reference_height"))
             )
         return streamwise_turbulence_intensity(
-            z, self.friction_velocity, self.boundary_layer_height, reference_speed, A1, B1
+            z, self.friction_velocity, self.boundary_layer_height, reference_speed, A1, B1,
+            self.convective_variance,
         )
 
     def wake_expansion_rate(self, hub_height, **constants):
@@ -646,7 +822,8 @@ class EkmanABL:
         hub_height = self._log_layer_heights(hub_height, "hub_height")
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,
-            np.hypot(*self._velocity(hub_height)), **constants,
+            np.hypot(*self._velocity(hub_height)), convective=self.convective_variance,
+            **constants,
         )
 
     # ----------------------------------------------------------------------------- drivers
@@ -689,6 +866,8 @@ class EkmanABL:
             brunt_vaisala_frequency=template.brunt_vaisala_frequency,
             reference_potential_temperature=template.reference_potential_temperature,
             **{template.stability_input: template._stability_value},
+            **({} if template.mixed_layer_height is None
+               else {"mixed_layer_height": template.mixed_layer_height}),
         )
         shape = np.broadcast_shapes(
             speed.shape, height.shape, *(np.shape(v) for v in per_condition.values())
@@ -700,7 +879,8 @@ class EkmanABL:
         distinct, first, inverse = np.unique(columns, axis=0, return_index=True, return_inverse=True)
         constants = {
             k: getattr(template, k)
-            for k in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns", "matching_fraction")
+            for k in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns", "matching_fraction",
+                      "businger_dyer_gamma")
         }
         rows = cls.check_inputs(
             **{k: distinct[:, 2 + i] for i, k in enumerate(per_condition)}, **constants

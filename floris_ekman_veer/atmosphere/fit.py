@@ -45,9 +45,13 @@ from floris_ekman_veer._validation import real_array, require_at
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
-               "on_misfit", "labels", "max_iterations")
+               "on_misfit", "labels", "max_iterations", "stability")
 #: Stability inputs the fit determines (refused as fixed inputs).
-STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
+STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
+                    "sensible_heat_flux")
+#: The signs of 1/L a fit may take (``stability``): 1/L >= 0 (stable or neutral), 1/L <= 0
+#: (convective or neutral), or either, chosen per record by the smaller misfit.
+STABILITY_CHOICES = ("stable", "convective", "either")
 #: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
 DEFAULT_SPEED_NOISE = 0.2
 DEFAULT_DIRECTION_NOISE = 1.0
@@ -91,6 +95,9 @@ class ProfileFit:
         iterations, converged: of the Levenberg-Marquardt iteration.
         labels: Record names used in messages (index by default).
         fixed_inputs: The fixed EkmanABL inputs as given.
+        stability_class: "convective" (-500 m <= L < 0), "neutral" (|L| > 500 m, Gryning et al.
+            2007's neutral class) or "stable" (0 < L <= 500 m); with ``stability="either"`` L
+            takes the sign whose fit misses the data less.
     """
 
     abl: object
@@ -116,6 +123,8 @@ class ProfileFit:
     speed_noise: float
     direction_noise: float
     single: bool
+    #: "convective", "neutral" or "stable" per record (`_stability_class` of the fitted L).
+    stability_class: np.ndarray | str | None = None
 
     def speed(self, heights):
         """Fitted speed [m/s] at ``heights`` ((n_heights,) or (n_records, n_heights)), shaped
@@ -159,11 +168,13 @@ class ProfileFit:
         with np.errstate(divide="ignore"):
             values = {
                 "stability_parameter": mu,
-                "obukhov_length": np.where(mu > 0, u_star / (self.abl.von_karman * f
-                                                              * np.where(mu > 0, mu, 1.0)), np.inf),
+                "obukhov_length": np.where(mu != 0, u_star / (self.abl.von_karman * f
+                                                               * np.where(mu != 0, mu, 1.0)), np.inf),
                 "surface_heat_flux": -mu * f * u_star**2 / gravity_ratio,
+                # heating (mu < 0): Q0 = C_r z_i / (1 + A_e) (docs/atmosphere.md#convective-boundary-layer)
                 "cooling_rate": -mu * f * u_star**2 / gravity_ratio
-                / np.asarray(self.boundary_layer_height, float) * 3600.0,
+                / np.asarray(self.boundary_layer_height, float) * 3600.0
+                * np.where(mu < 0, 1.0 + self.abl.entrainment_ratio, 1.0),
             }
         if stability_input not in values:
             raise ValueError(f"stability_input must be one of {list(values)}; got "
@@ -213,8 +224,10 @@ class _ProfileModel:
     x = (ln u*, lam = 100 m/L, [ln z0]) per record, and the normalised residuals."""
 
     def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
-                 speed_noise, direction_noise):
+                 speed_noise, direction_noise, sign=1.0):
         self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        # The sign of 1/L: the unknown lam >= 0 is 100 m/|L| (convective fits: sign -1).
+        self.sign = float(sign)
         self.z, self.s, self.d = heights, speeds, directions
         self.sigma_s, self.sigma_d = speed_noise, direction_noise
         self.ms = np.isfinite(speeds)
@@ -239,7 +252,7 @@ class _ProfileModel:
         log_u = x[:, 0]
         u_star = np.exp(log_u)
         z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
-        mu = u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        mu = self.sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
         p = {k: v[index] for k, v in self.params.items()}
         p["value"], p["z0"] = mu, z0
         with np.errstate(all="ignore"):
@@ -361,7 +374,8 @@ def _checked_data(name, value, shape=None):
 def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
-                on_misfit="raise", labels=None, max_iterations=100, **fixed_inputs):
+                on_misfit="raise", labels=None, max_iterations=100, stability="stable",
+                **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -378,6 +392,11 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
         labels: a name per record for messages (e.g. time stamps); default its index.
         max_iterations: of the Levenberg-Marquardt iteration.
+        stability: the sign of 1/L fitted: ``"stable"`` (1/L >= 0, the default), ``"convective"``
+            (1/L <= 0: the convective layer of docs/atmosphere.md#convective-boundary-layer, its
+            mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
+            both, each record taking the sign whose fit misses its data less
+            (``ProfileFit.stability_class`` says which).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
             ``coriolis_parameter`` (required), ``roughness_length`` (required unless fitted),
             ``brunt_vaisala_frequency`` or ``lapse_rate``, ``reference_potential_temperature``,
@@ -387,6 +406,15 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         The fitted EkmanABL, shape (n_records,) (scalar for 1-D data), with ``profile_fit``: the
         :class:`ProfileFit` (unknowns, direction offset, residuals per record).
     """
+    if stability not in STABILITY_CHOICES:
+        raise ValueError(f"fit_profile: stability must be one of {list(STABILITY_CHOICES)}; got "
+                         f"{stability!r}")
+    if stability == "either":
+        return _fit_either_sign(
+            abl_class, heights, speeds, directions, speed_noise=speed_noise,
+            direction_noise=direction_noise, fit_roughness=fit_roughness,
+            refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
+            max_iterations=max_iterations, **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -463,7 +491,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         )
 
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise))
+                          float(speed_noise), float(direction_noise),
+                          -1.0 if stability == "convective" else 1.0)
     x, cost, converged, iterations = _multistart(model, n, max_iterations)
     index = np.arange(n)
     g, mu, z0_fit, valid, _ = model.state(x, index)
@@ -497,7 +526,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     u_star = np.exp(x[:, 0])
     kappa_f = model.kappa * model.f
     with np.errstate(divide="ignore"):
-        obukhov = np.where(mu > 0, u_star / (kappa_f * np.where(mu > 0, mu, 1.0)), np.inf)
+        obukhov = np.where(mu != 0, u_star / (kappa_f * np.where(mu != 0, mu, 1.0)), np.inf)
     fit = ProfileFit(
         abl=abl, heights=heights, speeds=speeds, directions=directions,
         fitted=("friction_velocity", "obukhov_length") + (("roughness_length",) if fit_roughness else ()),
@@ -510,7 +539,64 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         fixed_inputs={k: (v if np.ndim(v) == 0 else shape(v)) for k, v in fixed.items()}
         | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
         speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
+        stability_class=shape(_stability_class(obukhov)),
     )
+    abl.profile_fit = fit
+    return abl
+
+
+#: |L| [m] above which a fit is classed neutral (Gryning et al. 2007's neutral class, |L| > 500 m).
+NEUTRAL_OBUKHOV_LENGTH = 500.0
+
+
+def _stability_class(obukhov_length):
+    """"convective" (-500 m <= L < 0), "neutral" (|L| > 500 m) or "stable" (0 < L <= 500 m)."""
+    length = np.asarray(obukhov_length, dtype=float)
+    return np.where(np.abs(length) > NEUTRAL_OBUKHOV_LENGTH, "neutral",
+                    np.where(length < 0, "convective", "stable"))
+
+
+def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, labels, **options):
+    """``fit_profile(stability="either")``: the stable and the convective fits of every record,
+    each record keeping the one with the smaller misfit; refused (``on_misfit="raise"``) where
+    neither passes the chi-square test, the message naming both misfits."""
+    fits = [
+        fit_profile(abl_class, heights, speeds, directions, on_misfit="flag", labels=labels,
+                    stability=sign, **options).profile_fit
+        for sign in ("stable", "convective")
+    ]
+    stable, convective = fits
+    take = np.asarray(convective.misfit) < np.asarray(stable.misfit)
+    chosen = {}
+    for field in attrs.fields(ProfileFit):
+        a, b = getattr(stable, field.name), getattr(convective, field.name)
+        if field.name in ("abl", "heights", "speeds", "directions", "labels", "fixed_inputs",
+                          "speed_noise", "direction_noise", "single", "fitted"):
+            chosen[field.name] = a
+        else:
+            chosen[field.name] = np.where(take, b, a)[()]
+    fit = ProfileFit(**chosen)
+    passes = np.atleast_1d(fit.fits)
+    if on_misfit == "raise" and not np.all(passes):
+        i = int(np.argmin(passes))
+        raise ValueError(
+            f"fit_profile: record {fit.labels[i]} fits no atmosphere of the model, stable or "
+            f"convective: misfit {np.atleast_1d(stable.misfit)[i]:.3g} stable, "
+            f"{np.atleast_1d(convective.misfit)[i]:.3g} convective (about 1 for the model plus "
+            f"the stated noise; {np.sum(~passes)} record(s) refused); fit it with "
+            "stability='stable' for what in its data the model cannot follow"
+        )
+    mu = np.asarray(fit.stability_parameter, float)
+    valid = np.isfinite(np.asarray(fit.geostrophic_wind, float))
+    fixed = {k: v for k, v in fit.fixed_inputs.items()}
+    abl = abl_class(
+        geostrophic_wind=np.where(valid, fit.geostrophic_wind, 10.0)[()],
+        stability_parameter=np.where(valid, mu, 0.0)[()],
+        **fixed,
+        **({"roughness_length": fit.roughness_length} if "roughness_length" in fit.fitted else {}),
+    )
+    fit.abl = abl
+    fit.boundary_layer_height = np.asarray(abl.boundary_layer_height)
     abl.profile_fit = fit
     return abl
 
@@ -522,7 +608,9 @@ def _starts(model, lams):
     rows = np.arange(n)
     lowest = np.argmin(np.where(model.ms, model.z, np.inf), axis=1)
     z1, s1 = model.z[rows, lowest][:, None], model.s[rows, lowest][:, None]
-    u_star = model.kappa * s1 / (np.log(z1 / model.z0[:, None]) + 5.0 * z1 * lams / _LENGTH_SCALE)
+    # (convective fits start from the neutral log law: the log-linear form is the stable one)
+    stable = 5.0 * z1 * lams / _LENGTH_SCALE * (model.sign > 0)
+    u_star = model.kappa * s1 / (np.log(z1 / model.z0[:, None]) + stable)
     columns = [np.log(u_star), lams]
     if model.fit_roughness:
         columns.append(np.broadcast_to(np.log(model.z0)[:, None], (n, k)))
@@ -592,6 +680,7 @@ class _SubsetModel:
     def __init__(self, model, index):
         self.ms, self.z, self.s = model.ms[index], model.z[index], model.s[index]
         self.z0, self.kappa, self.fit_roughness = model.z0[index], model.kappa, model.fit_roughness
+        self.sign = model.sign
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,

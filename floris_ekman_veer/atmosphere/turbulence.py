@@ -24,6 +24,24 @@ ALPHA_PRIME = 0.33
 MIXING_LAYER_FLOOR = 0.021
 #: Exponent of the smooth maximum in Eq. (kw_CNBL_SBL_model).
 MERGE_EXPONENT = 6.0
+#: Panofsky et al. (1977) convective scaling sigma_u/u* = (12 - 0.5 z_i/L)^(1/3): the neutral
+#: term and the buoyant coefficient (docs/atmosphere.md#convective-turbulence).
+PANOFSKY_NEUTRAL = 12.0
+PANOFSKY_BUOYANT = 0.5
+
+
+def convective_variance(mixed_layer_height, obukhov_length):
+    """The buoyant excess of the streamwise variance over the paper's law, <u'u'>_c/u*^2 =
+    (12 - 0.5 z_i/L)^(2/3) - 12^(2/3) for L < 0 (Panofsky et al. 1977, the part of their
+    sigma_u/u* = (12 - 0.5 z_i/L)^(1/3) that convection adds to its neutral value), 0 for L >= 0
+    or infinite (docs/atmosphere.md#convective-turbulence). It vanishes continuously as 1/L -> 0."""
+    z_i = np.asarray(mixed_layer_height, dtype=float)
+    inverse = 1.0 / np.asarray(obukhov_length, dtype=float)
+    unstable = inverse < 0
+    excess = (PANOFSKY_NEUTRAL - PANOFSKY_BUOYANT * z_i * np.where(unstable, inverse, 0.0)) ** (
+        2.0 / 3.0
+    ) - PANOFSKY_NEUTRAL ** (2.0 / 3.0)
+    return np.where(unstable, excess, 0.0)
 
 
 def turbulence_top(boundary_layer_height, A1=TOWNSEND_PERRY_A1, B1=TOWNSEND_PERRY_B1):
@@ -32,8 +50,10 @@ def turbulence_top(boundary_layer_height, A1=TOWNSEND_PERRY_A1, B1=TOWNSEND_PERR
     return np.asarray(boundary_layer_height, dtype=float) * np.exp(B1 / A1)
 
 
-def _variance_factor(height, boundary_layer_height, A1, B1):
-    """sqrt(max(A1 ln(h/z) + B1, 0)), Eq. (upup_var) continued to its zero above h.
+def _variance_factor(height, boundary_layer_height, A1, B1, convective=0.0):
+    """sqrt(max(A1 ln(h/z) + B1, 0) + c(z)), Eq. (upup_var) continued to its zero above h, plus
+    the convective excess c (`convective_variance`, 0 in neutral and stable layers), uniform in
+    the mixed layer (Panofsky et al. 1977) and tapered linearly from h to h exp(B1/A1) above it.
 
     Inside the ABL (z < h) this is the paper's law unchanged. At z = h the law still gives
     <u'u'> = B1 u*^2, while the geostrophic flow above is laminar: stopping the law at h would
@@ -44,9 +64,14 @@ def _variance_factor(height, boundary_layer_height, A1, B1):
     """
     height = np.asarray(height, dtype=float)
     boundary_layer_height = np.asarray(boundary_layer_height, dtype=float)
-    inside = height < turbulence_top(boundary_layer_height, A1, B1)
+    top = turbulence_top(boundary_layer_height, A1, B1)
+    inside = height < top
     ratio = np.where(inside, boundary_layer_height / np.where(inside, height, 1.0), 1.0)
-    return np.where(inside, np.sqrt(np.maximum(A1 * np.log(ratio) + B1, 0.0)), 0.0)
+    depth = top - boundary_layer_height
+    taper = np.clip(np.divide(top - height, depth, out=np.ones(np.broadcast(height, depth).shape),
+                              where=depth > 0), 0.0, 1.0)
+    variance = np.maximum(A1 * np.log(ratio) + B1, 0.0) + np.asarray(convective, float) * taper
+    return np.where(inside, np.sqrt(variance), 0.0)
 
 
 def streamwise_turbulence_intensity(
@@ -56,15 +81,18 @@ def streamwise_turbulence_intensity(
     reference_speed,
     A1: float = TOWNSEND_PERRY_A1,
     B1: float = TOWNSEND_PERRY_B1,
+    convective=0.0,
 ):
     """I_u = [A1 ln(h/z) + B1]^(1/2) u*/U_ref, Eq. (Iu_model); above h the law is continued to
-    its zero at h exp(B1/A1) and is 0 higher up (see `_variance_factor`).
+    its zero at h exp(B1/A1) and is 0 higher up (see `_variance_factor`). In a convective layer
+    ``convective`` (`convective_variance`, with h = z_i) adds the buoyant variance of Panofsky
+    et al. (1977) (docs/atmosphere.md#convective-turbulence).
 
     ``reference_speed`` is U_h in the paper (hub-height speed); any positive speed works.
     Heights must be positive (the caller checks them against the roughness length).
     """
     return (
-        _variance_factor(height, boundary_layer_height, A1, B1)
+        _variance_factor(height, boundary_layer_height, A1, B1, convective)
         * np.asarray(friction_velocity, dtype=float)
         / np.asarray(reference_speed, dtype=float)
     )
@@ -80,6 +108,7 @@ def wake_expansion_rate(
     alpha_prime: float = ALPHA_PRIME,
     floor: float = MIXING_LAYER_FLOOR,
     n: float = MERGE_EXPONENT,
+    convective=0.0,
 ):
     """k_w = [floor^n + (alpha' I_u(z_h))^n]^(1/n), Eq. (kw_CNBL_SBL_model).
 
@@ -90,9 +119,12 @@ def wake_expansion_rate(
     is allowed: I_u follows the variance law continued above h (`_variance_factor`), so k_w
     falls continuously to the floor, reached for hubs at or above h exp(B1/A1), the limit of
     vanishing ambient turbulence (docs/atmosphere.md#shallow-boundary-layer).
+
+    ``convective``: the buoyant variance of a convective layer (`convective_variance`), so
+    that k_w = alpha' I_u keeps the paper's form there (docs/atmosphere.md#convective-turbulence).
     """
     hub_height = np.asarray(hub_height, dtype=float)
     turbulent = alpha_prime * streamwise_turbulence_intensity(
-        hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1
+        hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1, convective
     )
     return (floor**n + turbulent**n) ** (1.0 / n)

@@ -137,7 +137,8 @@ CONFIG_PATH = f"wake.wake_velocity_parameters.{PARAMETER_BLOCK}.{ATMOSPHERE_KEY}
 # Inputs of which at most one may be given (EkmanABL's contract).
 EXCLUSIVE_INPUTS = (
     ("coriolis_parameter", "latitude"),
-    ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length"),
+    ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
+     "sensible_heat_flux"),
     ("brunt_vaisala_frequency", "lapse_rate"),
 )
 

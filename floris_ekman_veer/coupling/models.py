@@ -354,11 +354,11 @@ class _EkmanWakeModel(BaseModel):
             return wake_expansion_rate(
                 abl.friction_velocity, abl.boundary_layer_height, hub_height, hub_speed,
                 A1=self.A1, B1=self.B1, alpha_prime=self.alpha_prime, floor=self.k_w_floor,
-                n=self.k_w_exponent,
+                n=self.k_w_exponent, convective=abl.convective_variance,
             )
         ambient = streamwise_turbulence_intensity(
             hub_height, abl.friction_velocity, abl.boundary_layer_height, hub_speed, self.A1,
-            self.B1,
+            self.B1, abl.convective_variance,
         )
         added_squared = np.maximum(
             np.asarray(turbulence_intensity, dtype=float) ** 2 - floris_turbulence**2, 0.0

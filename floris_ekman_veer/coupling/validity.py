@@ -1,15 +1,24 @@
 """Per-condition validity of a model's atmosphere: is each condition inside what the paper
 validated? (docs/yaw_steering.md#the-validated-envelope)
 
-Narasimhan, Gayme & Meneveau (JRSE 2025) validate the model against LES from the neutral CNBL
-(stability parameter mu = 0) to the strongly stable SBL-6 (Table 1: mu = 148.49, h of about
-200 m, 22.5 degrees of veer across a 50-150 m rotor), always with the whole rotor inside the
-boundary layer. A condition is *inside the envelope* when 0 <= mu <= 169 (SBL-6 as the model
-closes the LES's cooling rate; Table 1 lists 148.49) and the boundary layer top h lies above
-every rotor top. Outside it (a shallow night, h below the rotor top) the
-inflow above h is the geostrophic wind and the wake model is extrapolated
-(docs/atmosphere.md#shallow-boundary-layer): its numbers, and any gain computed from them, are
-not validated.
+Narasimhan, Gayme & Meneveau (JRSE 2025) validate the wake model against LES of one forcing
+(G = 15 m/s, z0 = 0.1 m, f_c = 1e-4 1/s; Table 1) in the neutral CNBL and the stable SBL-4,
+SBL-5 and SBL-6 (Section 4.3; SBL-1..3 enter only the turbulence-intensity comparison), with a
+50-150 m rotor well inside the boundary layer (h / rotor top >= 218/150 = 1.45 in the LES) and
+friction Rossby numbers Ro = u*/(f z0) of 3.39e4 to 6.02e4. A condition is *inside the envelope*
+only where all three hold, each with the paper's own cases inside it as the model computes them:
+
+- its stability is one the wake validation covers: near-neutral (|mu| < 2.81, half of SBL-1's
+  5.62) or SBL-4 to SBL-6 (55.4 <= mu <= 169, so that both Table 1's mu and the cooling-rate
+  closure's of each of these cases are inside, and those of SBL-3 are not); convective layers
+  (mu <= -2.81) are beyond the paper (docs/atmosphere.md#convective-boundary-layer);
+- h / rotor top >= 1.33 (the LES's 1.45 with the h the model gives SBL-6, 199 m);
+- Ro within the LES's range widened to the model's u* of the paper's cases (3.39e4 to 6.27e4),
+  or a ``rossby_range`` the caller documents.
+
+Outside it the wake model is extrapolated (a shallow night, h below the rotor top, sees the
+geostrophic wind above h: docs/atmosphere.md#shallow-boundary-layer): its numbers, and any gain
+computed from them, are not validated.
 """
 
 from __future__ import annotations
@@ -37,20 +46,99 @@ def _mu_sbl6_closure() -> float:
 #: 148.49 and the cooling-rate closure's 169), so that the paper's own SBL-6 case is inside.
 MU_ENVELOPE = max(MU_SBL6_TABLE1, _mu_sbl6_closure())
 
+#: Table 1: the LES cases' stability parameter mu, friction Rossby number u*/(f z0), cooling rate
+#: [K/h] and h [m] (G = 15 m/s, f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s, Theta0 = 265 K).
+TABLE1 = {
+    "CNBL": (0.0, 6.02e4, 0.0, 1157.0),
+    "SBL-1": (5.62, 5.93e4, -0.03, 1032.0),
+    "SBL-2": (20.59, 5.25e4, -0.125, 662.0),
+    "SBL-3": (39.84, 4.58e4, -0.25, 463.0),
+    "SBL-4": (59.25, 4.12e4, -0.375, 361.0),
+    "SBL-5": (78.35, 3.84e4, -0.5, 306.0),
+    "SBL-6": (148.49, 3.39e4, -1.0, 218.0),
+}
+#: The cases whose wakes the paper compares with LES (Section 4.3).
+WAKE_VALIDATED = ("CNBL", "SBL-4", "SBL-5", "SBL-6")
+#: The LES rotor top [m]: hub 100 m + D/2 = 50 m (Section 3.1).
+LES_ROTOR_TOP = 150.0
 
-def validity_report(fmodel) -> pd.DataFrame:
+
+def _paper_cases():
+    """The model's ABL of each Table 1 case (its cooling rate at G = 15 m/s), one vectorised solve."""
+    from floris_ekman_veer.atmosphere.ekman import EkmanABL
+
+    return EkmanABL(geostrophic_wind=15.0, coriolis_parameter=1e-4, roughness_length=0.1,
+                    cooling_rate=np.array([case[2] for case in TABLE1.values()]),
+                    brunt_vaisala_frequency=6.1e-3, reference_potential_temperature=265.0)
+
+
+_MODEL_CASES = _paper_cases()
+#: Each case's two values of mu: Table 1's and the cooling-rate closure's (CNBL 0 and 0 ...
+#: SBL-3 39.84 and 51.56, SBL-4 59.25 and 72.71, ... SBL-6 148.49 and 169.02).
+_CASE_MU = np.array([[case[0] for case in TABLE1.values()],
+                     np.asarray(_MODEL_CASES.stability_parameter, dtype=float)])
+#: Class edges in mu: midway between the larger mu of a case and the smaller of the next, so that
+#: both readings of every case fall in its own class (2.81, 14.4, 34.2, 55.4, 75.5, 120.7).
+CLASS_EDGES = 0.5 * (_CASE_MU.max(axis=0)[:-1] + _CASE_MU.min(axis=0)[1:])
+#: |mu| below this is near-neutral (the CNBL class): the CNBL/SBL-1 edge, half of SBL-1's 5.62.
+MU_NEAR_NEUTRAL = float(CLASS_EDGES[0])
+#: The lower stability parameter of the validated stable wakes: the SBL-3/SBL-4 edge (55.4).
+MU_SBL4 = float(CLASS_EDGES[list(TABLE1).index("SBL-4") - 1])
+#: h / rotor top of the LES (218/150 = 1.45) and of the model's SBL-6 (199/150 = 1.33): the smaller.
+MIN_H_OVER_ROTOR_TOP = min(TABLE1["SBL-6"][3], float(_MODEL_CASES.boundary_layer_height[-1])) / (
+    LES_ROTOR_TOP)
+#: Friction Rossby numbers of Table 1 (3.39e4-6.02e4) widened to the model's u* of the same cases
+#: (3.48e4-6.27e4): 3.39e4 to 6.27e4 (compared with a relative tolerance of 1e-9).
+ROSSBY_RANGE = (
+    min(min(c[1] for c in TABLE1.values()), float(np.min(_MODEL_CASES.friction_rossby_number))),
+    max(max(c[1] for c in TABLE1.values()), float(np.max(_MODEL_CASES.friction_rossby_number))),
+)
+
+
+def stability_class(mu) -> np.ndarray:
+    """The paper's case a stability parameter belongs to (:data:`CLASS_EDGES`): "convective" for
+    mu <= -MU_NEAR_NEUTRAL, "CNBL", "SBL-1".."SBL-6", and "beyond SBL-6" above MU_ENVELOPE."""
+    mu = np.asarray(mu, dtype=float)
+    label = np.array(list(TABLE1), dtype=object)[np.searchsorted(CLASS_EDGES, mu, side="right")]
+    label = np.where(mu <= -MU_NEAR_NEUTRAL, "convective", label)
+    return np.where(mu > MU_ENVELOPE * (1 + 1e-12), "beyond SBL-6", label)
+
+
+def wake_validated_stability(mu) -> np.ndarray:
+    """Whether mu is one of the stabilities whose wakes the paper validates: near-neutral
+    (|mu| < MU_NEAR_NEUTRAL) or SBL-4 to SBL-6 (MU_SBL4 <= mu <= MU_ENVELOPE)."""
+    mu = np.asarray(mu, dtype=float)
+    return (np.abs(mu) < MU_NEAR_NEUTRAL) | (
+        (mu >= MU_SBL4 * (1 - 1e-12)) & (mu <= MU_ENVELOPE * (1 + 1e-12))
+    )
+
+
+def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     """One row per condition of ``fmodel``: the atmosphere against the paper's envelope.
 
     Columns: ``wind_direction``, ``wind_speed`` [m/s at the reference height],
-    ``boundary_layer_height`` h [m], ``rotor_top`` [m] (the highest rotor of the farm),
-    ``h_above_rotor_top`` (bool), ``veer_across_rotor_deg`` (change of wind direction from the
-    lowest rotor bottom to the highest rotor top, positive veering), ``turbulence_intensity``
-    (the ABL's I_u at the farm's mean hub height, Eq. Iu_model), ``stability_parameter`` mu,
-    ``inside_envelope`` (0 <= mu <= :data:`MU_ENVELOPE` = 169 and h above the rotor top).
+    ``boundary_layer_height`` h [m] (z_i in a convective layer), ``rotor_top`` [m] (the highest
+    rotor of the farm), ``h_above_rotor_top`` (bool), ``h_over_rotor_top`` (h / rotor top),
+    ``veer_across_rotor_deg`` (change of wind direction from the lowest rotor bottom to the
+    highest rotor top, positive veering), ``turbulence_intensity`` (the ABL's I_u at the farm's
+    mean hub height, Eq. Iu_model, with the convective variance in a convective layer),
+    ``stability_parameter`` mu, ``obukhov_length`` L [m], ``sensible_heat_flux`` [W/m^2, upward
+    > 0] (the surface heat flux the condition implies), ``friction_rossby_number`` u*/(f z0),
+    ``stability_class`` (:func:`stability_class`), and the four checks
+    ``wake_validated_stability`` (:func:`wake_validated_stability`), ``deep_enough``
+    (h / rotor top >= :data:`MIN_H_OVER_ROTOR_TOP`), ``rossby_in_range`` (within
+    ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three).
 
     Raises:
-        ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report).
+        ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
+            ``rossby_range`` is not two increasing positive numbers.
     """
+    low, high = (float(v) for v in rossby_range)
+    if not (0 < low < high):
+        raise ValueError(
+            f"validity_report: rossby_range must be two positive numbers (low, high) with "
+            f"low < high; got {tuple(rossby_range)!r}"
+        )
     core = fmodel.core
     spec = atmosphere_of(core)
     if spec is None:
@@ -67,7 +155,13 @@ def validity_report(fmodel) -> pd.DataFrame:
     mu = np.broadcast_to(np.asarray(abl.stability_parameter, dtype=float).reshape(-1), h.shape)
     veer = np.asarray(abl.wind_direction_change(bottom, top), dtype=float).reshape(-1)
     ti = np.asarray(abl.turbulence_intensity(float(np.mean(hubs))), dtype=float).reshape(-1)
+    per_condition = lambda value: np.broadcast_to(  # noqa: E731
+        np.asarray(value, dtype=float).reshape(-1), h.shape)
+    rossby = per_condition(abl.friction_rossby_number)
     above = h >= top
+    validated = wake_validated_stability(mu)
+    deep = h / top >= MIN_H_OVER_ROTOR_TOP * (1 - 1e-12)
+    in_range = (rossby >= low * (1 - 1e-9)) & (rossby <= high * (1 + 1e-9))
     return pd.DataFrame({
         "wind_direction": np.asarray(flow_field.wind_directions, dtype=float),
         "wind_speed": np.asarray(flow_field.wind_speeds, dtype=float),
@@ -77,7 +171,15 @@ def validity_report(fmodel) -> pd.DataFrame:
         "veer_across_rotor_deg": veer,
         "turbulence_intensity": ti,
         "stability_parameter": mu,
-        "inside_envelope": above & (mu >= 0.0) & (mu <= MU_ENVELOPE * (1 + 1e-12)),
+        "h_over_rotor_top": h / top,
+        "obukhov_length": per_condition(abl.obukhov_length),
+        "sensible_heat_flux": per_condition(abl.sensible_heat_flux),
+        "friction_rossby_number": rossby,
+        "stability_class": stability_class(mu),
+        "wake_validated_stability": validated,
+        "deep_enough": deep,
+        "rossby_in_range": in_range,
+        "inside_envelope": validated & deep & in_range,
     })
 
 
@@ -87,7 +189,7 @@ def validity_summary(report: pd.DataFrame, label: str = "") -> str:
     n = len(report)
     prefix = f"{label}: " if label else ""
     line = (
-        f"{prefix}{inside} of {n} conditions inside the paper's CNBL..SBL-6 envelope "
+        f"{prefix}{inside} of {n} conditions inside the paper's validated envelope "
         f"(h {report.boundary_layer_height.min():.0f}-{report.boundary_layer_height.max():.0f} m, "
         f"rotor top {report.rotor_top.iloc[0]:.0f} m; veer across the rotor "
         f"{report.veer_across_rotor_deg.min():.1f}-{report.veer_across_rotor_deg.max():.1f} deg; "
@@ -97,5 +199,15 @@ def validity_summary(report: pd.DataFrame, label: str = "") -> str:
     outside = report[~report["inside_envelope"]]
     if len(outside):
         speeds = ", ".join(f"{s:g}" for s in sorted(set(outside.wind_speed)))
-        line += f"; OUTSIDE at {speeds} m/s (results there are extrapolated, not validated)"
+        line += f"; OUTSIDE at {speeds} m/s (results there are extrapolated, not validated"
+        reasons = [
+            text for column, text in (
+                ("wake_validated_stability", "stability not among CNBL, SBL-4..6"),
+                ("deep_enough", f"h below {MIN_H_OVER_ROTOR_TOP:.2f} x rotor top"),
+                ("rossby_in_range", "Ro outside the LES's"),
+            ) if column in outside and not outside[column].all()
+        ]
+        if "stability_class" in outside and (outside.stability_class == "convective").any():
+            reasons.insert(0, "convective: beyond the paper")
+        line += f": {'; '.join(reasons)})" if reasons else ")"
     return line
