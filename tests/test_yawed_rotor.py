@@ -367,3 +367,37 @@ def test_flow_field_carries_the_veer_aware_thrust(veer, yaw, wind_direction):
         sampled = fmodel.sample_flow_at_points(x.ravel(), y.ravel(), z.ravel())[0]
     disk = np.sum(w.ravel() * sampled**3)
     assert rotor == pytest.approx(disk, rel=2e-3)
+
+
+def test_cubature_crossflow_grows_with_the_points():
+    """The ambient moments at a cubature grid's points are the point values themselves, in
+    memory proportional to the points: 9,216 points (a 96 x 96 polar-size grid) and 4
+    conditions stay within a few MB (an identity membership matrix, (n_findex, N, N), was
+    680 MB per condition)."""
+    import tracemalloc
+
+    from floris_ekman_veer.coupling.yawed_rotor import _cells_crossflow
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        fmodel = FlorisModel(FARM)
+        fmodel.set(layout_x=[0.0], layout_y=[0.0], solver_settings={
+            "type": "turbine_cubature_grid", "turbine_grid_points": 3})
+    grid = fmodel.core.grid
+    n_points, n_findex = 9216, 4
+    z = np.linspace(30.0, 150.0, n_points).reshape(1, 1, n_points, 1)
+    grid.z_sorted, grid.sorted_indices = z, np.zeros((1, 1, n_points, 1), dtype=int)
+    abl = EkmanABL.from_reference_wind(np.full((n_findex, 1, 1, 1), 9.0), 90.0,
+                                       **atmosphere("sbl6"))
+    tracemalloc.start()
+    try:
+        moments = _cells_crossflow(abl, 90.0, 90.0, 126.0, 0, (n_findex, 1, n_points, 1), grid)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 30 * n_findex * n_points * 8 * len(MOMENTS)  # ~9 MB, not N^2 (2.7 GB)
+    U, V = abl.hub_aligned_velocity(z.reshape(-1), 90.0)
+    np.testing.assert_allclose(moments["U1"][0, 0, :, 0], U[0, 0, 0] if U.ndim > 1 else U,
+                               rtol=1e-12)
+    np.testing.assert_allclose(moments["UV"][-1].ravel(), np.ravel(U * V)[-n_points:],
+                               rtol=1e-12, atol=1e-15)

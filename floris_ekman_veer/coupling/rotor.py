@@ -96,9 +96,10 @@ class RotorCells:
         weight: (rows, columns) area weights over the disk area, summing to 1.
         area: (n^2,) the cells' areas in this quadrature (exact: 1/n^2 each).
         cell: (rows * columns,) cell index of each sub-point.
-        membership: (rows * columns, n^2) weight of sub-point s in cell k (0 elsewhere).
-        indicator: (rows * columns, n^2) 1 where sub-point s is in cell k.
         row_chord: (rows,) half-chord of the disk at each row height.
+
+    Nothing here is dense in (sub-points x cells): a fine grid's n^2 cells cost memory and work
+    in proportion to the sub-points (:attr:`row_cells`).
     """
 
     n: int
@@ -106,8 +107,6 @@ class RotorCells:
     sub_y: np.ndarray
     weight: np.ndarray
     cell: np.ndarray
-    membership: np.ndarray
-    indicator: np.ndarray
     row_chord: np.ndarray
     area: np.ndarray
 
@@ -124,6 +123,20 @@ class RotorCells:
     def row_start(self) -> np.ndarray:
         """(rows,) position of each row's first sub-point among the sub-points with weight."""
         return np.concatenate([[0], np.cumsum(self.row_width)[:-1]])
+
+    @functools.cached_property
+    def row_cells(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The area weight of each sub-point row in each cell, sparse: ``(row, weight, start)``
+        with one entry per (cell, row) the cell crosses, ordered by cell then row, and
+        ``start`` (n^2,) the first entry of each cell (:func:`row_cell_sums`)."""
+        weight = self.weight.ravel()
+        kept = weight > 0.0
+        row = np.repeat(np.arange(self.rows), self.sub_y.shape[1])[kept]
+        key = self.cell[kept] * self.rows + row
+        keys, inverse = np.unique(key, return_inverse=True)
+        sums = np.bincount(inverse, weights=weight[kept], minlength=keys.size)
+        cells = keys // self.rows
+        return keys % self.rows, sums, np.searchsorted(cells, np.arange(self.n**2))
 
     @functools.cached_property
     def cell_grid(self) -> np.ndarray:
@@ -231,12 +244,16 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
             f"{rows} sub-quadrature rows leave cells of the {n} x {n} turbine grid empty: use "
             "more rows"
         )
-    membership = np.zeros((weight.size, n * n))
-    membership[np.arange(weight.size), cell] = weight
-    indicator = (membership > 0.0).astype(float)
-    return RotorCells(
-        n, row_z, sub_y, weight.reshape(sub_y.shape), cell, membership, indicator, chord, totals
-    )
+    return RotorCells(n, row_z, sub_y, weight.reshape(sub_y.shape), cell, chord, totals)
+
+
+def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
+    """sum over rows of ``values`` (..., rows) times each row's area weight in each cell:
+    (..., n^2). Cost and memory in proportion to the (cell, row) pairs, not rows x n^2; and a
+    segment sum per condition, not a matrix product, so that a condition's numbers do not
+    depend on how many others share its batch (BLAS blocks a product by its size)."""
+    row, weight, start = cells.row_cells
+    return np.add.reduceat(values[..., row] * weight, start, axis=-1)
 
 
 def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.ndarray:
@@ -245,10 +262,9 @@ def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.n
     ``u_rows``: (..., rows); ``moment`` m (1 or 3) broadcasting against ``u_rows[..., 0]``.
     Returns (..., n, n) in FLORIS's point order.
     """
-    row_membership = cells.membership.reshape(cells.rows, -1, cells.n**2).sum(axis=1)
     moment = np.asarray(moment)[..., None]
     powers = np.where(moment == 1.0, u_rows, u_rows**3)
-    mean = powers @ row_membership / cells.area
+    mean = row_cell_sums(powers, cells) / cells.area
     mean = np.where(moment == 1.0, mean, np.cbrt(mean))
     return mean.reshape(*u_rows.shape[:-1], cells.n, cells.n)
 

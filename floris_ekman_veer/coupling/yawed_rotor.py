@@ -52,7 +52,12 @@ from floris_ekman_veer.coupling.crossflow import (
     normal_squares,
     veer_ratio,
 )
-from floris_ekman_veer.coupling.rotor import AMBIENT_NODES, AMBIENT_ROWS, rotor_cells
+from floris_ekman_veer.coupling.rotor import (
+    AMBIENT_NODES,
+    AMBIENT_ROWS,
+    rotor_cells,
+    row_cell_sums,
+)
 
 
 def _plain_method(average_method):
@@ -198,18 +203,18 @@ def _cells_crossflow(abl, reference_height, hub, diameter, turbine, shape, grid)
     if isinstance(grid, TurbineCubatureGrid) and tuple(shape[2:]) == grid.z_sorted.shape[2:]:
         position = int(np.flatnonzero(grid.sorted_indices[0, :, 0, 0] == turbine)[0])
         z = grid.z_sorted[0, position].reshape(-1)
-        membership, area, cells_shape = np.eye(z.size), np.ones(z.size), grid.z_sorted.shape[2:]
+        cell_sums, area, cells_shape = None, 1.0, grid.z_sorted.shape[2:]
     elif len(shape) == 4 and shape[2] == shape[3]:
         cells = rotor_cells(shape[2], AMBIENT_ROWS, AMBIENT_NODES)
         z = hub + 0.5 * diameter * cells.row_z
-        membership = cells.membership.reshape(cells.rows, -1, cells.n**2).sum(axis=1)
+        cell_sums = functools.partial(row_cell_sums, cells=cells)
         area, cells_shape = cells.area, (cells.n, cells.n)
     else:
         return None
     u, v = inflow.ambient_velocity(abl, z.reshape(1, 1, 1, -1), reference_height)
     u, v = (np.broadcast_to(x, (n_findex, 1, 1, z.size)).reshape(n_findex, z.size) for x in (u, v))
     return {name: value.reshape(n_findex, 1, *cells_shape)
-            for name, value in cell_moments(u, v, membership, area).items()}
+            for name, value in cell_moments(u, v, cell_sums, area).items()}
 
 
 @contextlib.contextmanager
