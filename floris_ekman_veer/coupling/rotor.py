@@ -97,6 +97,8 @@ class RotorCells:
         area: (n^2,) the cells' areas in this quadrature (exact: 1/n^2 each).
         cell: (rows * columns,) cell index of each sub-point.
         row_chord: (rows,) half-chord of the disk at each row height.
+        nodes: sub-points per stretch of a row in one cell (each row: stretches of ``nodes``
+            consecutive sub-points, padding included).
 
     Nothing here is dense in (sub-points x cells): a fine grid's n^2 cells cost memory and work
     in proportion to the sub-points (:attr:`row_cells`).
@@ -109,6 +111,7 @@ class RotorCells:
     cell: np.ndarray
     row_chord: np.ndarray
     area: np.ndarray
+    nodes: int = 1
 
     @property
     def rows(self) -> int:
@@ -244,7 +247,8 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
             f"{rows} sub-quadrature rows leave cells of the {n} x {n} turbine grid empty: use "
             "more rows"
         )
-    return RotorCells(n, row_z, sub_y, weight.reshape(sub_y.shape), cell, chord, totals)
+    return RotorCells(n, row_z, sub_y, weight.reshape(sub_y.shape), cell, chord, totals,
+                      nodes_per_interval)
 
 
 def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
