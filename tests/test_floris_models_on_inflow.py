@@ -62,7 +62,7 @@ def run(fmodel, speeds, directions, yaw):
                    turbulence_intensities=np.full(len(speeds), 0.06), yaw_angles=yaw)
     with warnings.catch_warnings():
         # numpy's "invalid value" from an unphysical C_T must not happen: an error here.
-        warnings.simplefilter("error", RuntimeWarning)
+        warnings.filterwarnings("error", message="invalid value", category=RuntimeWarning)
         fmodel.run()
         return fmodel.get_turbine_powers(), fmodel.get_turbine_thrust_coefficients()
 
@@ -107,3 +107,21 @@ def test_issue_reproducer_light_wind_batch():
     alone, _ = run(fmodel, ws[[5]], wd[[5]], yaw[[5]])
     np.testing.assert_array_equal(pair[1], alone[0])
     np.testing.assert_array_equal(powers[[0, 5]], pair)
+
+
+def test_ekman_veer_light_wind_yawed_farm_raises_no_numpy_warning():
+    """The ekman_veer model reads FLORIS's axial induction, 0.5/cos b (1 - sqrt(1 - ct_i cos b)),
+    of the veer-aware thrust: with C_T above 1 numpy warned 'invalid value encountered in sqrt'
+    (floris operation_models.py) once per optimiser run. Light-wind yawed conditions of the
+    reproducer: no RuntimeWarning, finite inductions at most 1/2."""
+    rng = np.random.default_rng(1)
+    wd, ws, yaw = rng.uniform(0, 360, 400), rng.uniform(3, 8, 400), rng.uniform(-30, 30, (400, 9))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fmodel = FlorisModel(FARM)
+    powers, thrust = run(fmodel, ws[:100], wd[:100], yaw[:100])
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message="invalid value", category=RuntimeWarning)
+        induction = fmodel.get_turbine_ais()
+    assert np.all(np.isfinite(powers)) and np.all(np.isfinite(induction))
+    assert np.all(induction * np.cos(np.radians(yaw[:100])) <= 0.5)
