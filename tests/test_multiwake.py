@@ -125,12 +125,18 @@ CASES = {
     "IEA 15 MW row 5 D": ("SBL-6", "iea_15MW", 11.0, ((0, 5, 10, 15), (0, 0, 0, 0)), None),
     "IEA 15 MW side by side +-0.55 D": ("SBL-4", "iea_15MW", 10.0,
                                        ((0, 0, 6), (-0.55, 0.55, 0)), None),
+    # The layer top (135 m) below the hub (150 m): +1.14 to +1.23 % with 24 strips per rotor.
+    "IEA 15 MW 4 x 4 at 7 D, 276 deg": ("SBL-6", "iea_15MW", 9.0,
+                                        (tuple(7.0 * (k // 4) for k in range(16)),
+                                         tuple(7.0 * (k % 4) for k in range(16))), "276"),
 }
 
 
 def _conditions(kind, turbines, speed):
     if kind is None:
         return None
+    if isinstance(kind, str) and kind == "276":
+        return dict(wind_directions=[276.0], wind_speeds=[speed], turbulence_intensities=[0.06])
     if isinstance(kind, str):  # wind turning through the 2 x 3 farm
         directions = [273.0, 280.0, 287.0]
         return dict(wind_directions=directions, wind_speeds=[speed] * 3,
@@ -161,6 +167,21 @@ def test_single_wakes_stay_within_0p2_percent(atmosphere):
     for layout in (((0, 6), (0, 0.35)), ((0, 9), (0, -0.6))):
         errors = power_errors(farm_config(atmosphere, "nrel_5MW", layout), conditions)
         assert np.max(np.abs(errors)) < 0.002, (layout, errors)
+
+
+@pytest.mark.parametrize("atmosphere, speed, layout", [
+    ("SBL-6", 9.0, ((0, 6.96), (0, 0.73))), ("SBL-6", 9.0, ((0, 10), (0, 0.6))),
+    ("SBL-6", 11.0, ((0, 6), (0, 0.35))), ("SBL-4", 9.0, ((0, 6), (0, 0.35)))])
+def test_large_rotor_single_wakes_stay_within_0p2_percent(atmosphere, speed, layout):
+    """IEA 15 MW (D 242 m, hub 150 m), where the stable layer's top lies on the rotor (SBL-6 at
+    9 m/s: h = 135 m, below the hub): the cells' strips are at most 5.25 m thick
+    (rotor.MAX_ROW_SPACING), 47 over the rotor. With 24 (10 m) the errors were +1.14 %,
+    +1.05 %, +0.53 % and +0.42 %."""
+    conditions = dict(wind_directions=[270.0] * 3, wind_speeds=[speed] * 3,
+                      turbulence_intensities=[0.06] * 3,
+                      yaw_angles=np.array([[0.0, 0.0], [20.0, 0.0], [-20.0, 0.0]]))
+    errors = power_errors(farm_config(atmosphere, "iea_15MW", layout, speed), conditions)
+    assert np.max(np.abs(errors)) < 0.002, errors
 
 
 def test_reference_is_converged():

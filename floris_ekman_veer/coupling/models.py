@@ -284,7 +284,8 @@ class RotorAmbient:
 
     @classmethod
     def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
-        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(grid.grid_resolution))
+        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(
+            grid.grid_resolution, float(np.max(grid.turbine_diameters))))
         x, y, z, radius, _ = rotor_geometry(grid)
         kind, heights, u, v = rows_profile(
             lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
