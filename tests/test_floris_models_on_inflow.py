@@ -1,5 +1,5 @@
 """FLORIS's own wake models on the package's inflow and veer-aware rotor: finite and
-batch-independent over the yawed conditions a study meets (docs/yaw_steering.md#thrust-bound).
+batch-independent over the yawed conditions a study meets (docs/yaw_steering.md).
 
 The NREL 5 MW 3 x 3 farm of ``inputs/farm_sbl6.yaml`` (SBL-6) with FLORIS's gauss, GCH, cc,
 jensen and turbopark set-ups (tests/conftest.py EXAMPLE_WAKES): wind speeds 3-25 m/s at 90 m,
