@@ -12,7 +12,11 @@ top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and e
 * said once per study: a warning is repeated only when it concerns wind speeds (or settings) not
   reported yet in this process, so a yaw optimiser's many re-builds and runs, an annual-energy
   study's classes and a script's repeated ``set()`` report each condition once. A recording
-  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh.
+  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh;
+* said by the process the user runs: in ParFlorisModel's worker processes (multiprocessing,
+  concurrent, Dask) the warnings are recorded and travel back with each chunk's result, and the
+  parent reports them as a serial run would (one thrust-limit summary counting all the run's
+  conditions; nothing the parent already said), at the user's line (coupling/parallel.py).
 
 Silencing, for this process and every worker process or Dask worker it starts or sends models
 to::
