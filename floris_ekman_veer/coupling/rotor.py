@@ -422,21 +422,23 @@ class RotorWakes:
 #: grid (``solver.turbine_grid_points``) also refines the cells' quadrature.
 ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
 
-#: ...and strips no thicker than this [m]: the stable layer's features (its top, where the
-#: inflow turns geostrophic, and the veer-sheared wake bands) are tens of metres whatever the
-#: rotor, so a larger rotor needs more strips. 24 strips over the NREL 5 MW's 126 m (5.25 m)
-#: give its single wakes within 0.04 % of the converged reference; the IEA 15 MW's 240 m with
-#: 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its 150 m hub), with 46
-#: by 0.14 % (tests/test_multiwake.py::test_single_wakes_stay_within_0p2_percent).
+#: ...and strips, on the shipped 3 x 3 grid, no thicker than this [m] (a finer or coarser grid
+#: refines or coarsens them in proportion, as above): the stable layer's features (its top,
+#: where the inflow turns geostrophic, and the veer-sheared wake bands) are tens of metres
+#: whatever the rotor, so a larger rotor needs more strips per point. 24 strips over the NREL
+#: 5 MW's 126 m (5.25 m) give its single wakes within 0.04 % of the converged reference; the IEA
+#: 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its
+#: 150 m hub), with 48 by 0.15 % (tests/test_multiwake.py).
 MAX_ROW_SPACING = 126.0 / 24.0
 
 
 def sub_quadrature(n: int, diameter: float = 0.0) -> tuple[int, int]:
     """(rows, nodes per interval) of the wake cells' sub-quadrature for an n x n turbine grid
-    on rotors up to ``diameter`` [m]: ROWS_PER_POINT n rows, more where strips would exceed
-    MAX_ROW_SPACING (a geometric choice: the same for every condition of a batch)."""
-    rows = int(np.ceil(diameter / MAX_ROW_SPACING - 1e-9))
-    return max(ROWS_PER_POINT * n, rows), NODES_PER_INTERVAL
+    on rotors up to ``diameter`` [m]: ROWS_PER_POINT rows per grid point, more on rotors whose
+    3 x 3 grid would have strips thicker than MAX_ROW_SPACING (a geometric choice: the same for
+    every condition of a batch)."""
+    per_point = int(np.ceil(diameter / (3.0 * MAX_ROW_SPACING) - 1e-9))
+    return max(ROWS_PER_POINT, per_point) * n, NODES_PER_INTERVAL
 
 
 def rotor_geometry(grid):
