@@ -12,7 +12,11 @@ top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and e
 * said once per study: a warning is repeated only when it concerns wind speeds (or settings) not
   reported yet in this process, so a yaw optimiser's many re-builds and runs, an annual-energy
   study's classes and a script's repeated ``set()`` report each condition once. A recording
-  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh.
+  context (``warnings.catch_warnings(record=True)``, ``pytest.warns``) starts afresh;
+* said by the process the user runs: in ParFlorisModel's worker processes (multiprocessing,
+  concurrent, Dask) the warnings are recorded and travel back with each chunk's result, and the
+  parent reports them as a serial run would (one thrust-limit summary counting all the run's
+  conditions; nothing the parent already said), at the user's line (coupling/parallel.py).
 
 Silencing, for this process and every worker process or Dask worker it starts or sends models
 to::
@@ -189,7 +193,13 @@ _REPORTED = _Reported()
 
 def warn(message: str, category: type, items=()) -> None:
     """Issue ``message`` at the user's line, unless silenced or every one of its ``items`` (wind
-    speeds, settings; none: the message itself) has been reported before."""
+    speeds, settings; none: the message itself) has been reported before. In a worker process
+    of the parent's ParFlorisModel run, the warning is recorded for the parent instead
+    (:func:`collecting`)."""
+    records = _COLLECTING.get()
+    if records is not None:
+        records.append(("warn", message, category, tuple(items)))
+        return
     if _silenced(category) or not _REPORTED.new(category, tuple(items) or (message,)):
         return
     frame = user_frame()
@@ -236,8 +246,15 @@ def run_scope(wind_speeds, reference_height):
         yield
     finally:
         _RUN.reset(token)
-    if notes:
+    if not notes:
+        return
+    records = _COLLECTING.get()
+    if records is None:
         _issue_thrust_limit(notes, wind_speeds, reference_height)
+        return
+    for limit, (_count, conditions) in notes.items():
+        flagged, total = _flagged(conditions, wind_speeds)
+        records.append(("thrust", limit, flagged, total, reference_height))
 
 
 def note_thrust_limit(heavy, limit: float) -> None:
@@ -259,20 +276,137 @@ def note_thrust_limit(heavy, limit: float) -> None:
         entry[1] = np.zeros(0, dtype=bool)
 
 
-def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
+def _flagged(conditions, wind_speeds):
+    """(wind speeds of the flagged conditions, number of conditions), or (None, None) where the
+    conditions are not those of the run (a full-flow solve of one condition)."""
     import numpy as np
 
-    for limit, (count, conditions) in notes.items():
-        where, items = "", ()
-        if wind_speeds is not None and conditions.size == np.size(wind_speeds):
-            speeds = np.asarray(wind_speeds, dtype=float).reshape(-1)[conditions]
-            where = (f" in {int(conditions.sum())} of {conditions.size} conditions (wind speeds "
-                     f"{speeds_text(speeds)} at {float(reference_height):g} m)")
-            items = tuple(sorted({round(float(s), 6) for s in speeds}))
-        warn(
-            f"turbine wakes{where} have C_T cos^2(yaw) > {limit:g}, beyond momentum "
-            f"theory: evaluated at C_T cos^2(yaw) = {limit:g} "
-            "(wake.wake_velocity_parameters.ekman_veer.max_thrust_coefficient; "
-            "docs/conventions.md#thrust-coefficient-and-yaw)",
-            ThrustLimitWarning, items,
-        )
+    if wind_speeds is None or conditions.size != np.size(wind_speeds):
+        return None, None
+    speeds = np.asarray(wind_speeds, dtype=float).reshape(-1)[conditions]
+    return [float(v) for v in speeds], int(conditions.size)
+
+
+def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
+    for limit, (_count, conditions) in notes.items():
+        _warn_thrust_limit(limit, *_flagged(conditions, wind_speeds), reference_height)
+
+
+def _warn_thrust_limit(limit, flagged, total, reference_height) -> None:
+    where, items = "", ()
+    if flagged is not None:
+        where = (f" in {len(flagged)} of {total} conditions (wind speeds "
+                 f"{speeds_text(flagged)} at {float(reference_height):g} m)")
+        items = tuple(sorted({round(float(s), 6) for s in flagged}))
+    warn(
+        f"turbine wakes{where} have C_T cos^2(yaw) > {limit:g}, beyond momentum "
+        f"theory: evaluated at C_T cos^2(yaw) = {limit:g} "
+        "(wake.wake_velocity_parameters.ekman_veer.max_thrust_coefficient; "
+        "docs/conventions.md#thrust-coefficient-and-yaw)",
+        ThrustLimitWarning, items,
+    )
+
+
+# -------------------------------------------------------------------- from worker processes
+#: Set while a worker process runs a chunk of the parent's conditions: the warnings of the
+#: chunk, recorded (:func:`warn`) to travel back with its result.
+_COLLECTING: contextvars.ContextVar = contextvars.ContextVar("floris_ekman_veer_collecting",
+                                                             default=None)
+#: Records that arrived with workers' results in this process, not yet reported.
+_ARRIVED: list = []
+
+
+def in_worker_process() -> bool:
+    """Whether this process was started by another (a multiprocessing, concurrent.futures or
+    Dask worker)."""
+    import multiprocessing
+
+    return multiprocessing.parent_process() is not None
+
+
+@contextlib.contextmanager
+def collecting():
+    """Record the package's warnings (and the per-run thrust-limit notes) instead of issuing
+    them, in a worker process; yields the list of records (None in the main process, where
+    warnings are issued as usual)."""
+    if not in_worker_process():
+        yield None
+        return
+    records: list = []
+    token = _COLLECTING.set(records)
+    try:
+        yield records
+    finally:
+        _COLLECTING.reset(token)
+
+
+def _arrive(records):
+    _ARRIVED.append(records)
+
+
+class WorkerRecords:
+    """The records of a worker's chunk, attached to its result: unpickled in the parent, they
+    join the records to report (:func:`report_from_workers`)."""
+
+    def __init__(self, records):
+        self.records = records
+
+    def __reduce__(self):
+        return _arrive, (self.records,)
+
+
+def _arrive_with(array, records):
+    _ARRIVED.append(records)
+    return array
+
+
+class _RecordsArray:
+    """Pickles an array result as the plain array, with the records arriving beside it."""
+
+    def __init__(self, array, records):
+        self.array, self.records = array, records
+
+    def __reduce__(self):
+        return _arrive_with, (self.array, self.records)
+
+
+def carrying(result, records):
+    """A worker's result that brings its warning ``records`` to the parent when unpickled
+    there."""
+    if not records:
+        return result
+    if hasattr(result, "__array__") and not hasattr(result, "__dict__"):
+        return _RecordsArray(result, records)
+    result._floris_ekman_veer_warnings = WorkerRecords(records)
+    return result
+
+
+def discard_from_workers() -> None:
+    """Forget records left by an earlier, failed parallel run."""
+    _ARRIVED.clear()
+
+
+def report_from_workers(n_conditions: int | None = None) -> None:
+    """Issue, at the user's line, what the workers of the parallel run just finished recorded:
+    each warning once (the parent's own reports count: a warning the parent already gave is not
+    repeated), and one thrust-limit summary over all chunks, out of the parent's
+    ``n_conditions``."""
+    arrived = [record for records in _ARRIVED for record in records]
+    _ARRIVED.clear()
+    thrust: dict = {}
+    for record in arrived:
+        if record[0] == "warn":
+            warn(*record[1:])
+            continue
+        _, limit, flagged, total, reference_height = record
+        entry = thrust.setdefault(limit, [[], 0, reference_height, True])
+        if flagged is None:
+            entry[3] = False
+        else:
+            entry[0].extend(flagged)
+            entry[1] += total
+    for limit, (flagged, total, reference_height, counted) in thrust.items():
+        if counted:
+            _warn_thrust_limit(limit, flagged, n_conditions or total, reference_height)
+        else:
+            _warn_thrust_limit(limit, None, None, reference_height)

@@ -330,3 +330,74 @@ def test_each_turbine_type_sees_its_own_rotor_layer():
     assert alone_low[0] != pytest.approx(alone_low[1], rel=1e-2)
     with pytest.raises(ValueError, match="Two different turbine definitions have the same name"):
         powers([low, {**low, "hub_height": 120.0}], [0.0, 2000.0], [[0.0, 0.0]] * 2)
+
+
+# ----------------------------------------------------------------- flow fields and turbines
+@pytest.mark.parametrize("veer", [True, False], ids=["M-1", "M-2"])
+@pytest.mark.parametrize("yaw", [20.0, -20.0])
+@pytest.mark.parametrize("wind_direction", [270.0, 275.0])
+def test_flow_field_carries_the_veer_aware_thrust(veer, yaw, wind_direction):
+    """FLORIS's full-flow solve (sample_flow_at_points, planes) runs the same veer-aware rotor
+    as the turbine solve: the rotor average of an NREL 5 MW 7 D behind a front yawed by +-20 deg
+    (SBL-6, 9 m/s) equals, in power (the cube of FLORIS's cubic mean), the disk integral of the
+    front's wake sampled with sample_flow_at_points (polar Gauss quadrature, 48 x 96) to 0.2 %.
+    Before the full-flow solve ran the veer-aware rotor: 1.0 % (M-2, 270 deg) and 2.2 %
+    (M-2, 275 deg), since its wake carried the cosine law's C_T."""
+    config = copy.deepcopy(load_yaml(FARM))
+    config["wake"]["wake_deflection_parameters"]["ekman_veer"]["veer"] = veer
+    D, hub = 126.0, 90.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        fmodel = FlorisModel(config)
+        fmodel.set(layout_x=[0.0, 7 * D], layout_y=[0.0, 0.0], wind_directions=[wind_direction],
+                   wind_speeds=[9.0], turbulence_intensities=[0.06], yaw_angles=[[yaw, 0.0]])
+        fmodel.run()
+        rotor = fmodel.turbine_average_velocities[0, 1] ** 3
+        fmodel.set(layout_x=[0.0], layout_y=[0.0], yaw_angles=[[yaw]])
+        z, w = polar_disk(hub, D / 2, n_r=48, n_theta=96)
+        # The second rotor faces the wind: its plane is normal to the wind direction.
+        wd = np.radians(wind_direction)
+        x0, y0 = 7 * D, 0.0
+        r = np.polynomial.legendre.leggauss(48)[0] * 0.5 + 0.5
+        theta = (np.arange(96) + 0.5) * 2.0 * np.pi / 96
+        across = (D / 2) * np.outer(r, np.cos(theta))
+        # Flow direction (-sin wd, -cos wd); the rotor's lateral axis is normal to it.
+        x = x0 + across * np.cos(wd)
+        y = y0 - across * np.sin(wd)
+        sampled = fmodel.sample_flow_at_points(x.ravel(), y.ravel(), z.ravel())[0]
+    disk = np.sum(w.ravel() * sampled**3)
+    assert rotor == pytest.approx(disk, rel=2e-3)
+
+
+def test_cubature_crossflow_grows_with_the_points():
+    """The ambient moments at a cubature grid's points are the point values themselves, in
+    memory proportional to the points: 9,216 points (a 96 x 96 polar-size grid) and 4
+    conditions stay within a few MB (an identity membership matrix, (n_findex, N, N), was
+    680 MB per condition)."""
+    import tracemalloc
+
+    from floris_ekman_veer.coupling.yawed_rotor import _cells_crossflow
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+        fmodel = FlorisModel(FARM)
+        fmodel.set(layout_x=[0.0], layout_y=[0.0], solver_settings={
+            "type": "turbine_cubature_grid", "turbine_grid_points": 3})
+    grid = fmodel.core.grid
+    n_points, n_findex = 9216, 4
+    z = np.linspace(30.0, 150.0, n_points).reshape(1, 1, n_points, 1)
+    grid.z_sorted, grid.sorted_indices = z, np.zeros((1, 1, n_points, 1), dtype=int)
+    abl = EkmanABL.from_reference_wind(np.full((n_findex, 1, 1, 1), 9.0), 90.0,
+                                       **atmosphere("sbl6"))
+    tracemalloc.start()
+    try:
+        moments = _cells_crossflow(abl, 90.0, 90.0, 126.0, 0, (n_findex, 1, n_points, 1), grid)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 30 * n_findex * n_points * 8 * len(MOMENTS)  # ~9 MB, not N^2 (2.7 GB)
+    U, V = abl.hub_aligned_velocity(z.reshape(-1), 90.0)
+    np.testing.assert_allclose(moments["U1"][0, 0, :, 0], U[0, 0, 0] if U.ndim > 1 else U,
+                               rtol=1e-12)
+    np.testing.assert_allclose(moments["UV"][-1].ravel(), np.ravel(U * V)[-n_points:],
+                               rtol=1e-12, atol=1e-15)

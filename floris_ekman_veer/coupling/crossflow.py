@@ -50,14 +50,14 @@ def ambient_crossflow(power_thrust_table, velocities):
 MOMENTS = ("U1", "U3", "V", "UV", "VV", "UUV", "UVV", "VVV")
 
 
-def cell_moments(u_rows, v_rows, row_membership, area):
-    """The :data:`MOMENTS` of each cell from U, V at sub-point rows: ``u_rows``, ``v_rows``
-    (..., rows); ``row_membership`` (rows, cells) the area weight of each row in each cell."""
+def cell_moments(u_rows, v_rows, cell_sums=None, area=1.0):
+    """The :data:`MOMENTS` of each cell from U, V at sub-point rows ``u_rows``, ``v_rows``
+    (..., rows): ``cell_sums(values)`` sums the rows' area weights into each cell (e.g.
+    :func:`~floris_ekman_veer.coupling.rotor.row_cell_sums`), of total ``area`` per cell; None:
+    every row is a cell of its own (the points of a cubature grid), the moments are point
+    values, in O(points) work and memory."""
     def mean(values):
-        # A sum per condition, not a matrix product: BLAS may round a row differently with
-        # the number of conditions, and a condition's numbers must not depend on its batch
-        # (ParFlorisModel chunks, the optimisers' tiled conditions).
-        return np.sum(values[..., :, None] * row_membership, axis=-2) / area
+        return values if cell_sums is None else cell_sums(values) / area
 
     return {
         "U1": mean(u_rows), "U3": np.cbrt(mean(u_rows**3)), "V": mean(v_rows),

@@ -284,7 +284,8 @@ class RotorAmbient:
 
     @classmethod
     def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
-        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(grid.grid_resolution))
+        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(
+            grid.grid_resolution, float(np.max(grid.turbine_diameters))))
         x, y, z, radius, _ = rotor_geometry(grid)
         kind, heights, u, v = rows_profile(
             lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
@@ -529,7 +530,10 @@ class _EkmanWakeModel(BaseModel):
                 return result.reshape(u_initial.shape)
         if rows_at is None:
             # Another deflection model: its centre at the point rows, interpolated in height.
-            centre = deflection_field_i[f, j, 0, :] @ row_interpolation(cells.n, cells.row_z)
+            # (A sum over the n points, not a matrix product: BLAS would block the product by
+            # the number of pairs, i.e. by the batch.)
+            centre = np.sum(deflection_field_i[f, j, 0, :, None]
+                            * row_interpolation(cells.n, cells.row_z), axis=1)
         else:
             # In chunks of rotors, so that the deflection's temporaries stay small.
             centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
@@ -549,8 +553,13 @@ class _EkmanWakeModel(BaseModel):
         flat = f * n_turbines + j
         moment = rotor.moment[f, j]
         n2 = cells.n**2
-        removed = np.zeros(f.size * n2)
-        overlap = np.zeros(f.size) if track else None
+        # Per entry (a pair's row): the moment removed on each cell stretch the row crosses
+        # and the row's overlap, summed into the pairs' cells once after the loop, in entry
+        # order (a pair's rows in ascending order): a condition's sums then do not depend on
+        # the grouping and chunking below, which depend on the whole batch.
+        nodes = cells.nodes
+        stretches = np.zeros((p.size, cells.sub_y.shape[1] // nodes))
+        row_overlap = np.zeros(p.size) if track else None
         # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
         # padding; few: all at once (the padding costs less than more calls).
         widths = cells.row_width[r]
@@ -585,19 +594,18 @@ class _EkmanWakeModel(BaseModel):
                 # No flow (at and below z0): no wake.
                 ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
                 du = self.sub_point_deficit(wake) * pair["hub_speed"]
-                removed += np.bincount(
-                    (pe[:, None] * n2 + cells.cell_grid[re, :width]).ravel(),
-                    weights=wakes.superpose(flat[pe], re, du, ambient_u,
-                                            moment[pe][:, None]).ravel(),
-                    minlength=removed.size)
+                stretches[chunk, :width // nodes] = wakes.superpose(
+                    flat[pe], re, du, ambient_u, moment[pe][:, None],
+                ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
                 if track:
                     # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
                     # rotor laterally, here as the area of the disk where it holds.
                     inside = (du > WAKE_OVERLAP_VELOCITY) & (
                         np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
-                    overlap += np.bincount(
-                        pe, weights=np.sum(cells.weight[re, :width] * inside, axis=1),
-                        minlength=f.size)
+                    row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+        removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
+                              weights=stretches.ravel(), minlength=f.size * n2)
+        overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None
         u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
         result[f[reached], j[reached]] = wakes.cell_returns(
             flat[reached], removed.reshape(f.size, n2)[reached], u_cell,

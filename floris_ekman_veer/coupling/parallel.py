@@ -90,9 +90,45 @@ def _splitting_preprocessing(method):
     return wrapper
 
 
+#: FLORIS's functions that run a chunk of conditions in a worker process.
+_WORKER_FUNCTIONS = ("_parallel_run", "_parallel_run_powers_only",
+                     "_parallel_sample_flow_at_points", "_parallel_sample_ti_at_points")
+
+
+def _recording_worker(function):
+    """A worker's chunk: the package's warnings are recorded and travel back with the result,
+    for the parent to report once at the user's line (floris_ekman_veer.warnings), instead of
+    being printed by each worker at the pool's frame with the worker's share of the counts."""
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with package_warnings.collecting() as records:
+            result = function(*args, **kwargs)
+        return package_warnings.carrying(result, records)
+
+    return wrapper
+
+
+def _reporting_parent(method):
+    """ParFlorisModel.run / _sample_value_at_points: report what the workers recorded."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        package_warnings.discard_from_workers()
+        result = method(self, *args, **kwargs)
+        package_warnings.report_from_workers(self.core.flow_field.n_findex)
+        return result
+
+    return wrapper
+
+
 def install_parallel_hook() -> None:
-    """Wrap ParFlorisModel's condition splitting (idempotent; ``register()`` calls it;
+    """Wrap ParFlorisModel's condition splitting, its worker functions and the parent's
+    reporting of the workers' warnings (idempotent; ``register()`` calls it;
     ``uninstall_inflow_hook`` restores it with the other patches)."""
+    import floris.par_floris_model as par
     from floris.par_floris_model import ParFlorisModel
 
     _patch(ParFlorisModel, "_preprocessing", _splitting_preprocessing)
+    for name in ("run", "_sample_value_at_points"):
+        _patch(ParFlorisModel, name, _reporting_parent)
+    for name in _WORKER_FUNCTIONS:  # (a module has a __dict__ as a class has)
+        _patch(par, name, _recording_worker)

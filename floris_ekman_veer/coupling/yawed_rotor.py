@@ -36,6 +36,7 @@ import functools
 import inspect
 
 import numpy as np
+from floris.core.farm import Farm
 from floris.core.grid import TurbineCubatureGrid
 from floris.core.rotor_velocity import average_velocity
 from floris.core.turbine.operation_models import CosineLossTurbine
@@ -51,7 +52,12 @@ from floris_ekman_veer.coupling.crossflow import (
     normal_squares,
     veer_ratio,
 )
-from floris_ekman_veer.coupling.rotor import AMBIENT_NODES, AMBIENT_ROWS, rotor_cells
+from floris_ekman_veer.coupling.rotor import (
+    AMBIENT_NODES,
+    AMBIENT_ROWS,
+    rotor_cells,
+    row_cell_sums,
+)
 
 
 def _plain_method(average_method):
@@ -111,9 +117,33 @@ def _veer_aware(original, kind):
             ratio = power_veer_ratio(*common)
             arguments["velocities"] = velocities * ratio[(...,) + (None,) * (velocities.ndim - 2)]
             return original(**arguments, **extra)
-        return original(**arguments, **extra) * thrust_veer_ratio(*common)
+        cosine_law = original(**arguments, **extra)
+        return bounded_thrust(cosine_law * thrust_veer_ratio(*common), cosine_law,
+                              arguments["yaw_angles"])
 
     return wrapper
+
+
+#: FLORIS's cosine-loss model clips the table's C_T to [0.0001, 0.9999] before it multiplies by
+#: cos(beta): momentum theory's largest thrust coefficient (a = 1/2) less a margin that keeps
+#: every wake model's sqrt(1 - ct_i) and sqrt(1 - ct_i cos beta) real.
+MAX_THRUST_COEFFICIENT = 0.9999
+
+
+def bounded_thrust(veer_aware, cosine_law, yaw_angles):
+    """The veer-aware ct_i with its C_T = ct_i / cos(beta) held to FLORIS's own clip.
+
+    The ratio <u_n^2>/<(U cos beta)^2> raises ct_i above the cosine law's on the side facing the
+    veered wind; where the table's C_T is already near its clip (light wind) the product would
+    leave momentum theory (C_T > 1: a > 1/2, the far wake flowing backwards) and FLORIS's gauss,
+    GCH, cc and turbopark take the root of 1 - ct_i (NaN). So the veer-aware C_T is clipped as
+    FLORIS clips the table's: ct_i <= 0.9999 cos(beta), and never below the cosine law's own
+    ct_i (FLORIS's tilt correction may put that slightly above; it stays FLORIS's). Elementwise:
+    a condition's thrust does not depend on the rest of its batch.
+    """
+    yaw = np.asarray(yaw_angles, dtype=float)
+    ceiling = MAX_THRUST_COEFFICIENT * np.cos(np.radians(yaw))
+    return np.minimum(veer_aware, np.maximum(cosine_law, ceiling))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -122,35 +152,46 @@ def _veer_aware(original, kind):
 
 def crossflow_lookup(core):
     """The look-up of :data:`~floris_ekman_veer.coupling.crossflow.CROSSFLOW` for a Core, or
-    None without an atmosphere. V cells are computed once per (turbine table, shape)."""
+    None without an atmosphere. V cells are computed once per (rotor, shape).
+
+    A table is known by identity: the Core's farm's tables, and those of every farm initialised
+    while the Core solves (:func:`_registering_farm`). FLORIS's full-flow solvers (planes,
+    ``sample_flow_at_points``) pre-solve the turbines on a deep copy of the farm whose tables
+    are new objects; registered, they get the same V cells, so a flow field carries the wakes of
+    the thrust the turbine powers see.
+    """
     spec = inflow.atmosphere_of(core)
     if spec is None or not core.flow_field.n_findex:
         return None
-    farm, flow_field = core.farm, core.flow_field
-    rotors: dict[int, set] = {}
-    for index, turbine in enumerate(farm.turbine_map):
-        table = farm.turbine_power_thrust_tables[turbine.turbine_type]
-        tables = [table] + [t for t in table.values() if isinstance(t, dict)]
-        for t in tables:
-            rotors.setdefault(id(t), set()).add(
-                (float(turbine.hub_height), float(turbine.rotor_diameter), index))
+    flow_field = core.flow_field
+    rotors: dict[int, tuple] = {}  # id(table) -> (table, {(hub, diameter, turbine index)})
+
+    def add_farm(farm):
+        for index, turbine in enumerate(farm.turbine_map):
+            table = farm.turbine_power_thrust_tables[turbine.turbine_type]
+            for t in [table] + [t for t in table.values() if isinstance(t, dict)]:
+                # Holding the table keeps its id from being reused while the look-up lives.
+                rotors.setdefault(id(t), (t, set()))[1].add(
+                    (float(turbine.hub_height), float(turbine.rotor_diameter), index))
+
+    add_farm(core.farm)
     cache: dict = {}
 
     def lookup(power_thrust_table, shape):
-        key = (id(power_thrust_table), tuple(shape))
-        if key in cache:
-            return cache[key]
-        found = rotors.get(id(power_thrust_table))
-        if not found:
+        entry = rotors.get(id(power_thrust_table))
+        if entry is None or entry[0] is not power_thrust_table:
             return None
         # FLORIS allows one definition per turbine_type name: one hub height and diameter.
-        hub, diameter = next(iter(found))[:2]
-        turbine = min(index for _, _, index in found)
-        abl = inflow.solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)
-        cache[key] = _cells_crossflow(abl, flow_field.reference_wind_height, hub, diameter,
-                                      turbine, shape, core.grid)
+        hub, diameter = next(iter(entry[1]))[:2]
+        turbine = min(index for _, _, index in entry[1])
+        key = (hub, diameter, turbine, tuple(shape))
+        if key not in cache:
+            abl = inflow.solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)
+            cache[key] = _cells_crossflow(abl, flow_field.reference_wind_height, hub, diameter,
+                                          turbine, shape, core.grid)
         return cache[key]
 
+    lookup.add_farm = add_farm
     return lookup
 
 
@@ -162,18 +203,18 @@ def _cells_crossflow(abl, reference_height, hub, diameter, turbine, shape, grid)
     if isinstance(grid, TurbineCubatureGrid) and tuple(shape[2:]) == grid.z_sorted.shape[2:]:
         position = int(np.flatnonzero(grid.sorted_indices[0, :, 0, 0] == turbine)[0])
         z = grid.z_sorted[0, position].reshape(-1)
-        membership, area, cells_shape = np.eye(z.size), np.ones(z.size), grid.z_sorted.shape[2:]
+        cell_sums, area, cells_shape = None, 1.0, grid.z_sorted.shape[2:]
     elif len(shape) == 4 and shape[2] == shape[3]:
         cells = rotor_cells(shape[2], AMBIENT_ROWS, AMBIENT_NODES)
         z = hub + 0.5 * diameter * cells.row_z
-        membership = cells.membership.reshape(cells.rows, -1, cells.n**2).sum(axis=1)
+        cell_sums = functools.partial(row_cell_sums, cells=cells)
         area, cells_shape = cells.area, (cells.n, cells.n)
     else:
         return None
     u, v = inflow.ambient_velocity(abl, z.reshape(1, 1, 1, -1), reference_height)
     u, v = (np.broadcast_to(x, (n_findex, 1, 1, z.size)).reshape(n_findex, z.size) for x in (u, v))
     return {name: value.reshape(n_findex, 1, *cells_shape)
-            for name, value in cell_moments(u, v, membership, area).items()}
+            for name, value in cell_moments(u, v, cell_sums, area).items()}
 
 
 @contextlib.contextmanager
@@ -195,6 +236,20 @@ def _with_crossflow(method):
     return wrapper
 
 
+def _registering_farm(method):
+    """Farm.initialize: a farm initialised while a Core solves (the full-flow solvers' deep
+    copy) joins the Core's crossflow look-up."""
+    @functools.wraps(method)
+    def wrapper(self, *args, **kwargs):
+        result = method(self, *args, **kwargs)
+        lookup = CROSSFLOW.get()
+        if lookup is not None:
+            lookup.add_farm(self)
+        return result
+
+    return wrapper
+
+
 def install_yawed_rotor_hook() -> None:
     """The veer-aware rotor on by default (idempotent): FLORIS's cosine-loss power and thrust
     read the crossflow; Core solves (through the inflow hook's Core wrappers) and FlorisModel's
@@ -203,5 +258,6 @@ def install_yawed_rotor_hook() -> None:
         inflow._patch(CosineLossTurbine, name, lambda original, kind=kind: _veer_aware(original, kind))
     for name in ("_get_turbine_powers", "get_turbine_thrust_coefficients", "get_turbine_ais"):
         inflow._patch(FlorisModel, name, _with_crossflow)
+    inflow._patch(Farm, "initialize", _registering_farm)
     if veer_aware not in inflow.CORE_CONTEXTS:
         inflow.CORE_CONTEXTS.append(veer_aware)
