@@ -60,6 +60,9 @@ DEFAULT_DIRECTION_NOISE = 1.0
 DEFAULT_REFUSAL_PROBABILITY = 1e-6
 #: Starting Obukhov lengths [m] of the multi-start (inf: neutral).
 STARTING_OBUKHOV_LENGTHS = (np.inf, 400.0, 200.0, 100.0, 50.0, 25.0)
+#: Starting Obukhov lengths [m] of the second, dense start of records the first one leaves
+#: refused: 40 from 10 m to 2 km, geometric.
+RESTART_OBUKHOV_LENGTHS = tuple(np.geomspace(10.0, 2000.0, 40))
 #: Factors on the best end point's 1/L of the restarts across the profile's step near h.
 _POLISH_FACTORS = (0.9, 0.97, 1.03, 1.1)
 #: ... for records whose fitted ABL top is below this times their highest measurement.
@@ -230,6 +233,16 @@ class ProfileFit:
         r, observations, _ = _normalised_residuals(speed, angle, speeds, directions,
                                                 self.speed_noise, self.direction_noise)
         return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted), 1)
+
+    def reason(self, i):
+        """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
+        for a record that fits, its kind is whatever its data look like)."""
+        hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
+                                                        np.shape(self.misfit)), -1)[i])
+        return misfit_reason(self.heights[i], self.speeds[i],
+                             None if self.directions is None else self.directions[i],
+                             self.speed_noise, self.direction_noise, hemisphere,
+                             np.reshape(self.roughness_length, -1)[i])
 
     def subset(self, index):
         """The fitted EkmanABL of records ``index`` only (shape (len(index),)), with its
@@ -631,11 +644,16 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
 
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
                           float(speed_noise), float(direction_noise))
+    from scipy.stats import chi2
+
+    dof = np.maximum(observations - n_unknowns, 1)
+    misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
     x, cost, converged, iterations = _multistart(model, n, max_iterations)
+    _restart_misfits(model, x, cost, converged, iterations, misfit_tolerance**2 * dof,
+                     max_iterations)
     index = np.arange(n)
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
-    dof = np.maximum(observations - n_unknowns, 1)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
     speed_rms = np.sqrt(np.sum(r[:, :m] ** 2, axis=1) / valid_speeds) * speed_noise
     if directions is None:
@@ -643,9 +661,6 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     else:
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
         direction_rms = np.sqrt(np.sum(r[:, m:] ** 2, axis=1) / count) * direction_noise
-    from scipy.stats import chi2
-
-    misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
     fits = misfit <= misfit_tolerance
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
@@ -754,6 +769,27 @@ def _multistart(model, n, max_iterations):
     return x, cost, converged, iterations
 
 
+def _restart_misfits(model, x, cost, converged, iterations, refused_cost, max_iterations):
+    """Records whose best end point the chi-square test would refuse start again from a dense
+    set of stabilities (:data:`RESTART_OBUKHOV_LENGTHS`): in a strongly stable light wind the
+    objective's valleys, between the kinks where h crosses a measurement height, are narrower
+    than the multi-start's spacing. Only the refused records pay for it; in place."""
+    refused = np.flatnonzero(~(cost <= refused_cost))
+    if refused.size == 0:
+        return
+    sub = _SubsetModel(model, refused)
+    lams = _LENGTH_SCALE / np.asarray(RESTART_OBUKHOV_LENGTHS)
+    k = lams.size
+    x2, cost2, converged2, iterations2 = _levenberg_marquardt(
+        model, _starts(sub, np.broadcast_to(lams, (refused.size, k))), max_iterations,
+        np.repeat(refused, k))
+    pick = _best(x2, cost2, refused.size, k)
+    better = cost2[pick] < cost[refused] * (1.0 - 1e-6) - 1e-12
+    chosen = refused[better]
+    x[chosen], cost[chosen] = x2[pick][better], cost2[pick][better]
+    converged[chosen], iterations[chosen] = converged2[pick][better], iterations2[pick][better]
+
+
 class _SubsetModel:
     """The data of some records of a `_ProfileModel`, for `_starts`."""
 
@@ -762,55 +798,93 @@ class _SubsetModel:
         self.z0, self.kappa, self.fit_roughness = model.z0[index], model.kappa, model.fit_roughness
 
 
-def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability):
-    i = int(failing[0])
-    order = np.argsort(heights[i])
-    z, s = heights[i][order], speeds[i][order]
-    reasons = []
+#: Below this speed [m/s] at every height a record is calm: cup anemometers and vanes start
+#: at about 0.5 to 1 m/s, and a vane below it points anywhere.
+CALM_SPEED = 1.0
+
+
+def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hemisphere,
+                  roughness_length):
+    """(kind, text): why one record (heights, speeds, directions or None: its data) fits no
+    atmosphere of the model, as a person reads it. ``hemisphere``: the sign of the Coriolis
+    parameter.
+
+    Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``convective``
+    (less shear between the lowest and highest speeds than the neutral surface layer's log
+    law, by more than three standard deviations of the noise: an unstable layer, a class the
+    model does not have), ``backing`` (the direction turns the other way than an Ekman layer),
+    ``falling speeds``, ``misfit``.
+    """
+    order = np.argsort(heights)
+    z, s = heights[order], speeds[order]
     ok = np.isfinite(s)
     zs, ss = z[ok], s[ok]
-    if zs.size >= 2:
-        drops = ss[1:] - ss[:-1]
-        j = int(np.argmin(drops))
-        if ss[-1] < ss[0] - 2.0 * model.sigma_s:
-            reasons.append(f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to "
-                           f"{ss[-1]:.3g} m/s at {zs[-1]:.4g} m (the model's wind grows with "
-                           "height from the ground up to its low-level jet)")
-        elif drops[j] < -2.0 * model.sigma_s and j == 0:
-            reasons.append(f"the speed falls with height from {zs[0]:.4g} m to {zs[1]:.4g} m by "
-                           f"{-drops[0]:.3g} m/s")
+    if zs.size and np.max(ss) < CALM_SPEED:
+        return "calm", (f"calm: every speed below {CALM_SPEED:g} m/s (at most {np.max(ss):.2g} "
+                        "m/s), where the vanes point anywhere and the layer has no Ekman profile")
+    if zs.size >= 2 and ss[0] > 0:
+        log_law = np.log(zs[-1] / roughness_length) / np.log(zs[0] / roughness_length)
+        spread = 3.0 * speed_noise * np.hypot(1.0, ss[-1] / ss[0]) / ss[0]
+        if ss[-1] / ss[0] < log_law - spread:
+            return "convective", (
+                f"less shear than a neutral boundary layer, the least the model has (the speed "
+                f"grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to {zs[-1]:.4g} m, the "
+                f"neutral log law {log_law:.3g} times): an unstable (convective) layer, outside "
+                "the model's classes (neutral CNBL and stable SBL)")
     if directions is not None:
-        d = directions[i][order]
+        d = directions[order]
         okd = np.isfinite(d)
         zd, dd = z[okd], d[okd]
         if zd.size >= 2:
             change = _wrap(dd[-1] - dd[0])
-            hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
             north = hemisphere > 0
-            if hemisphere * change < -2.0 * model.sigma_d:
-                reasons.append(
+            # (beyond three standard deviations of a difference of two vane readings)
+            if hemisphere * change < -3.0 * np.sqrt(2.0) * direction_noise:
+                return "backing", (
                     f"the direction {'backs' if north else 'veers'} with height by "
-                    f"{abs(change):.3g} deg from {zd[0]:.4g} m to {zd[-1]:.4g} m (an Ekman layer "
-                    f"in the {'northern' if north else 'southern'} hemisphere "
+                    f"{abs(change):.3g} deg from {zd[0]:.4g} m to {zd[-1]:.4g} m (a front or "
+                    f"cold-air advection; an Ekman layer in the "
+                    f"{'northern' if north else 'southern'} hemisphere "
                     f"{'veers' if north else 'backs'}: the direction turns "
                     f"{'clockwise' if north else 'anticlockwise'} with height)"
                 )
-    if not reasons:
-        reasons.append("the shape of its profile is outside the model's (speed and direction "
-                       "change together set u*, L and z0; a profile kinked beyond the model's, "
-                       "or directions turning more than its stability allows with that shear)")
+    if zs.size >= 2:
+        drops = ss[1:] - ss[:-1]
+        if ss[-1] < ss[0] - 2.0 * speed_noise:
+            return "falling speeds", (
+                f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to {ss[-1]:.3g} m/s at "
+                f"{zs[-1]:.4g} m (the model's wind grows with height from the ground up to its "
+                "low-level jet)")
+        if drops[0] < -2.0 * speed_noise:
+            return "falling speeds", (f"the speed falls with height from {zs[0]:.4g} m to "
+                                      f"{zs[1]:.4g} m by {-drops[0]:.3g} m/s")
+    return "misfit", ("the shape of its profile is outside the model's (speed and direction "
+                      "change together set u*, L and z0; a profile kinked beyond the model's, "
+                      "or directions turning more than its stability allows with that shear)")
+
+
+def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
+                  model, tolerance, probability):
+    i = int(failing[0])
+    hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
+    _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
+                              model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
     more = ""
     if failing.size > 1:
         shown = ", ".join(str(labels[k]) for k in failing[1:6])
         more = (f"; {failing.size - 1} more record(s) fail ({shown}"
                 f"{', ...' if failing.size > 6 else ''})")
     direction = "" if directions is None else f" and the directions by {direction_rms[i]:.3g} deg"
+    if not np.isfinite(misfit[i]):
+        return ValueError(
+            f"fit_profile: record {labels[i]} fits no atmosphere of the model: no state of the "
+            f"model reaches its data: {reason}{more}. Give on_misfit='flag' to keep the other "
+            "records' fits and read profile_fit.fits")
     return ValueError(
         f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
         f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
         f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg; refused "
         f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
-        f"{'; '.join(reasons)}{more}. Give "
+        f"{reason}{more}. Give "
         "on_misfit='flag' to keep the fits and read profile_fit.fits"
     )
