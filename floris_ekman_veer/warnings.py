@@ -276,3 +276,8 @@ def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
             "docs/conventions.md#thrust-coefficient-and-yaw)",
             ThrustLimitWarning, items,
         )
+
+
+# A setting that names no warning class is refused when the package is imported, not when a
+# warning would first fire mid-study.
+_parse(warnings_setting())

@@ -809,11 +809,12 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
     atmosphere of the model, as a person reads it. ``hemisphere``: the sign of the Coriolis
     parameter.
 
-    Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``convective``
+    Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``falling speeds``,
+    ``convective``
     (less shear between the lowest and highest speeds than the neutral surface layer's log
     law, by more than three standard deviations of the noise: an unstable layer, a class the
     model does not have), ``backing`` (the direction turns the other way than an Ekman layer),
-    ``falling speeds``, ``misfit``.
+    ``misfit``.
     """
     order = np.argsort(heights)
     z, s = heights[order], speeds[order]
@@ -822,6 +823,16 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
     if zs.size and np.max(ss) < CALM_SPEED:
         return "calm", (f"calm: every speed below {CALM_SPEED:g} m/s (at most {np.max(ss):.2g} "
                         "m/s), where the vanes point anywhere and the layer has no Ekman profile")
+    if zs.size >= 2:
+        drops = ss[1:] - ss[:-1]
+        if ss[-1] < ss[0] - 2.0 * speed_noise:
+            return "falling speeds", (
+                f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to {ss[-1]:.3g} m/s at "
+                f"{zs[-1]:.4g} m (the model's wind grows with height from the ground up to its "
+                "low-level jet)")
+        if drops[0] < -2.0 * speed_noise:
+            return "falling speeds", (f"the speed falls with height from {zs[0]:.4g} m to "
+                                      f"{zs[1]:.4g} m by {-drops[0]:.3g} m/s")
     if zs.size >= 2 and ss[0] > 0:
         log_law = np.log(zs[-1] / roughness_length) / np.log(zs[0] / roughness_length)
         spread = 3.0 * speed_noise * np.hypot(1.0, ss[-1] / ss[0]) / ss[0]
@@ -848,16 +859,6 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                     f"{'veers' if north else 'backs'}: the direction turns "
                     f"{'clockwise' if north else 'anticlockwise'} with height)"
                 )
-    if zs.size >= 2:
-        drops = ss[1:] - ss[:-1]
-        if ss[-1] < ss[0] - 2.0 * speed_noise:
-            return "falling speeds", (
-                f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to {ss[-1]:.3g} m/s at "
-                f"{zs[-1]:.4g} m (the model's wind grows with height from the ground up to its "
-                "low-level jet)")
-        if drops[0] < -2.0 * speed_noise:
-            return "falling speeds", (f"the speed falls with height from {zs[0]:.4g} m to "
-                                      f"{zs[1]:.4g} m by {-drops[0]:.3g} m/s")
     return "misfit", ("the shape of its profile is outside the model's (speed and direction "
                       "change together set u*, L and z0; a profile kinked beyond the model's, "
                       "or directions turning more than its stability allows with that shear)")

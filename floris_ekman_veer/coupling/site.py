@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
+from floris_ekman_veer._validation import real_array, require_at
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.inflow import set_atmosphere
@@ -263,7 +264,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
 
 #: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
 EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "missing data",
-                   "calm", "backing", "falling speeds", "convective", "misfit", "two states")
+                   "calm", "falling speeds", "convective", "backing", "misfit", "two states")
 
 
 def _screen(records, labels, heights, speeds, directions, time_column, unknowns):
@@ -343,13 +344,24 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     """
     if shear_exponent is None and veer is None:
         raise ValueError("atmosphere_from_shear_and_veer needs shear_exponent, veer or both")
+    for name, value, ok, valid in (
+            ("hub_speed", hub_speed, lambda v: v > 0, "> 0 m/s"),
+            ("hub_height", hub_height, lambda v: v > 0, "> 0 m"),
+            ("rotor_diameter", rotor_diameter, lambda v: v > 0, "> 0 m"),
+            ("shear_exponent", shear_exponent, lambda v: np.isfinite(v), "finite"),
+            ("veer", veer, lambda v: np.isfinite(v), "finite [deg]")):
+        if value is None:
+            continue
+        array = real_array(f"atmosphere_from_shear_and_veer: {name}", value, valid)
+        require_at(np.isfinite(array) & ok(array), f"atmosphere_from_shear_and_veer: {name}",
+                   valid, array)
     single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
                                            shear_exponent, veer))
     hub_speed, hub_height, rotor_diameter = (
         np.atleast_1d(np.asarray(v, dtype=float)) for v in (hub_speed, hub_height, rotor_diameter)
     )
     n = np.broadcast_shapes(hub_speed.shape, hub_height.shape, rotor_diameter.shape,
-                            np.shape(shear_exponent or 0.0), np.shape(veer or 0.0))
+                            *(np.shape(v) for v in (shear_exponent, veer) if v is not None))
     if len(n) != 1:
         raise ValueError("atmosphere_from_shear_and_veer: inputs must be numbers or 1-D arrays")
     radius = 0.5 * np.broadcast_to(rotor_diameter, n)[:, None]
@@ -374,8 +386,20 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     if single:
         heights, speeds = heights[0], speeds[0]
         directions = None if directions is None else directions[0]
-    return EkmanABL.fit_profile(
-        heights, speeds, directions,
-        speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
-        **fit_options_and_inputs,
-    )
+    try:
+        return EkmanABL.fit_profile(
+            heights, speeds, directions,
+            speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
+            **fit_options_and_inputs,
+        )
+    except ValueError as error:
+        text = str(error)
+        if "fits no atmosphere of the model" not in text:
+            raise
+        given = ", ".join(f"{k}={v!r}" for k, v in (("shear_exponent", shear_exponent),
+                                                     ("veer", veer)) if v is not None)
+        raise ValueError(
+            f"atmosphere_from_shear_and_veer: no atmosphere of the model has {given} [deg of "
+            f"veer from the bottom to the top of the rotor] at hub_speed {hub_speed.tolist()} "
+            f"m/s (within speed_tolerance={speed_tolerance:g}, veer_tolerance={veer_tolerance:g}"
+            f" deg): {text.split('): ', 1)[-1]}") from None
