@@ -58,7 +58,7 @@ def businger_dyer_speed(z, hub_speed, obukhov_length):
     return hub_speed * shape(z) / shape(HUB_HEIGHT)
 
 
-def main() -> None:
+def main(output: Path = OUTPUT) -> pd.DataFrame:
     rng = np.random.default_rng(SEED)
     time = pd.date_range("2025-01-01 00:00", periods=8760, freq="h")
     n = time.size
@@ -118,9 +118,10 @@ def main() -> None:
                 for j, h in enumerate(HEIGHTS)}
     columns["true_kind"] = kind
     table = pd.DataFrame(columns)
-    table.to_csv(OUTPUT, index=False, compression={"method": "gzip", "mtime": 0})
+    table.to_csv(output, index=False, compression={"method": "gzip", "mtime": 0})
     counts = table["true_kind"].value_counts().to_dict()
-    print(f"wrote {OUTPUT} ({len(table)} records: {counts})")
+    print(f"wrote {output} ({len(table)} records: {counts})")
+    return table
 
 
 if __name__ == "__main__":
