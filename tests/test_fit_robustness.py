@@ -155,3 +155,19 @@ def test_shear_and_veer_inputs_are_vectorised():
     np.testing.assert_allclose(abl.geostrophic_wind, [a.geostrophic_wind for a in one],
                                rtol=1e-6)
     np.testing.assert_allclose(abl.speed(90.0), [6.0, 9.0], rtol=0.02)
+
+
+def test_chunks_do_not_change_the_fits():
+    rng = np.random.default_rng(3)
+    n = 60
+    lengths = np.where(rng.random(n) < 0.3, np.inf, rng.uniform(30.0, 800.0, n))
+    abl = EkmanABL.from_reference_wind(rng.uniform(3.0, 14.0, n), 90.0, obukhov_length=lengths,
+                                       **SITE)
+    s = abl.speed(Z[:, None]).T + rng.normal(0.0, 0.1, (n, Z.size))
+    d = 270.0 - abl.wind_angle(Z[:, None]).T + rng.normal(0.0, 0.5, (n, Z.size))
+    whole = EkmanABL.fit_profile(Z, s, d, on_misfit="flag", **SITE).profile_fit
+    chunked = EkmanABL.fit_profile(Z, s, d, on_misfit="flag", chunk_size=7, **SITE).profile_fit
+    for name in ("geostrophic_wind", "obukhov_length", "misfit", "direction_offset"):
+        np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), name)
+    with pytest.raises(ValueError, match=r"chunk_size must be an integer >= 1; got 0"):
+        EkmanABL.fit_profile(Z, s, d, chunk_size=0, **SITE)

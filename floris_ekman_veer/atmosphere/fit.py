@@ -49,7 +49,9 @@ from floris_ekman_veer._validation import real_array, require_at
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
-               "on_misfit", "labels", "max_iterations")
+               "on_misfit", "labels", "max_iterations", "chunk_size")
+#: Records iterated together by default: the work arrays stay below about 100 MB.
+DEFAULT_CHUNK_SIZE = 4096
 #: Stability inputs the fit determines (refused as fixed inputs).
 STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
 #: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
@@ -523,7 +525,8 @@ def _checked_data(name, value, shape=None):
 def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
-                on_misfit="raise", labels=None, max_iterations=100, **fixed_inputs):
+                on_misfit="raise", labels=None, max_iterations=100, chunk_size=DEFAULT_CHUNK_SIZE,
+                **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -540,6 +543,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
         labels: a name per record for messages (e.g. time stamps); default its index.
         max_iterations: of the Levenberg-Marquardt iteration.
+        chunk_size: records iterated together (bounds the memory; the fits do not depend on
+            it: each record's iteration is its own).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
             ``coriolis_parameter`` (required), ``roughness_length`` (required unless fitted),
             ``brunt_vaisala_frequency`` or ``lapse_rate``, ``reference_potential_temperature``,
@@ -564,6 +569,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             or max_iterations < 1):
         raise ValueError(f"fit_profile: max_iterations must be an integer >= 1; got "
                          f"{max_iterations!r}")
+    if (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
+            or chunk_size < 1):
+        raise ValueError(f"fit_profile: chunk_size must be an integer >= 1; got {chunk_size!r}")
     heights = real_array("heights", heights, "> 0 m")
     require_at(np.isfinite(heights) & (heights > 0), "heights", "finite and > 0 m", heights)
     if heights.shape not in ((m,), (n, m)):
@@ -648,9 +656,20 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
 
     dof = np.maximum(observations - n_unknowns, 1)
     misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
-    x, cost, converged, iterations = _multistart(model, n, max_iterations)
-    _restart_misfits(model, x, cost, converged, iterations, misfit_tolerance**2 * dof,
-                     max_iterations)
+    # The iteration in chunks of records: its work arrays (records x starts x unknowns x data)
+    # stay bounded, whatever the number of records.
+    parts = []
+    for chunk in np.array_split(np.arange(n), -(-n // chunk_size)):
+        part = model if chunk.size == n else _ProfileModel(
+            abl_class, heights[chunk], speeds[chunk],
+            None if directions is None else directions[chunk],
+            {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
+            z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
+            float(speed_noise), float(direction_noise))
+        result = _multistart(part, chunk.size, max_iterations)
+        _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
+        parts.append(result)
+    x, cost, converged, iterations = (np.concatenate(a) for a in zip(*parts))
     index = np.arange(n)
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
