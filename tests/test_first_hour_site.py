@@ -125,3 +125,16 @@ def test_readme_quick_start_prints_its_numbers():
     printed = [float(v) for v in re.findall(r"[\d.]+", run.stdout.splitlines()[0])]
     np.testing.assert_allclose(printed, powers, atol=0.005)
     assert run.stdout.splitlines()[1] == "[True, True]"
+
+
+def test_the_pages_build_shipped_inputs_that_build_without_a_warning():
+    """The inputs the README's and docs' code blocks build warn about nothing before the user's
+    set() (a placeholder condition outside the envelope would)."""
+    blocks = "".join(m for page in [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+                     for m in re.findall(r"```python\n(.*?)```", page.read_text(), flags=re.S))
+    names = set(re.findall(r'example_input\("(\w+)"\)', blocks))
+    assert "farm_night" in names and "farm_sbl6" not in names
+    for name in sorted(names):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            FlorisModel(floris_ekman_veer.example_input(name))
