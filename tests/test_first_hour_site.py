@@ -138,3 +138,13 @@ def test_the_pages_build_shipped_inputs_that_build_without_a_warning():
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             FlorisModel(floris_ekman_veer.example_input(name))
+
+
+def test_nan_heterogeneous_multipliers_are_named():
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+    with pytest.raises(ValueError, match=r"flow_field.heterogeneous_inflow_config.speed_multipliers "
+                                         r"must be finite and > 0; got nan at condition 0"):
+        fmodel.set(wind_directions=[270.0], wind_speeds=[9.0], turbulence_intensities=[0.06],
+                   heterogeneous_inflow_config={"speed_multipliers": [[1.0, np.nan, 1.0]],
+                                                "x": [0.0, 500.0, 1000.0],
+                                                "y": [0.0, 500.0, -500.0]})

@@ -183,6 +183,14 @@ def _check_conditions(flow_field) -> None:
                  "finite and >= 0 [m/s]", speeds)
     require_each(np.isfinite(intensities) & (intensities >= 0),
                  "flow_field.turbulence_intensities", "finite and >= 0", intensities)
+    heterogeneous = getattr(flow_field, "heterogeneous_inflow_config", None) or {}
+    multipliers = heterogeneous.get("speed_multipliers")
+    if multipliers is not None:
+        values = np.asarray(multipliers, dtype=float)
+        # (a NaN would reach the thrust as "ct must be >= 0 ... got nan")
+        require_each(np.isfinite(values) & (values > 0),
+                     "flow_field.heterogeneous_inflow_config.speed_multipliers",
+                     "finite and > 0", np.atleast_1d(values))
 
 
 def _check_turbines(farm) -> None:
