@@ -136,11 +136,13 @@ def test_unclear_inputs_get_messages_naming_them():
     with pytest.raises(ValueError, match=r"hub_speed must be > 0 m/s; got nan"):
         atmosphere_from_shear_and_veer(np.nan, 90.0, 126.0, 0.2, **SITE)
     for veer in (-5.0, 90.0):
-        with pytest.raises(ValueError, match=rf"atmosphere_from_shear_and_veer: no atmosphere of "
-                                             rf"the model has veer={veer}"):
+        with pytest.raises(ValueError, match=rf"atmosphere_from_shear_and_veer: veer={veer} \[deg, "
+                                             r"from the bottom to the top of the rotor\] at "
+                                             r"hub_speed \[9.0\] m/s fits no atmosphere"):
             atmosphere_from_shear_and_veer(9.0, 90.0, 126.0, veer=veer, **SITE)
-    with pytest.raises(ValueError, match=r"no atmosphere of the model has shear_exponent=0.2, "
-                                         r"veer=10.0"):
+    with pytest.raises(ValueError, match=r"shear_exponent=0.2 and veer=10.0 \[deg, from the "
+                                         r"bottom to the top of the rotor\] at hub_speed \[9.0\] "
+                                         r"m/s fits no atmosphere"):
         atmosphere_from_shear_and_veer(9.0, 90.0, 126.0, 0.2, 10.0, **SITE)
     records = pd.DataFrame({f"speed_{z:.0f}m": [s[j]] for j, z in enumerate(Z)})
     with pytest.raises(ValueError, match=r"fit_site: reference_height must be > 10 roughness "

@@ -20,7 +20,6 @@ import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
-from floris_ekman_veer._validation import real_array, require_at
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.coupling.energy import annual_energy
 from floris_ekman_veer.coupling.inflow import set_atmosphere
@@ -203,7 +202,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         raise ValueError(f"fit_site: reference_height must be > 10 roughness lengths "
                          f"(roughness_length {z0:g} m: above the roughness sublayer, where the "
                          f"fitted profile is a wind a turbine meets); got {reference_height!r} m")
-    excluded = _screen(records, labels, heights, speeds, directions, time_column,
+    excluded = _screen(records, labels, heights, speeds, directions,
                        3 if fit_options_and_inputs.get("fit_roughness") else 2)
     if on_misfit == "raise" and excluded:
         row, (kind, text) = next(iter(sorted(excluded.items())))
@@ -212,7 +211,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                          "such records (SiteAtmosphere.summary() tells what was left out and why)")
     per_record = {k: v for k, v in fit_options_and_inputs.items() if np.ndim(v) == 1}
     fit_inputs = dict(fit_options_and_inputs)
-    candidates = np.array([i for i in range(len(records)) if i not in excluded], int)
+    candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
     if candidates.size == 0:
         raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
     inputs = {**fit_inputs, **{k: np.asarray(v)[candidates] for k, v in per_record.items()}}
@@ -267,7 +266,7 @@ EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "mi
                    "calm", "falling speeds", "convective", "backing", "misfit", "two states")
 
 
-def _screen(records, labels, heights, speeds, directions, time_column, unknowns):
+def _screen(records, labels, heights, speeds, directions, unknowns):
     """{row: (kind, text)} of the records no fit should see: repeated time stamps, zero or
     negative speed readings, too few data."""
     excluded = {}
@@ -342,6 +341,8 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     (``fit_roughness=True`` lets z0 meet the shear). Vectorised: the inputs broadcast over
     conditions of shape (n,).
     """
+    from floris_ekman_veer._validation import real_array, require_at
+
     if shear_exponent is None and veer is None:
         raise ValueError("atmosphere_from_shear_and_veer needs shear_exponent, veer or both")
     for name, value, ok, valid in (
@@ -396,10 +397,10 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
         text = str(error)
         if "fits no atmosphere of the model" not in text:
             raise
-        given = ", ".join(f"{k}={v!r}" for k, v in (("shear_exponent", shear_exponent),
-                                                     ("veer", veer)) if v is not None)
+        given = " and ".join(f"{k}={v!r}{unit}" for k, v, unit in (
+            ("shear_exponent", shear_exponent, ""),
+            ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
         raise ValueError(
-            f"atmosphere_from_shear_and_veer: no atmosphere of the model has {given} [deg of "
-            f"veer from the bottom to the top of the rotor] at hub_speed {hub_speed.tolist()} "
-            f"m/s (within speed_tolerance={speed_tolerance:g}, veer_tolerance={veer_tolerance:g}"
-            f" deg): {text.split('): ', 1)[-1]}") from None
+            f"atmosphere_from_shear_and_veer: {given} at hub_speed {hub_speed.tolist()} m/s "
+            f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
+            f"veer_tolerance={veer_tolerance:g} deg): {text.split('): ', 1)[-1]}") from None
