@@ -9,7 +9,16 @@ script, not a test:
 2. Recovery (docs/measurements.md#recovery): per atmosphere, 200 noisy records; the maximum
    over 30-150 m of the relative speed error and of the direction-change error of each fit
    against the true profile, as median, 95th percentile and maximum over the records.
+3. ``--large N`` (e.g. 100000): N noisy records of 1,000 random atmospheres in one call, in
+   chunks of ``chunk_size`` records (default 4,096), against one chunk of N / 10 records:
+   time per record (CPU time, best of ``--repeats``) and the peak of numpy's allocations
+   above the input arrays (tracemalloc), measured interleaved in one process.
 """
+
+import argparse
+import time
+import tracemalloc
+
 
 import numpy as np
 
@@ -36,7 +45,45 @@ def sample(abl, rng=None, n=None):
     return s, d
 
 
+def large(n, repeats):
+    """Time and peak memory of fit_profile on n records, chunked (default) and as one chunk of
+    n / 10 records (the unchunked cost, scaled)."""
+    rng = np.random.default_rng(1)
+    length = np.where(rng.random(1000) < 0.3, np.inf, rng.uniform(40.0, 800.0, 1000))
+    truth = EkmanABL.from_reference_wind(rng.uniform(4.0, 14.0, 1000), 90.0,
+                                         obukhov_length=length, **SITE)
+    s, d = sample(truth)
+    reps = -(-n // 1000)
+    s = (np.tile(s, (reps, 1))[:n] + rng.normal(0.0, 0.1, (n, HEIGHTS.size)))
+    d = (np.tile(d, (reps, 1))[:n] + rng.normal(0.0, 0.5, (n, HEIGHTS.size)))
+    cases = {f"{n} records, chunks of 4096": (s, d, {}),
+             f"{n // 10} records, one chunk": (s[: n // 10], d[: n // 10], {"chunk_size": n})}
+    best = {label: (np.inf, 0.0) for label in cases}
+    for _ in range(repeats):
+        for label, (speeds, directions, options) in cases.items():
+            tracemalloc.start()
+            start = time.process_time()
+            fit = EkmanABL.fit_profile(HEIGHTS, speeds, directions, on_misfit="flag", **NOISE,
+                                       **SITE, **options).profile_fit
+            seconds = time.process_time() - start
+            peak = tracemalloc.get_traced_memory()[1]
+            tracemalloc.stop()
+            per_record = seconds / len(speeds) * 1e3
+            best[label] = (min(best[label][0], per_record), max(best[label][1], peak / 2**20))
+            print(f"  {label}: {per_record:.3f} ms of CPU per record, peak {peak / 2**20:.0f} "
+                  f"MiB above the inputs, {np.mean(fit.fits) * 100:.2f} % fit")
+    for label, (ms, mib) in best.items():
+        print(f"| {label} | {ms:.3f} ms | {mib:.0f} MiB |")
+
+
 def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--large", type=int, default=0)
+    parser.add_argument("--repeats", type=int, default=2)
+    args = parser.parse_args()
+    if args.large:
+        large(args.large, args.repeats)
+        return
     rng = np.random.default_rng(0)
     n = 1000
     length = np.where(rng.random(n) < 0.3, np.inf, rng.uniform(40.0, 800.0, n))

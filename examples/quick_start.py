@@ -35,7 +35,7 @@ def veer_input(gch: bool = False, veer: bool = True) -> dict:
     if not veer:
         config["wake"]["wake_deflection_parameters"]["ekman_veer"] = {"veer": False}
     config["wake"].update({name: gch for name in GCH_SWITCHES})
-    config["flow_field"]["reference_wind_height"] = 90.0
+    config["flow_field"].update(reference_wind_height=90.0, wind_shear=0.0)  # the atmosphere's
     return config
 
 

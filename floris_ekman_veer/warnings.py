@@ -410,3 +410,8 @@ def report_from_workers(n_conditions: int | None = None) -> None:
             _warn_thrust_limit(limit, flagged, n_conditions or total, reference_height)
         else:
             _warn_thrust_limit(limit, None, None, reference_height)
+
+
+# A setting that names no warning class is refused when the package is imported, not when a
+# warning would first fire mid-study.
+_parse(warnings_setting())

@@ -333,3 +333,78 @@ def test_readme_quick_start_fits_a_screen_and_links_the_gallery():
     assert len(set(scripts)) >= 4
     for script in scripts:
         assert "--gallery" in (REPO / script).read_text(), script
+
+
+# ------------------------------------------------------------ numbers the pages take from scripts
+#: Numbers of the README and docs/ that a named script prints: (page, the page's text holding
+#: the number, the script and its arguments, a regular expression of the script's output whose
+#: groups are the number(s) the page's text holds, in the page's order). A page that changes its
+#: text, or a script whose output moves, fails here; each script runs once (slow: they are the
+#: examples themselves).
+SCRIPT_NUMBERS = [
+    ("README.md", r"P/P0 = ([\d.]+) with M-1, against ([\d.]+) with M-2 and M-3 and ([\d.]+) and "
+                  r"([\d.]+) with FLORIS's GCH and cc on the same inflow",
+     ("examples/paper_power.py",),
+     r"beta = \+0 deg.*?SBL-6\s+M-1(?:\s+\S+ \(\S+\)){3}\s+([\d.]+) .*?SBL-6\s+M-2(?:\s+\S+ \(\S+\)){3}"
+     r"\s+([\d.]+) .*?SBL-6\s+GCH(?:\s+\S+ \(\S+\)){3}\s+([\d.]+) .*?SBL-6\s+cc(?:\s+\S+ \(\S+\)){3}"
+     r"\s+([\d.]+) "),
+    ("README.md", r"in CNBL, without veer, M-1, M-2 and M-3 agree \(([\d.]+)\)",
+     ("examples/paper_power.py",),
+     r"beta = \+0 deg.*?CNBL\s+M-1(?:\s+\S+ \(\S+\)){3}\s+([\d.]+) "),
+    ("docs/measurements.md", r"\| zero reading \| (\d+) \| \| calm \| (\d+) \| \| convective \| "
+                             r"(\d+) \| \| backing \| (\d+) \| \| misfit \| (\d+) \| \| fitted \| "
+                             r"(\d+) \|",
+     ("examples/site_year.py",),
+     r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?convective\s+(\d+) .*?backing\s+(\d+) .*?"
+     r"misfit\s+(\d+) .*?fitted\s+(\d+) "),
+    ("docs/measurements.md", r"\| ekman_veer \| ([\d.]+) \| ([\d.]+) \| ([+\-][\d.]+) % \|",
+     ("examples/site_fit.py",),
+     r"ekman_veer\s+([\d.]+)\s+([\d.]+)\s+([+\-]?[\d.]+)"),
+]
+
+
+def page_numbers(page: str, pattern: str) -> list[str]:
+    match = re.search(pattern, re.sub(r"\s+", " ", (REPO / page).read_text()))
+    assert match, f"{page} no longer holds the text {pattern!r}: update SCRIPT_NUMBERS with it"
+    return list(match.groups())
+
+
+@pytest.mark.parametrize("page, text, script, output", SCRIPT_NUMBERS,
+                         ids=[f"{p}:{s[0]}" for p, _, s, _ in SCRIPT_NUMBERS])
+def test_pages_hold_the_texts_their_scripts_are_compared_with(page, text, script, output):
+    assert page_numbers(page, text)
+    assert (REPO / script[0]).is_file()
+
+
+_SCRIPT_OUTPUT: dict = {}
+
+
+def script_output(script, tmp_path_factory) -> str:
+    import os
+    import subprocess
+    import sys
+
+    if script not in _SCRIPT_OUTPUT:
+        env = {**os.environ, "MPLBACKEND": "Agg",
+               "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
+        run = subprocess.run([sys.executable, str(REPO / script[0]), *script[1:]],
+                             cwd=tmp_path_factory.mktemp("script"), env=env, capture_output=True,
+                             text=True, timeout=1800)
+        assert run.returncode == 0, run.stderr[-3000:]
+        _SCRIPT_OUTPUT[script] = run.stdout
+    return _SCRIPT_OUTPUT[script]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page, text, script, output", SCRIPT_NUMBERS,
+                         ids=[f"{p}:{s[0]}" for p, _, s, _ in SCRIPT_NUMBERS])
+def test_page_numbers_are_what_their_scripts_print(page, text, script, output, tmp_path_factory):
+    printed = re.search(output, script_output(script, tmp_path_factory), flags=re.S)
+    assert printed, f"{script[0]} no longer prints {output!r}"
+    written = page_numbers(page, text)
+    got = [g for g in printed.groups()]
+    assert len(got) <= len(written)
+    for text_value, value in zip(written, got):
+        decimals = len(text_value.partition(".")[2])
+        assert abs(float(text_value) - float(value)) <= 0.51 * 10.0**-decimals, \
+            (page, text_value, script[0], value)

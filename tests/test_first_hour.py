@@ -55,7 +55,8 @@ def defaults_with_veer(**wake_switches) -> dict:
     config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {"atmosphere": dict(STABLE_ATMOSPHERE)}
     config["wake"].update(wake_switches)
     config["farm"].update(layout_x=[0.0, 630.0, 1260.0], layout_y=[0.0, 0.0, 0.0])
-    config["flow_field"].update(reference_wind_height=90.0, wind_directions=[270.0, 275.0],
+    config["flow_field"].update(reference_wind_height=90.0, wind_shear=0.0,
+                                wind_directions=[270.0, 275.0],
                                 wind_speeds=[8.0, 10.0], turbulence_intensities=[0.06, 0.06])
     return config
 

@@ -38,6 +38,10 @@ class in (imports point one way, docs/coupling.md#registry).
 
 from __future__ import annotations
 
+import difflib
+import importlib
+import inspect
+
 import attrs
 import numpy as np
 
@@ -45,7 +49,9 @@ from floris_ekman_veer._validation import real_array, require_at
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
-               "on_misfit", "labels", "max_iterations", "stability")
+               "on_misfit", "labels", "max_iterations", "stability", "chunk_size")
+#: Records iterated together by default: the work arrays stay below about 100 MB.
+DEFAULT_CHUNK_SIZE = 4096
 #: Stability inputs the fit determines (refused as fixed inputs).
 STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
                     "sensible_heat_flux")
@@ -60,10 +66,16 @@ DEFAULT_DIRECTION_NOISE = 1.0
 DEFAULT_REFUSAL_PROBABILITY = 1e-6
 #: Starting Obukhov lengths [m] of the multi-start (inf: neutral).
 STARTING_OBUKHOV_LENGTHS = (np.inf, 400.0, 200.0, 100.0, 50.0, 25.0)
+#: Starting Obukhov lengths [m] of the second, dense start of records the first one leaves
+#: refused: 40 from 10 m to 2 km, geometric.
+RESTART_OBUKHOV_LENGTHS = tuple(np.geomspace(10.0, 2000.0, 40))
 #: Factors on the best end point's 1/L of the restarts across the profile's step near h.
 _POLISH_FACTORS = (0.9, 0.97, 1.03, 1.1)
 #: ... for records whose fitted ABL top is below this times their highest measurement.
 _POLISH_HEIGHT_RATIO = 1.2
+#: A state whose chi-square exceeds the fit's by at most this lies in the fit's two-sigma
+#: confidence region (one parameter): the data cannot tell it from the fit.
+CONFIDENCE_CHI_SQUARE = 4.0
 #: Default starting roughness length [m] when it is fitted and none is given.
 DEFAULT_ROUGHNESS_START = 0.05
 #: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
@@ -125,6 +137,8 @@ class ProfileFit:
     single: bool
     #: "convective", "neutral" or "stable" per record (`_stability_class` of the fitted L).
     stability_class: np.ndarray | str | None = None
+    #: The refusal threshold of ``misfit`` per record (the chi-square test).
+    misfit_tolerance: np.ndarray | float = np.inf
 
     def speed(self, heights):
         """Fitted speed [m/s] at ``heights`` ((n_heights,) or (n_records, n_heights)), shaped
@@ -188,13 +202,94 @@ class ProfileFit:
             self._check_block(block, stability_input, reference_height)
         return block
 
-    def _check_block(self, block, stability_input, reference_height):
+    def given_back(self, block, reference_height):
+        """Per record: does the atmosphere ``block`` (:meth:`atmosphere`), driven by the fitted
+        speed at ``reference_height``, give back the fit? (bool array, and the ABL it gives.)
+
+        It does when the reference-wind solve finds the fitted state (G to 1e-6), or, where the
+        speed at that height has two states a hair apart (a fitted ABL top h next to a
+        measurement height, where the profile has its kinks: h, and the direction's step at
+        0.9973 h, docs/atmosphere.md#lateral-velocity-near-the-abl-top), when the state it finds
+        lies in the fit's two-sigma confidence region: its chi-square on the record's data at
+        most :data:`CONFIDENCE_CHI_SQUARE` above the fit's. (A second state that the data tell
+        apart, e.g. the heat-flux closure's deeper one, is not given back.)
+        """
         speed = self.speed(np.reshape(float(reference_height), (1,)))[:, 0]
         again = type(self.abl).from_reference_wind(speed if not self.single else speed[0],
                                                    float(reference_height), **block)
-        error = np.abs(np.asarray(again.geostrophic_wind) / self.geostrophic_wind - 1.0)
-        wrong = np.flatnonzero(np.reshape(~(error <= 1e-6), -1))
+        error = np.reshape(np.abs(np.asarray(again.geostrophic_wind) / self.geostrophic_wind
+                                  - 1.0), -1)
+        same = error <= 1e-6
+        if not np.all(same):
+            other = np.flatnonzero(~same)
+            chi2_again, _ = self._chi_square(again, other)
+            chi2_fit, _ = self._chi_square(self.abl, other)
+            same[other] = chi2_again - chi2_fit <= CONFIDENCE_CHI_SQUARE
+        return same, again
+
+    def misfit_of(self, abl, index):
+        """The ``misfit`` of ``abl`` (an EkmanABL of this fit's shape) on the data of records
+        ``index``, as the fit measures it."""
+        chi2, dof = self._chi_square(abl, index)
+        return np.sqrt(chi2 / dof)
+
+    def _chi_square(self, abl, index):
+        heights, speeds = self.heights[index], self.speeds[index]
+        directions = None if self.directions is None else self.directions[index]
+        if self.single:
+            speed = np.atleast_2d(abl.speed(heights[0]))
+            angle = np.atleast_2d(abl.wind_angle(heights[0]))
+        else:
+            z = np.transpose(self.heights)
+            speed = np.transpose(abl.speed(z))[index]
+            angle = np.transpose(abl.wind_angle(z))[index]
+        r, observations, _ = _normalised_residuals(speed, angle, speeds, directions,
+                                                self.speed_noise, self.direction_noise)
+        return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted), 1)
+
+    def reason(self, i):
+        """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
+        for a record that fits, its kind is whatever its data look like)."""
+        hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
+                                                        np.shape(self.misfit)), -1)[i])
+        return misfit_reason(self.heights[i], self.speeds[i],
+                             None if self.directions is None else self.directions[i],
+                             self.speed_noise, self.direction_noise, hemisphere,
+                             np.reshape(self.roughness_length, -1)[i])
+
+    def subset(self, index):
+        """The fitted EkmanABL of records ``index`` only (shape (len(index),)), with its
+        ``profile_fit``: the same fits, not re-fitted."""
+        index = np.asarray(index, int)
+        if self.single:
+            raise ValueError("subset: this fit is of one record")
+        per_record = lambda v: np.asarray(v)[index]  # noqa: E731
+        fixed = {k: (v if np.ndim(v) == 0 else per_record(v)) for k, v in self.fixed_inputs.items()}
+        solved = {k: v for k, v in fixed.items() if k != "roughness_length"}
+        abl = type(self.abl)(
+            geostrophic_wind=np.where(np.isfinite(self.geostrophic_wind), self.geostrophic_wind,
+                                      10.0)[index],
+            stability_parameter=np.where(np.isfinite(self.geostrophic_wind),
+                                         self.stability_parameter, 0.0)[index],
+            roughness_length=per_record(self.roughness_length), **solved,
+        )
+        values = {a.name: getattr(self, a.name) for a in attrs.fields(type(self))}
+        for name, value in values.items():
+            if name in ("abl", "fitted", "labels", "fixed_inputs", "speed_noise",
+                        "direction_noise", "single"):
+                continue
+            if isinstance(value, np.ndarray) and value.ndim >= 1 and value.shape[0] == len(self.labels):
+                values[name] = value[index]
+        values.update(abl=abl, labels=[self.labels[i] for i in index], fixed_inputs=fixed)
+        fit = type(self)(**values)
+        abl.profile_fit = fit
+        return abl
+
+    def _check_block(self, block, stability_input, reference_height):
+        same, again = self.given_back(block, reference_height)
+        wrong = np.flatnonzero(~same)
         if wrong.size:
+            speed = self.speed(np.reshape(float(reference_height), (1,)))[:, 0]
             i = int(wrong[0])
             raise ValueError(
                 f"the atmosphere block with {stability_input}, driven by the fitted speed "
@@ -202,8 +297,10 @@ class ProfileFit:
                 f"fit of record {self.labels[i]} (G {np.reshape(again.geostrophic_wind, -1)[i]:.4g}"
                 f" instead of {np.reshape(self.geostrophic_wind, -1)[i]:.4g} m/s; "
                 f"{wrong.size} record(s)): that closure has two states with this speed there "
-                "and the reference-wind solve takes the deeper one; give the stability as "
-                "stability_parameter or obukhov_length"
+                "and the reference-wind solve takes the deeper one, which does not fit the "
+                "record's data; give the stability as stability_parameter or obukhov_length"
+                + (f" (records {', '.join(str(self.labels[k]) for k in wrong[:5])}"
+                   f"{', ...' if wrong.size > 5 else ''})" if wrong.size > 1 else "")
             )
 
 
@@ -243,6 +340,9 @@ class _ProfileModel:
         self.params = params
         self.f = params["f"]
         self.kappa = self.template.von_karman
+        # The shallowest boundary layer the ABL class accepts (a state below it is no model state).
+        self.min_depth = float(getattr(importlib.import_module(abl_class.__module__),
+                                       "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
 
     def fixed_at(self, index):
         return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
@@ -258,16 +358,38 @@ class _ProfileModel:
         with np.errstate(all="ignore"):
             _, _, h_hat, _, b, along = self.template._state(log_u, p)
             g = u_star * np.hypot(along, b) / self.kappa
+            h = h_hat * u_star / p["f"]
             valid = (
                 (x[:, 1] >= 0) & (along > 0) & np.isfinite(g) & np.isfinite(mu)
                 # a surface layer above the roughness, with margin for the re-solve's round-off
-                & (self.template.matching_fraction * h_hat * u_star / p["f"] > 1.001 * z0)
+                & (self.template.matching_fraction * h > 1.001 * z0)
+                # a layer as deep as the ABL class accepts (light winds: u* -> 0, h -> 0)
+                & (h >= 1.001 * self.min_depth)
             )
-        return g, mu, z0, valid, h_hat * u_star / p["f"]
+        return g, mu, z0, valid, h
 
     def abl(self, g, mu, z0, index):
+        """The ABLs of states (g, mu, z0) of records ``index``, and which of them the class
+        solves (a state the ABL class refuses, its own checks stricter than :meth:`state`'s in
+        the last bits, is replaced by a neutral stand-in and marked False: one record's trial
+        step never aborts the others')."""
+        fixed = self.fixed_at(index)
+        try:
+            return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
+                            **fixed), np.ones(len(index), bool)
+        except ValueError:
+            pass
+        solved = np.ones(len(index), bool)
+        for k in range(len(index)):  # only after a refusal: find the refused states
+            try:
+                self.cls(geostrophic_wind=g[k], stability_parameter=mu[k],
+                         roughness_length=np.broadcast_to(z0, (len(index),))[k],
+                         **{n: (v[k] if np.ndim(v) else v) for n, v in fixed.items()})
+            except ValueError:
+                solved[k] = False
+        g, mu = np.where(solved, g, 10.0), np.where(solved, mu, 0.0)
         return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
-                        **self.fixed_at(index))
+                        **fixed), solved
 
     def residuals(self, x, index):
         """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
@@ -276,24 +398,37 @@ class _ProfileModel:
         g = np.where(valid, g, 10.0)
         mu = np.where(valid, mu, 0.0)
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl = self.abl(g, mu, z0, index)
-        z = self.z[index]
-        speed = np.transpose(abl.speed(np.transpose(z)))
-        ms = self.ms[index]
-        r_s = np.where(ms, (speed - np.where(ms, self.s[index], 0.0)) / self.sigma_s, 0.0)
-        if self.d is None:
-            return r_s, valid, np.zeros(len(index))
-        angle = np.transpose(abl.wind_angle(np.transpose(z)))
-        md = self.md[index]
-        # Measured direction plus the model's flow angle: the offset, constant for a perfect fit.
-        e = np.where(md, self.d[index], 0.0) + angle
-        first = np.argmax(md, axis=1)
-        e_ref = e[np.arange(len(index)), first]
-        relative = np.where(md, _wrap(e - e_ref[:, None]), 0.0)
-        count = np.maximum(np.sum(md, axis=1), 1)
-        mean = np.sum(relative, axis=1) / count
-        r_d = np.where(md, (relative - mean[:, None]) / self.sigma_d, 0.0)
-        return np.concatenate([r_s, r_d], axis=1), valid, e_ref + mean
+        abl, solved = self.abl(g, mu, z0, index)
+        valid = valid & solved
+        z = np.transpose(self.z[index])
+        speed = np.transpose(abl.speed(z))
+        angle = None if self.d is None else np.transpose(abl.wind_angle(z))
+        r, _, offset = _normalised_residuals(
+            speed, angle, self.s[index], None if self.d is None else self.d[index],
+            self.sigma_s, self.sigma_d, offset=True)
+        return r, valid, offset
+
+
+def _normalised_residuals(speed, angle, speeds, directions, sigma_s, sigma_d, offset=False):
+    """Normalised residuals (k, n_obs) of model speeds and flow angles (k, m) against measured
+    speeds and directions (NaN: missing), the number of observations per record, and (with
+    ``offset``) the free rotation of the directions: measured direction plus the model's flow
+    angle is constant for a perfect fit; its mean is eliminated."""
+    ms = np.isfinite(speeds)
+    r_s = np.where(ms, (speed - np.where(ms, speeds, 0.0)) / sigma_s, 0.0)
+    observations = np.sum(ms, axis=1)
+    if directions is None:
+        return r_s, observations, np.zeros(len(speeds))
+    md = np.isfinite(directions)
+    e = np.where(md, directions, 0.0) + angle
+    first = np.argmax(md, axis=1)
+    e_ref = e[np.arange(len(speeds)), first]
+    relative = np.where(md, _wrap(e - e_ref[:, None]), 0.0)
+    count = np.maximum(np.sum(md, axis=1), 1)
+    mean = np.sum(relative, axis=1) / count
+    r_d = np.where(md, (relative - mean[:, None]) / sigma_d, 0.0)
+    observations = observations + np.maximum(np.sum(md, axis=1) - 1, 0)
+    return np.concatenate([r_s, r_d], axis=1), observations, e_ref + mean
 
 
 def _solve_normal(jtj, jtr, damping, x_lam, bounded):
@@ -362,6 +497,35 @@ def _levenberg_marquardt(model, x, max_iterations, records):
     return x, cost, converged, iterations
 
 
+def _check_option_names(abl_class, fixed_inputs):
+    """An unknown keyword is a ValueError naming it, the closest valid name and the options."""
+    inputs = [k for k in inspect.signature(abl_class.__init__).parameters if k != "self"]
+    unknown = sorted(set(fixed_inputs) - set(inputs))
+    if unknown:
+        valid = list(FIT_OPTIONS) + [k for k in inputs if k not in STABILITY_INPUTS
+                                     and k != "geostrophic_wind"]
+        close = difflib.get_close_matches(unknown[0], valid, n=1)
+        raise ValueError(
+            f"fit_profile: unknown option or input {unknown[0]!r}"
+            + (f" (did you mean {close[0]!r}?)" if close else "")
+            + f"; the options are {list(FIT_OPTIONS)} and the fixed {abl_class.__name__} inputs "
+            f"{valid[len(FIT_OPTIONS):]}")
+
+
+def _check_degrees(directions):
+    """Directions given in radians are refused: all of them within +-2 pi in two records or
+    more (a table of winds all within 6.3 deg of north). One record cannot tell: a northerly
+    wind veering by a few degrees looks like radians."""
+    finite = directions[np.isfinite(directions)]
+    records = int(np.sum(np.any(np.isfinite(directions), axis=1)))
+    if records >= 2 and np.all(np.abs(finite) <= 2.0 * np.pi):
+        raise ValueError(
+            f"fit_profile: directions must be in degrees; all {finite.size} given lie within "
+            f"+-2 pi ({finite.min():.3g} to {finite.max():.3g}), as radians would. Convert "
+            "radians with np.degrees; directions that are degrees within 6.3 deg of north can "
+            "be given as 360 + direction")
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -375,6 +539,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
                 on_misfit="raise", labels=None, max_iterations=100, stability="stable",
+                chunk_size=DEFAULT_CHUNK_SIZE,
                 **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
@@ -397,6 +562,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
             both, each record taking the sign whose fit misses its data less
             (``ProfileFit.stability_class`` says which).
+        chunk_size: records iterated together (bounds the memory; the fits do not depend on
+            it: each record's iteration is its own).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
             ``coriolis_parameter`` (required), ``roughness_length`` (required unless fitted),
             ``brunt_vaisala_frequency`` or ``lapse_rate``, ``reference_potential_temperature``,
@@ -406,6 +573,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         The fitted EkmanABL, shape (n_records,) (scalar for 1-D data), with ``profile_fit``: the
         :class:`ProfileFit` (unknowns, direction offset, residuals per record).
     """
+    _check_option_names(abl_class, fixed_inputs)
     if stability not in STABILITY_CHOICES:
         raise ValueError(f"fit_profile: stability must be one of {list(STABILITY_CHOICES)}; got "
                          f"{stability!r}")
@@ -414,7 +582,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             abl_class, heights, speeds, directions, speed_noise=speed_noise,
             direction_noise=direction_noise, fit_roughness=fit_roughness,
             refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
-            max_iterations=max_iterations, **fixed_inputs)
+            max_iterations=max_iterations, chunk_size=chunk_size, **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -422,6 +590,16 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         raise ValueError(f"fit_profile: speeds must be (n_records, n_heights) or (n_heights,); "
                          f"got shape {speeds.shape}")
     n, m = speeds.shape
+    if n == 0 or m == 0:
+        raise ValueError(f"fit_profile: speeds hold no records (shape {speeds.shape}); give "
+                         "(n_records, n_heights) with at least one record and one height")
+    if (isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))
+            or max_iterations < 1):
+        raise ValueError(f"fit_profile: max_iterations must be an integer >= 1; got "
+                         f"{max_iterations!r}")
+    if (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
+            or chunk_size < 1):
+        raise ValueError(f"fit_profile: chunk_size must be an integer >= 1; got {chunk_size!r}")
     heights = real_array("heights", heights, "> 0 m")
     require_at(np.isfinite(heights) & (heights > 0), "heights", "finite and > 0 m", heights)
     if heights.shape not in ((m,), (n, m)):
@@ -431,7 +609,20 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     if directions is not None:
         directions = np.atleast_2d(_checked_data("directions", directions,
                                                  np.shape(speeds[0] if single else speeds)))
-    require_at(np.isnan(speeds) | (speeds > 0), "speeds", "> 0 m/s (NaN: missing)", speeds)
+    labels = list(range(n)) if labels is None else list(labels)
+    if len(labels) != n:
+        raise ValueError(f"fit_profile: labels must name the {n} records; got {len(labels)}")
+    bad = ~(np.isnan(speeds) | (speeds > 0))
+    if np.any(bad):
+        i, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"fit_profile: speeds must be > 0 m/s (NaN: missing); record {labels[i]} has "
+            f"{speeds[i, j]:g} m/s at {heights[i, j]:g} m"
+            + (f" ({int(bad.sum()) - 1} more value(s) in {int(bad.any(axis=1).sum())} "
+               "record(s))" if bad.sum() > 1 else "")
+            + ": a zero reading is a calm or a stalled anemometer; give NaN (missing) there")
+    if directions is not None:
+        _check_degrees(directions)
     for name, value in (("speed_noise", speed_noise), ("direction_noise", direction_noise),
                         ("refusal_probability", refusal_probability)):
         upper = 1.0 if name == "refusal_probability" else np.inf
@@ -443,9 +634,6 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
     if not isinstance(fit_roughness, bool):
         raise ValueError(f"fit_profile: fit_roughness must be True or False; got {fit_roughness!r}")
-    labels = list(range(n)) if labels is None else list(labels)
-    if len(labels) != n:
-        raise ValueError(f"fit_profile: labels must name the {n} records; got {len(labels)}")
 
     given = sorted(k for k in fixed_inputs if k in STABILITY_INPUTS or k == "geostrophic_wind")
     if given:
@@ -490,14 +678,30 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             f"{n_unknowns} data in all ({n_unknowns} unknowns)"
         )
 
+    sign = -1.0 if stability == "convective" else 1.0
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise),
-                          -1.0 if stability == "convective" else 1.0)
-    x, cost, converged, iterations = _multistart(model, n, max_iterations)
+                          float(speed_noise), float(direction_noise), sign)
+    from scipy.stats import chi2
+
+    dof = np.maximum(observations - n_unknowns, 1)
+    misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
+    # The iteration in chunks of records: its work arrays (records x starts x unknowns x data)
+    # stay bounded, whatever the number of records.
+    parts = []
+    for chunk in np.array_split(np.arange(n), -(-n // chunk_size)):
+        part = model if chunk.size == n else _ProfileModel(
+            abl_class, heights[chunk], speeds[chunk],
+            None if directions is None else directions[chunk],
+            {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
+            z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
+            float(speed_noise), float(direction_noise), sign)
+        result = _multistart(part, chunk.size, max_iterations)
+        _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
+        parts.append(result)
+    x, cost, converged, iterations = (np.concatenate(a) for a in zip(*parts))
     index = np.arange(n)
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
-    dof = np.maximum(observations - n_unknowns, 1)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
     speed_rms = np.sqrt(np.sum(r[:, :m] ** 2, axis=1) / valid_speeds) * speed_noise
     if directions is None:
@@ -505,9 +709,6 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     else:
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
         direction_rms = np.sqrt(np.sum(r[:, m:] ** 2, axis=1) / count) * direction_noise
-    from scipy.stats import chi2
-
-    misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
     fits = misfit <= misfit_tolerance
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
@@ -540,6 +741,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
         speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
         stability_class=shape(_stability_class(obukhov)),
+        misfit_tolerance=shape(misfit_tolerance),
     )
     abl.profile_fit = fit
     return abl
@@ -674,6 +876,27 @@ def _multistart(model, n, max_iterations):
     return x, cost, converged, iterations
 
 
+def _restart_misfits(model, x, cost, converged, iterations, refused_cost, max_iterations):
+    """Records whose best end point the chi-square test would refuse start again from a dense
+    set of stabilities (:data:`RESTART_OBUKHOV_LENGTHS`): in a strongly stable light wind the
+    objective's valleys, between the kinks where h crosses a measurement height, are narrower
+    than the multi-start's spacing. Only the refused records pay for it; in place."""
+    refused = np.flatnonzero(~(cost <= refused_cost))
+    if refused.size == 0:
+        return
+    sub = _SubsetModel(model, refused)
+    lams = _LENGTH_SCALE / np.asarray(RESTART_OBUKHOV_LENGTHS)
+    k = lams.size
+    x2, cost2, converged2, iterations2 = _levenberg_marquardt(
+        model, _starts(sub, np.broadcast_to(lams, (refused.size, k))), max_iterations,
+        np.repeat(refused, k))
+    pick = _best(x2, cost2, refused.size, k)
+    better = cost2[pick] < cost[refused] * (1.0 - 1e-6) - 1e-12
+    chosen = refused[better]
+    x[chosen], cost[chosen] = x2[pick][better], cost2[pick][better]
+    converged[chosen], iterations[chosen] = converged2[pick][better], iterations2[pick][better]
+
+
 class _SubsetModel:
     """The data of some records of a `_ProfileModel`, for `_starts`."""
 
@@ -683,55 +906,94 @@ class _SubsetModel:
         self.sign = model.sign
 
 
-def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability):
-    i = int(failing[0])
-    order = np.argsort(heights[i])
-    z, s = heights[i][order], speeds[i][order]
-    reasons = []
+#: Below this speed [m/s] at every height a record is calm: cup anemometers and vanes start
+#: at about 0.5 to 1 m/s, and a vane below it points anywhere.
+CALM_SPEED = 1.0
+
+
+def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hemisphere,
+                  roughness_length):
+    """(kind, text): why one record (heights, speeds, directions or None: its data) fits no
+    atmosphere of the model, as a person reads it. ``hemisphere``: the sign of the Coriolis
+    parameter.
+
+    Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``falling speeds``,
+    ``convective``
+    (less shear between the lowest and highest speeds than the neutral surface layer's log
+    law, by more than three standard deviations of the noise: an unstable layer, a class the
+    model does not have), ``backing`` (the direction turns the other way than an Ekman layer),
+    ``misfit``.
+    """
+    order = np.argsort(heights)
+    z, s = heights[order], speeds[order]
     ok = np.isfinite(s)
     zs, ss = z[ok], s[ok]
+    if zs.size and np.max(ss) < CALM_SPEED:
+        return "calm", (f"calm: every speed below {CALM_SPEED:g} m/s (at most {np.max(ss):.2g} "
+                        "m/s), where the vanes point anywhere and the layer has no Ekman profile")
     if zs.size >= 2:
         drops = ss[1:] - ss[:-1]
-        j = int(np.argmin(drops))
-        if ss[-1] < ss[0] - 2.0 * model.sigma_s:
-            reasons.append(f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to "
-                           f"{ss[-1]:.3g} m/s at {zs[-1]:.4g} m (the model's wind grows with "
-                           "height from the ground up to its low-level jet)")
-        elif drops[j] < -2.0 * model.sigma_s and j == 0:
-            reasons.append(f"the speed falls with height from {zs[0]:.4g} m to {zs[1]:.4g} m by "
-                           f"{-drops[0]:.3g} m/s")
+        if ss[-1] < ss[0] - 2.0 * speed_noise:
+            return "falling speeds", (
+                f"the speed falls from {ss[0]:.3g} m/s at {zs[0]:.4g} m to {ss[-1]:.3g} m/s at "
+                f"{zs[-1]:.4g} m (the model's wind grows with height from the ground up to its "
+                "low-level jet)")
+        if drops[0] < -2.0 * speed_noise:
+            return "falling speeds", (f"the speed falls with height from {zs[0]:.4g} m to "
+                                      f"{zs[1]:.4g} m by {-drops[0]:.3g} m/s")
+    if zs.size >= 2 and ss[0] > 0:
+        log_law = np.log(zs[-1] / roughness_length) / np.log(zs[0] / roughness_length)
+        spread = 3.0 * speed_noise * np.hypot(1.0, ss[-1] / ss[0]) / ss[0]
+        if ss[-1] / ss[0] < log_law - spread:
+            return "convective", (
+                f"less shear than a neutral boundary layer, the least the model has (the speed "
+                f"grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to {zs[-1]:.4g} m, the "
+                f"neutral log law {log_law:.3g} times): an unstable (convective) layer, outside "
+                "the model's classes (neutral CNBL and stable SBL)")
     if directions is not None:
-        d = directions[i][order]
+        d = directions[order]
         okd = np.isfinite(d)
         zd, dd = z[okd], d[okd]
         if zd.size >= 2:
             change = _wrap(dd[-1] - dd[0])
-            hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
             north = hemisphere > 0
-            if hemisphere * change < -2.0 * model.sigma_d:
-                reasons.append(
+            # (beyond three standard deviations of a difference of two vane readings)
+            if hemisphere * change < -3.0 * np.sqrt(2.0) * direction_noise:
+                return "backing", (
                     f"the direction {'backs' if north else 'veers'} with height by "
-                    f"{abs(change):.3g} deg from {zd[0]:.4g} m to {zd[-1]:.4g} m (an Ekman layer "
-                    f"in the {'northern' if north else 'southern'} hemisphere "
+                    f"{abs(change):.3g} deg from {zd[0]:.4g} m to {zd[-1]:.4g} m (a front or "
+                    f"cold-air advection; an Ekman layer in the "
+                    f"{'northern' if north else 'southern'} hemisphere "
                     f"{'veers' if north else 'backs'}: the direction turns "
                     f"{'clockwise' if north else 'anticlockwise'} with height)"
                 )
-    if not reasons:
-        reasons.append("the shape of its profile is outside the model's (speed and direction "
-                       "change together set u*, L and z0; a profile kinked beyond the model's, "
-                       "or directions turning more than its stability allows with that shear)")
+    return "misfit", ("the shape of its profile is outside the model's (speed and direction "
+                      "change together set u*, L and z0; a profile kinked beyond the model's, "
+                      "or directions turning more than its stability allows with that shear)")
+
+
+def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
+                  model, tolerance, probability):
+    i = int(failing[0])
+    hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
+    _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
+                              model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
     more = ""
     if failing.size > 1:
         shown = ", ".join(str(labels[k]) for k in failing[1:6])
         more = (f"; {failing.size - 1} more record(s) fail ({shown}"
                 f"{', ...' if failing.size > 6 else ''})")
     direction = "" if directions is None else f" and the directions by {direction_rms[i]:.3g} deg"
+    if not np.isfinite(misfit[i]):
+        return ValueError(
+            f"fit_profile: record {labels[i]} fits no atmosphere of the model: no state of the "
+            f"model reaches its data: {reason}{more}. Give on_misfit='flag' to keep the other "
+            "records' fits and read profile_fit.fits")
     return ValueError(
         f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
         f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
         f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg; refused "
         f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
-        f"{'; '.join(reasons)}{more}. Give "
+        f"{reason}{more}. Give "
         "on_misfit='flag' to keep the fits and read profile_fit.fits"
     )

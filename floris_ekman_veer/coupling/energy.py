@@ -215,6 +215,12 @@ class AnnualEnergy:
         ax.legend(fontsize=7)
         return ax
 
+    def __attrs_post_init__(self):
+        # print(result.table) shows every column in a plain terminal (coupling/tables.py).
+        from floris_ekman_veer.coupling.tables import FullTable
+
+        object.__setattr__(self, "table", FullTable(self.table))
+
 
 def annual_energy(
     fmodel,

@@ -63,6 +63,35 @@ def check_core(core) -> None:
     check_reference_height(core.flow_field)
     _check_conditions(core.flow_field)
     _check_turbines(core.farm)
+    warn_ignored_flow_inputs(core)
+
+
+def warn_ignored_flow_inputs(core) -> None:
+    """With an atmosphere, FLORIS's ``flow_field.wind_shear`` is not used (the atmosphere gives
+    the inflow's shear), and ``flow_field.wind_veer`` is not used by the ekman_veer models
+    (the atmosphere gives the veer; FLORIS's gauss models still read it as they do without the
+    package, docs/user_guide.md#floris-inputs-the-atmosphere-replaces): one
+    :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per value per study, so that a
+    value the user set is never silently without effect. Zero (the shipped inputs') is silent."""
+    from floris_ekman_veer.coupling.inflow import CONFIG_PATH, read_atmosphere
+
+    if read_atmosphere(core.wake.wake_velocity_parameters) is None:
+        return
+    flow_field = core.flow_field
+    shear, veer = float(flow_field.wind_shear), float(flow_field.wind_veer)
+    if shear != 0.0:
+        package_warnings.warn(
+            f"flow_field.wind_shear = {shear:g} is not used: the atmosphere ({CONFIG_PATH}) "
+            "gives the inflow's shear; set wind_shear: 0.0 to say so "
+            "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
+            package_warnings.ModelSettingsWarning, items=(("wind_shear", shear),))
+    if veer != 0.0 and uses_wake_models(core):
+        package_warnings.warn(
+            f"flow_field.wind_veer = {veer:g} deg is not used by the "
+            f"{VELOCITY_MODEL_NAME} models: the atmosphere ({CONFIG_PATH}) gives the veer; set "
+            "wind_veer: 0.0 to say so (FLORIS's gauss models read it, "
+            "docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
+            package_warnings.ModelSettingsWarning, items=(("wind_veer", veer),))
 
 
 def _check_layout(farm) -> None:
@@ -154,6 +183,14 @@ def _check_conditions(flow_field) -> None:
                  "finite and >= 0 [m/s]", speeds)
     require_each(np.isfinite(intensities) & (intensities >= 0),
                  "flow_field.turbulence_intensities", "finite and >= 0", intensities)
+    heterogeneous = getattr(flow_field, "heterogeneous_inflow_config", None) or {}
+    multipliers = heterogeneous.get("speed_multipliers")
+    if multipliers is not None:
+        values = np.asarray(multipliers, dtype=float)
+        # (a NaN would reach the thrust as "ct must be >= 0 ... got nan")
+        require_each(np.isfinite(values) & (values > 0),
+                     "flow_field.heterogeneous_inflow_config.speed_multipliers",
+                     "finite and > 0", np.atleast_1d(values))
 
 
 def _check_turbines(farm) -> None:

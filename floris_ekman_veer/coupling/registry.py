@@ -13,6 +13,7 @@ and optimization modules, and none of them imports it (docs/coupling.md#registry
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import MutableMapping
 
 from floris_ekman_veer.coupling.names import (  # noqa: F401  (part of the registry's interface)
@@ -41,6 +42,48 @@ def register_in(table: MutableMapping, name: str, cls: type, kind: str) -> type:
     return cls
 
 
+class UnknownModelError(ValueError, KeyError):
+    """A model name FLORIS's tables do not hold (a ValueError, and the KeyError FLORIS's own
+    lookup raised, for code that catches that)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+class RegisteredModels(dict):
+    """FLORIS's table of one kind of model. Looking up a name it does not hold (a typo,
+    ``ekman_ver``) is an :class:`UnknownModelError` naming the input, the registered models and
+    the closest match, instead of FLORIS's bare ``KeyError: 'ekman_ver'``."""
+
+    def __init__(self, table, path: str):
+        super().__init__(table)
+        self.path = path
+
+    def __missing__(self, name):
+        names = sorted(str(k) for k in self)
+        close = difflib.get_close_matches(str(name), names, n=1)
+        raise UnknownModelError(
+            f"{self.path}: no model named {name!r}"
+            + (f" (did you mean {close[0]!r}?)" if close else "")
+            + f"; the registered models are {names} (floris_ekman_veer adds its own on import)"
+        )
+
+
+def name_checked(tables: MutableMapping, paths: dict) -> None:
+    """Make each table of ``tables`` (FLORIS's MODEL_MAP, TURBINE_MODEL_MAP) a
+    :class:`RegisteredModels` in place (idempotent; the entries are kept)."""
+    for kind, path in paths.items():
+        table = tables.get(kind)
+        if table is not None and type(table).__name__ != RegisteredModels.__name__:
+            tables[kind] = RegisteredModels(table, path)
+
+
+#: Where each kind of model is named in a FLORIS input.
+MODEL_PATHS = {kind: f"wake.model_strings.{kind}" for kind in
+               ("velocity_model", "deflection_model", "turbulence_model", "combination_model")}
+OPERATION_MODEL_PATH = {"operation_model": "farm.turbine_type[...].operation_model"}
+
+
 def register_operation_model() -> type:
     """Register the actuator disk as FLORIS operation model ``"actuator-disk"``; return its class.
 
@@ -51,6 +94,7 @@ def register_operation_model() -> type:
 
     from floris_ekman_veer.coupling.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
 
+    name_checked(floris_turbine.TURBINE_MODEL_MAP, OPERATION_MODEL_PATH)
     return register_in(
         floris_turbine.TURBINE_MODEL_MAP["operation_model"], OPERATION_MODEL_NAME,
         ActuatorDiskTurbine, "operation model",
@@ -74,6 +118,7 @@ def register() -> None:
     from floris_ekman_veer.coupling.wake_settings import install_wake_settings_hook
     from floris_ekman_veer.coupling.yawed_rotor import install_yawed_rotor_hook
 
+    name_checked(MODEL_MAP, MODEL_PATHS)
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
                 "velocity_model")
     register_in(MODEL_MAP["velocity_model"], GAUSSIAN_2014_NAME, Gaussian2014VelocityDeficit,

@@ -76,7 +76,9 @@ class SiteAtmosphere:
             the reference height (the fitted profile's speed and meteorological direction, the
             fitted ABL's I_u).
         atmosphere: the ``ekman_veer.atmosphere`` block, one entry per record.
-        dropped: labels of the records left out as fitting no atmosphere (``on_misfit="drop"``).
+        dropped: labels of the records left out (``on_misfit="drop"``).
+        excluded: the records left out, one row each (index: the row in ``records``): ``time``,
+            ``kind`` (one of :data:`EXCLUSION_KINDS`) and ``reason``, a sentence.
     """
 
     labels: list
@@ -87,6 +89,22 @@ class SiteAtmosphere:
     turbulence_intensities: np.ndarray
     atmosphere: dict
     dropped: list
+    excluded: pd.DataFrame = attrs.field(
+        factory=lambda: pd.DataFrame({"time": [], "kind": [], "reason": []}))
+
+    def summary(self) -> pd.DataFrame:
+        """What was left out and why: per kind of record (:data:`EXCLUSION_KINDS`), the number
+        of records, the first and last time stamps, and one reason as written; and the number
+        fitted (kind ``fitted``)."""
+        rows = []
+        for kind in EXCLUSION_KINDS:
+            some = self.excluded[self.excluded["kind"] == kind]
+            if len(some):
+                rows.append({"kind": kind, "records": len(some), "first": some["time"].iloc[0],
+                             "last": some["time"].iloc[-1], "example": some["reason"].iloc[0]})
+        rows.append({"kind": "fitted", "records": len(self.labels), "first": self.labels[0],
+                     "last": self.labels[-1], "example": ""})
+        return pd.DataFrame(rows).set_index("kind")
 
     @property
     def profile_fit(self):
@@ -145,13 +163,21 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
              time_column: str = "time", **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
+    Records a mast logs that no atmosphere of the model describes (docs/measurements.md#a-year-of-records)
+    are named by their time stamp and a reason: a zero (or negative) speed reading, too few
+    data, calm, a direction backing with height (a front), speeds falling with height, less
+    shear than a neutral layer (convective: the model has neutral and stable layers only), a
+    profile the model cannot follow (misfit), a repeated time stamp, or a fitted state the
+    atmosphere block cannot give back. One record never aborts the others' fits.
+
     Args:
         records: DataFrame with ``speed_<h>m``, ``direction_<h>m`` and optionally ``time``.
         reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually).
         stability_input: the stability input of the atmosphere block (``stability_parameter``,
             ``obukhov_length`` or ``cooling_rate``; the block is checked to give back the fit).
-        on_misfit: ``"raise"`` (ValueError naming the first record no atmosphere of the model
-            fits) or ``"drop"`` (leave such records out, listed in ``dropped``).
+        on_misfit: ``"raise"`` (ValueError naming the first such record, its time stamp and
+            why) or ``"drop"`` (leave such records out: ``dropped`` lists them,
+            ``excluded`` gives each one's reason and ``summary()`` the counts).
         time_column: the column naming the records in messages and classes.
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
@@ -171,39 +197,131 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
               else [str(i) for i in records.index])
     if len(records) == 0:
         raise ValueError("fit_site: records is empty")
+    z0 = np.max(np.asarray(fit_options_and_inputs.get("roughness_length", 0.0), float))
+    if not reference_height > 10.0 * z0:
+        raise ValueError(f"fit_site: reference_height must be > 10 roughness lengths "
+                         f"(roughness_length {z0:g} m: above the roughness sublayer, where the "
+                         f"fitted profile is a wind a turbine meets); got {reference_height!r} m")
+    excluded = _screen(records, labels, heights, speeds, directions,
+                       3 if fit_options_and_inputs.get("fit_roughness") else 2)
+    if on_misfit == "raise" and excluded:
+        row, (kind, text) = next(iter(sorted(excluded.items())))
+        raise ValueError(f"fit_site: record {labels[row]} cannot be fitted: {text}"
+                         + _more(excluded, labels, row) + ". Give on_misfit='drop' to leave out "
+                         "such records (SiteAtmosphere.summary() tells what was left out and why)")
     per_record = {k: v for k, v in fit_options_and_inputs.items() if np.ndim(v) == 1}
     fit_inputs = dict(fit_options_and_inputs)
-
-    def fit(keep, policy):
-        inputs = {**fit_inputs, **{k: np.asarray(v)[keep] for k, v in per_record.items()}}
-        return EkmanABL.fit_profile(
-            heights, speeds[keep], None if directions is None else directions[keep],
-            on_misfit=policy, labels=[labels[i] for i in keep], **inputs,
-        )
-
-    everything = np.arange(len(records))
-    abl = fit(everything, "raise" if on_misfit == "raise" else "flag")
-    dropped = []
-    if on_misfit == "drop" and not np.all(abl.profile_fit.fits):
-        keep = everything[abl.profile_fit.fits]
-        dropped = [labels[i] for i in everything[~abl.profile_fit.fits]]
-        if keep.size == 0:
-            raise ValueError(f"fit_site: no record fits an atmosphere of the model "
-                             f"({len(dropped)} records)")
-        abl = fit(keep, "raise")
-    profile = abl.profile_fit
-    z_ref = np.array([float(reference_height)])
-    return SiteAtmosphere(
-        labels=list(profile.labels),
-        abl=abl,
-        reference_height=float(reference_height),
-        wind_speeds=profile.speed(z_ref)[:, 0],
-        wind_directions=profile.direction(z_ref)[:, 0],
-        turbulence_intensities=np.asarray(abl.turbulence_intensity(float(reference_height)),
-                                          float).reshape(-1),
-        atmosphere=profile.atmosphere(stability_input, reference_height=float(reference_height)),
-        dropped=dropped,
+    candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
+    if candidates.size == 0:
+        raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
+    inputs = {**fit_inputs, **{k: np.asarray(v)[candidates] for k, v in per_record.items()}}
+    abl = EkmanABL.fit_profile(
+        heights, speeds[candidates], None if directions is None else directions[candidates],
+        on_misfit="raise" if on_misfit == "raise" else "flag",
+        labels=[labels[i] for i in candidates], **inputs,
     )
+    fit = abl.profile_fit
+    for k in np.flatnonzero(~np.asarray(fit.fits)):
+        excluded[int(candidates[k])] = fit.reason(k)
+    kept = np.flatnonzero(fit.fits)
+    z_ref = float(reference_height)
+    if kept.size:
+        abl = fit.subset(kept) if kept.size < candidates.size else abl
+        fit = abl.profile_fit
+        same, _ = fit.given_back(fit.atmosphere(stability_input), z_ref)
+        if on_misfit == "raise" and not np.all(same):
+            fit.atmosphere(stability_input, reference_height=z_ref)  # raises, naming the records
+        for k in np.flatnonzero(~same):
+            excluded[int(candidates[kept[k]])] = (
+                "two states", f"its fitted state has a second one, deeper, with the same speed at "
+                f"{z_ref:g} m, which the atmosphere block gives and which does not fit the data "
+                f"(give the stability as another stability_input)")
+        if not np.all(same):
+            kept = kept[same]
+            abl = fit.subset(np.flatnonzero(same))
+            fit = abl.profile_fit
+    if kept.size == 0:
+        raise ValueError(f"fit_site: no record fits an atmosphere of the model "
+                         f"({_reasons_text(excluded)})")
+    rows = sorted(excluded)
+    table = pd.DataFrame({"time": [labels[i] for i in rows],
+                          "kind": [excluded[i][0] for i in rows],
+                          "reason": [excluded[i][1] for i in rows]},
+                         index=pd.Index(rows, name="row"))
+    return SiteAtmosphere(
+        labels=list(fit.labels),
+        abl=abl,
+        reference_height=z_ref,
+        wind_speeds=fit.speed(np.array([z_ref]))[:, 0],
+        wind_directions=fit.direction(np.array([z_ref]))[:, 0],
+        turbulence_intensities=np.asarray(abl.turbulence_intensity(z_ref), float).reshape(-1),
+        atmosphere=fit.atmosphere(stability_input),
+        dropped=list(table["time"]),
+        excluded=table,
+    )
+
+
+#: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
+EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "missing data",
+                   "calm", "falling speeds", "convective", "backing", "misfit", "two states")
+
+
+def _screen(records, labels, heights, speeds, directions, unknowns):
+    """{row: (kind, text)} of the records no fit should see: repeated time stamps, zero or
+    negative speed readings, too few data."""
+    excluded = {}
+    by_height = {float(m[1]): str(c) for c in records.columns if (m := SPEED_COLUMN.match(str(c)))}
+    speed_columns = [by_height[h] for h in heights]
+    stamps = pd.Series(labels)
+    repeated = stamps.duplicated(keep=False)
+    if repeated.any():
+        data = pd.DataFrame(speeds if directions is None else np.hstack([speeds, directions]))
+        for stamp, group in stamps[repeated].groupby(stamps[repeated], sort=False):
+            same = group.index.to_numpy()
+            if len(data.iloc[same].drop_duplicates()) == 1:  # (NaN equals NaN here)
+                for k in same[1:]:
+                    excluded[k] = ("repeated record", f"a repeat of row {same[0]} (same time "
+                                   "stamp and data): counted once")
+            else:
+                for k in same:
+                    excluded[k] = ("repeated time stamp",
+                                   f"time stamp {stamp} is given to {len(same)} records (rows "
+                                   f"{', '.join(str(j) for j in same)}) with different data: "
+                                   "which one is the record of that time is unknown")
+    bad = ~(np.isnan(speeds) | (speeds > 0))
+    for i in np.flatnonzero(bad.any(axis=1)):
+        if i in excluded:
+            continue
+        columns = [speed_columns[j] for j in np.flatnonzero(bad[i])]
+        values = sorted({f"{v:g}" for v in speeds[i][bad[i]]})
+        what = "zero" if values == ["0"] else "zero or negative" if "0" in values else "negative"
+        excluded[i] = ("zero reading",
+                       f"{what} speed reading ({', '.join(values)} m/s) in "
+                       f"{', '.join(columns)}: a calm or a stalled or failed anemometer; give NaN "
+                       "(missing) where a reading is not a measurement")
+    valid = np.sum(np.isfinite(speeds), axis=1)
+    changes = 0 if directions is None else np.maximum(
+        np.sum(np.isfinite(directions), axis=1) - 1, 0)
+    for i in np.flatnonzero((valid < 1) | (valid + changes < unknowns)):
+        if i not in excluded:
+            excluded[i] = ("missing data",
+                           f"{valid[i]} speed(s) and {np.broadcast_to(changes, valid.shape)[i]} "
+                           f"direction change(s): the fit needs a speed and {unknowns} data in all")
+    return excluded
+
+
+def _more(excluded, labels, first):
+    others = [k for k in sorted(excluded) if k != first]
+    if not others:
+        return ""
+    shown = ", ".join(labels[k] for k in others[:5])
+    return (f"; {len(others)} more record(s) cannot be fitted either ({_reasons_text(excluded)}"
+            f": {shown}{', ...' if len(others) > 5 else ''})")
+
+
+def _reasons_text(excluded):
+    counts = pd.Series([kind for kind, _ in excluded.values()]).value_counts()
+    return ", ".join(f"{n} {kind}" for kind, n in counts.items())
 
 
 def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_exponent=None,
@@ -223,15 +341,28 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     (``fit_roughness=True`` lets z0 meet the shear). Vectorised: the inputs broadcast over
     conditions of shape (n,).
     """
+    from floris_ekman_veer._validation import real_array, require_at
+
     if shear_exponent is None and veer is None:
         raise ValueError("atmosphere_from_shear_and_veer needs shear_exponent, veer or both")
+    for name, value, ok, valid in (
+            ("hub_speed", hub_speed, lambda v: v > 0, "> 0 m/s"),
+            ("hub_height", hub_height, lambda v: v > 0, "> 0 m"),
+            ("rotor_diameter", rotor_diameter, lambda v: v > 0, "> 0 m"),
+            ("shear_exponent", shear_exponent, lambda v: np.isfinite(v), "finite"),
+            ("veer", veer, lambda v: np.isfinite(v), "finite [deg]")):
+        if value is None:
+            continue
+        array = real_array(f"atmosphere_from_shear_and_veer: {name}", value, valid)
+        require_at(np.isfinite(array) & ok(array), f"atmosphere_from_shear_and_veer: {name}",
+                   valid, array)
     single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
                                            shear_exponent, veer))
     hub_speed, hub_height, rotor_diameter = (
         np.atleast_1d(np.asarray(v, dtype=float)) for v in (hub_speed, hub_height, rotor_diameter)
     )
     n = np.broadcast_shapes(hub_speed.shape, hub_height.shape, rotor_diameter.shape,
-                            np.shape(shear_exponent or 0.0), np.shape(veer or 0.0))
+                            *(np.shape(v) for v in (shear_exponent, veer) if v is not None))
     if len(n) != 1:
         raise ValueError("atmosphere_from_shear_and_veer: inputs must be numbers or 1-D arrays")
     radius = 0.5 * np.broadcast_to(rotor_diameter, n)[:, None]
@@ -256,8 +387,20 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     if single:
         heights, speeds = heights[0], speeds[0]
         directions = None if directions is None else directions[0]
-    return EkmanABL.fit_profile(
-        heights, speeds, directions,
-        speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
-        **fit_options_and_inputs,
-    )
+    try:
+        return EkmanABL.fit_profile(
+            heights, speeds, directions,
+            speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
+            **fit_options_and_inputs,
+        )
+    except ValueError as error:
+        text = str(error)
+        if "fits no atmosphere of the model" not in text:
+            raise
+        given = " and ".join(f"{k}={v!r}{unit}" for k, v, unit in (
+            ("shear_exponent", shear_exponent, ""),
+            ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
+        raise ValueError(
+            f"atmosphere_from_shear_and_veer: {given} at hub_speed {hub_speed.tolist()} m/s "
+            f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
+            f"veer_tolerance={veer_tolerance:g} deg): {text.split('): ', 1)[-1]}") from None

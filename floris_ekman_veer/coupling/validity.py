@@ -113,6 +113,41 @@ def wake_validated_stability(mu) -> np.ndarray:
     )
 
 
+#: Columns of the report that describe the condition, not its boundary layer.
+_CONDITION_COLUMNS = ("wind_direction", "wind_speed", "rotor_top")
+
+
+def _rest_rows_marked(report_function):
+    """Rows of conditions at rest (calm, or below every cut-in where no ABL reaches their speed,
+    docs/user_guide.md#calm-and-weak-winds) have no boundary layer: an ``at_rest`` column, NaN
+    (False, for flags; "at rest", for names) in the boundary layer's columns, and never
+    inside the envelope. (The solve gives them a moving condition's ABL as a stand-in.)"""
+    import functools
+
+    @functools.wraps(report_function)
+    def report_with_rest(fmodel, *args, **kwargs):
+        report = report_function(fmodel, *args, **kwargs)
+        flow_field = fmodel.core.flow_field
+        abl = solve(atmosphere_of(fmodel.core), flow_field.wind_speeds,
+                    flow_field.reference_wind_height)  # (cached: the report's own solve)
+        rest = np.asarray(getattr(abl, "at_rest", np.zeros(len(report), bool))).reshape(-1)
+        for column in report.columns:
+            if column in _CONDITION_COLUMNS or not rest.any():
+                continue
+            values = report[column]
+            if pd.api.types.is_bool_dtype(values):
+                report[column] = values & ~rest
+            elif pd.api.types.is_numeric_dtype(values):
+                report[column] = values.astype(float).where(~rest, np.nan)
+            else:
+                report[column] = values.where(~rest, "at rest")
+        report.insert(2, "at_rest", rest)
+        return report
+
+    return report_with_rest
+
+
+@_rest_rows_marked
 def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     """One row per condition of ``fmodel``: the atmosphere against the paper's envelope.
 
@@ -127,7 +162,8 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     ``stability_class`` (:func:`stability_class`), and the four checks
     ``wake_validated_stability`` (:func:`wake_validated_stability`), ``deep_enough``
     (h / rotor top >= :data:`MIN_H_OVER_ROTOR_TOP`), ``rossby_in_range`` (within
-    ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three).
+    ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three), and
+    ``at_rest`` (a calm condition: no boundary layer, its columns NaN).
 
     Raises:
         ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
