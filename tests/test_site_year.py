@@ -75,7 +75,7 @@ def test_one_call_fits_every_fittable_record_and_names_the_others(records, site)
     assert backing.str.contains(r"backs with height by [\d.]+ deg from 30 m to 150 m").all()
     assert excluded[excluded["kind"] == "calm"]["reason"].str.startswith("calm: every speed").all()
     assert excluded[excluded["kind"] == "convective"]["reason"].str.contains(
-        r"unstable \(convective\) layer, outside the model's classes").all()
+        r"unstable \(convective\) layer, outside the stable fit's classes .*stability=\"either\"").all()
 
 
 def test_summary_counts_what_was_left_out_and_why(site):

@@ -949,7 +949,8 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                 f"less shear than a neutral boundary layer, the least the model has (the speed "
                 f"grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to {zs[-1]:.4g} m, the "
                 f"neutral log law {log_law:.3g} times): an unstable (convective) layer, outside "
-                "the model's classes (neutral CNBL and stable SBL)")
+                "the stable fit's classes (neutral CNBL and stable SBL; stability=\"either\" "
+                "fits convective layers too, docs/atmosphere.md#convective-boundary-layer)")
     if directions is not None:
         d = directions[order]
         okd = np.isfinite(d)
