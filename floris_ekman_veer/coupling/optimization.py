@@ -23,6 +23,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
@@ -43,15 +44,22 @@ SCIPY_METHODS = (
 DEFAULT_CHUNK_SIZE = 256
 
 
-#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) the optimiser over the
-#: given bounds, over their negative and positive halves, and a refinement around
-#: each; ``"single"`` one run of the optimiser as given (FLORIS's own behaviour).
+#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) FLORIS's serial refine over
+#: the given bounds (its first grid spans both signs) refined by sign flips and quadratic-model
+#: steps in all turbines' yaws at once (:class:`BothSignsRefinement`); ``"single"`` one run of
+#: the optimiser as given (FLORIS's own behaviour).
 SEARCHES = ("both_signs", "single")
 
 #: Half-width of the refinement window around the best yaw found, as a fraction of each
-#: turbine's bound range: 1/8 of +-25 deg is +-6.25 deg, which FLORIS's default serial-refine
-#: passes [5, 4] resolve to 0.8 deg (docs/yaw_steering.md#finding-the-optimum).
+#: turbine's bound range, for optimisers other than the serial refine (which
+#: :class:`BothSignsRefinement` refines instead): 1/8 of +-25 deg is +-6.25 deg, which FLORIS's
+#: default serial-refine passes [5, 4] resolve to 0.8 deg.
 REFINE_FRACTION = 1.0 / 8.0
+
+#: Finite-difference steps [deg] of the quadratic-model refinement after the serial refine: one
+#: full model (gradient and Hessian) per step, the last one re-using the previous Hessian's
+#: cross terms (docs/yaw_steering.md#finding-the-optimum).
+QUADRATIC_STEPS = (1.0, 0.5)
 
 
 def optimize_yaw(
@@ -101,9 +109,10 @@ def optimize_yaw(
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
-    run = functools.partial(_optimize_once, fmodel, optimizer_class, progress=progress,
-                            chunk_size=chunk_size)
-    first = run(**optimizer_kwargs)
+    run = functools.partial(_optimize_once, fmodel, progress=progress, chunk_size=chunk_size)
+    if search == "both_signs" and issubclass(optimizer_class, YawOptimizationSR):
+        return run(_both_signs_class(optimizer_class), **optimizer_kwargs)
+    first = run(optimizer_class, **optimizer_kwargs)
     if search == "single" or first["farm_power_opt"].isna().any():
         return first
 
@@ -118,7 +127,7 @@ def optimize_yaw(
         # The restricted bounds exclude the zero-yaw baseline by design; FLORIS prints an
         # "INFO: yaw_angles_baseline exceed ... constraints" line for each such run.
         with contextlib.redirect_stdout(io.StringIO()):
-            return run(**_with_bounds(optimizer_kwargs, lower, upper))
+            return run(optimizer_class, **_with_bounds(optimizer_kwargs, lower, upper))
 
     candidates = [first]
     if np.any((lower < 0.0) & (upper > 0.0)):
@@ -127,31 +136,168 @@ def optimize_yaw(
     width = REFINE_FRACTION * (upper - lower)
     refined = []
     for candidate in candidates:
-        centre = np.vstack(candidate["yaw_angles_opt"].to_numpy())
+        centre = np.clip(np.vstack(candidate["yaw_angles_opt"].to_numpy()), lower, upper)
         refined.append(run_within(np.maximum(centre - width, lower),
                                   np.minimum(centre + width, upper)))
     return _best_of(candidates + refined)
 
 
-def _with_bounds(options, lower, upper):
-    """The options with per-condition bounds (and no x0 outside them)."""
-    bounded = {**options, "minimum_yaw_angle": lower, "maximum_yaw_angle": upper}
-    if options.get("x0") is not None:
-        bounded["x0"] = np.clip(np.broadcast_to(np.asarray(options["x0"], dtype=float),
-                                                lower.shape), lower, upper)
-    return bounded
+@functools.cache
+def _both_signs_class(optimizer_class):
+    """``optimizer_class`` (a serial refine) with :class:`BothSignsRefinement` in front."""
+    return type(f"BothSigns{optimizer_class.__name__}", (BothSignsRefinement, optimizer_class),
+                {"__module__": __name__})
 
 
-def _best_of(frames):
-    """Per condition, the row of the frame with the highest farm_power_opt (the first on ties)."""
-    powers = np.stack([f["farm_power_opt"].to_numpy(dtype=float) for f in frames])
-    choice = np.argmax(powers, axis=0)
-    best = frames[0].copy()
-    for k, frame in enumerate(frames[1:], start=1):
-        rows = choice == k
-        best.loc[rows, "yaw_angles_opt"] = frame.loc[rows, "yaw_angles_opt"]
-        best.loc[rows, "farm_power_opt"] = frame.loc[rows, "farm_power_opt"]
-    return best
+class BothSignsRefinement:
+    """Mix-in for FLORIS's serial-refine optimiser (``YawOptimizationSR`` or a subclass): its
+    search, started inside the bounds, then refined in all turbines' yaws together.
+
+    The serial refine (Fleming et al. 2022) moves one turbine at a time on grids that end
+    ``(upper - lower) / (Ny_passes[0] - 1) / prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg
+    and [5, 4]); where the best yaws of two turbines are coupled (an upstream turbine's yaw
+    steers the wake the next one steers further) it stops on the ridge between them. After its
+    passes, every condition's best yaws are refined, all conditions in one FLORIS evaluation
+    per step, as the serial refine evaluates its grids:
+
+    1. sign flips: each turbine's yaw mirrored (clipped to its bounds) one at a time, and all
+       of them together (n_turbines + 1 evaluations);
+    2. per step h of :data:`QUADRATIC_STEPS`, a quadratic model of the farm power fitted to
+       the best yaws, two points along each turbine's yaw and one along each pair (the full
+       gradient and Hessian: 1 + n(n+3)/2 evaluations; the last step keeps the cross terms of
+       the previous Hessian and samples the 2n points only), and its maximum, limited to 4 h
+       in each yaw and to the bounds, at full and half length (2 evaluations).
+
+    Every evaluation is kept only where it beats the best so far, so the result is never below
+    the serial refine's. Bounds that exclude zero yaw start the search at the allowed yaw
+    closest to the baseline (FLORIS's own run would return the out-of-bounds baseline when no
+    grid point beats it).
+    """
+
+    def __init__(self, fmodel, *args, **kwargs):
+        super().__init__(fmodel, *args, **kwargs)
+        start = np.clip(self._yaw_angles_baseline_subset, self._minimum_yaw_angle_subset,
+                        self._maximum_yaw_angle_subset)
+        if np.any(start != self._yaw_angles_baseline_subset):
+            self._yaw_angles_opt_subset = start
+            self._farm_power_opt_subset = self._calculate_farm_power(start)
+
+    def _finalize(self, *args, **kwargs):
+        if not args and not kwargs:
+            self._refine_both_signs()
+        return super()._finalize(*args, **kwargs)
+
+    def _refine_both_signs(self):
+        lower, upper = self._minimum_yaw_angle_subset, self._maximum_yaw_angle_subset
+        best = self._yaw_angles_opt_subset
+        n = best.shape[1]
+        flips = np.repeat(best[None], n + 1, axis=0)
+        flips[np.arange(n), :, np.arange(n)] *= -1.0
+        flips[n] *= -1.0
+        self._keep_best(np.clip(flips, lower, upper))
+        hessian = None
+        for k, step in enumerate(QUADRATIC_STEPS):
+            best, power = self._yaw_angles_opt_subset, self._farm_power_opt_subset
+            cross = hessian is None or k < len(QUADRATIC_STEPS) - 1
+            points = _quadratic_stencil(best, lower, upper, step, cross)
+            powers = self._keep_best(points)
+            gradient, hessian = _quadratic_fit(points - best, powers - power,
+                                               None if cross else hessian)
+            moves = _newton_moves(gradient, hessian, best, lower, upper, 4.0 * step)
+            self._keep_best(np.clip(best + np.concatenate([moves, 0.5 * moves[:1]]),
+                                    lower, upper))
+
+    def _keep_best(self, points):
+        """Evaluate (K, n_findex, n_turbines) yaws in one FLORIS run (FLORIS's own tiling and
+        memory of the serial refine) and keep per condition the best above the best so far."""
+        powers = self._calc_powers_with_memory(points)
+        finite = np.where(np.isfinite(powers), powers, -np.inf)
+        pick = np.argmax(finite, axis=0)
+        conditions = np.arange(points.shape[1])
+        better = finite[pick, conditions] > self._farm_power_opt_subset
+        self._yaw_angles_opt_subset = np.where(better[:, None], points[pick, conditions],
+                                               self._yaw_angles_opt_subset)
+        self._farm_power_opt_subset = np.where(better, finite[pick, conditions],
+                                               self._farm_power_opt_subset)
+        return powers
+
+
+def _quadratic_stencil(centre, lower, upper, step, cross):
+    """(K, n_findex, n_turbines) yaws around ``centre``: per turbine two points ``step`` apart
+    inside its bounds (+-step, or one-sided step and 2 step at a bound), and with ``cross`` one
+    point per turbine pair; turbines whose range is below 3e-3 deg stay put."""
+    reach = np.minimum(step, (upper - lower) / 3.0)
+    first = np.where(centre + reach <= upper, reach, -reach)
+    second = np.where((centre - first >= lower) & (centre - first <= upper), -first, 2.0 * first)
+    n = centre.shape[1]
+    offsets = []
+    for i in range(n):
+        for along in (first, second):
+            offset = np.zeros_like(centre)
+            offset[:, i] = along[:, i]
+            offsets.append(offset)
+    if cross:
+        for i, j in zip(*np.triu_indices(n, 1)):
+            offset = np.zeros_like(centre)
+            offset[:, [i, j]] = first[:, [i, j]]
+            offsets.append(offset)
+    return np.clip(centre + np.stack(offsets), lower, upper)
+
+
+def _quadratic_fit(offsets, gains, hessian=None):
+    """Gradient and Hessian, per condition, of the quadratic fitted (least squares) to
+    ``gains`` (K, n_findex) at ``offsets`` (K, n_findex, n) from the centre; with ``hessian``
+    given, only the gradient and the Hessian's diagonal are fitted (its cross terms kept).
+    Conditions with a non-finite gain get a zero gradient."""
+    d = np.moveaxis(offsets, 0, 1)                                   # (F, K, n)
+    y = np.moveaxis(gains, 0, 1)                                     # (F, K)
+    n_conditions, _, n = d.shape
+    if hessian is None:
+        i, j = np.triu_indices(n)
+    else:
+        i = j = np.arange(n)
+        off_diagonal = hessian * (1.0 - np.eye(n))
+        y = y - 0.5 * np.einsum("fki,fij,fkj->fk", d, off_diagonal, d)
+    columns = np.concatenate(
+        [d, d[:, :, i] * d[:, :, j] * np.where(i == j, 0.5, 1.0)], axis=2)
+    finite = np.all(np.isfinite(y), axis=1)
+    coefficients = np.einsum("fpk,fk->fp", np.linalg.pinv(columns),
+                             np.where(finite[:, None], y, 0.0))
+    fitted = np.zeros((n_conditions, n, n))
+    fitted[:, i, j] = coefficients[:, n:]
+    fitted[:, j, i] = coefficients[:, n:]
+    if hessian is not None:
+        fitted = fitted + off_diagonal
+    return np.where(finite[:, None], coefficients[:, :n], 0.0), fitted
+
+
+def _newton_moves(gradient, hessian, centre, lower, upper, radius):
+    """(2, n_findex, n) moves towards the maximum of the quadratic model: the full Newton move
+    and the move of each yaw alone (the Hessian's diagonal), both over the yaws not held at a
+    bound and at most ``radius`` along each direction of the Hessian (or each yaw).
+
+    The full move solves the model along the Hessian's eigenvectors, an eigenvalue that would
+    move further than ``radius`` (or is not negative: no maximum) being lowered until the move
+    is ``radius`` uphill; a yaw at a bound that the move would push out is held there and the
+    move recomputed (an active set, twice at most)."""
+    n = centre.shape[1]
+    free = upper - lower >= 1e-3
+    for _ in range(3):
+        both = free[:, :, None] & free[:, None, :]
+        values, vectors = np.linalg.eigh(np.where(both, hessian, -np.eye(n)))
+        along = np.einsum("fkj,fk->fj", vectors, np.where(free, gradient, 0.0))
+        values = np.minimum(values, -np.abs(along) / radius - 1e-300)
+        move = -np.einsum("fij,fj->fi", vectors, along / values)
+        held = free & (((centre <= lower) & (move < 0.0)) | ((centre >= upper) & (move > 0.0)))
+        if not held.any():
+            break
+        free = free & ~held
+    move = np.clip(np.where(free, move, 0.0), -radius, radius)
+    curvature = np.einsum("fii->fi", hessian)
+    alone = np.where(free & (curvature < 0.0),
+                     np.clip(-gradient / np.where(curvature < 0.0, curvature, -1.0),
+                             -radius, radius), 0.0)
+    return np.stack([move, alone])
 
 
 def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer_kwargs):
