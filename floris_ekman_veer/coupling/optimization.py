@@ -300,6 +300,27 @@ def _newton_moves(gradient, hessian, centre, lower, upper, radius):
     return np.stack([move, alone])
 
 
+def _with_bounds(options, lower, upper):
+    """The options with per-condition bounds (and no x0 outside them)."""
+    bounded = {**options, "minimum_yaw_angle": lower, "maximum_yaw_angle": upper}
+    if options.get("x0") is not None:
+        bounded["x0"] = np.clip(np.broadcast_to(np.asarray(options["x0"], dtype=float),
+                                                lower.shape), lower, upper)
+    return bounded
+
+
+def _best_of(frames):
+    """Per condition, the row of the frame with the highest farm_power_opt (the first on ties)."""
+    powers = np.stack([f["farm_power_opt"].to_numpy(dtype=float) for f in frames])
+    choice = np.argmax(powers, axis=0)
+    best = frames[0].copy()
+    for k, frame in enumerate(frames[1:], start=1):
+        rows = choice == k
+        best.loc[rows, "yaw_angles_opt"] = frame.loc[rows, "yaw_angles_opt"]
+        best.loc[rows, "farm_power_opt"] = frame.loc[rows, "farm_power_opt"]
+    return best
+
+
 def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer_kwargs):
     """One run of the optimiser over every condition (per atmosphere and chunk)."""
     n_findex = fmodel.core.flow_field.n_findex
