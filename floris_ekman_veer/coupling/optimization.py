@@ -195,17 +195,34 @@ class BothSignsRefinement:
         flips[np.arange(n), :, np.arange(n)] *= -1.0
         flips[n] *= -1.0
         self._keep_best(np.clip(flips, lower, upper))
+        coupled = self._coupled_pairs()
         hessian = None
         for k, step in enumerate(QUADRATIC_STEPS):
             best, power = self._yaw_angles_opt_subset, self._farm_power_opt_subset
-            cross = hessian is None or k < len(QUADRATIC_STEPS) - 1
-            points = _quadratic_stencil(best, lower, upper, step, cross)
-            powers = self._keep_best(points)
-            gradient, hessian = _quadratic_fit(points - best, powers - power,
-                                               None if cross else hessian)
+            pairs = coupled if hessian is None or k < len(QUADRATIC_STEPS) - 1 else None
+            stencil = _QuadraticStencil(best, lower, upper, step, pairs)
+            gradient, hessian = stencil.fit(self._keep_best(stencil.points) - power, hessian)
             moves = _newton_moves(gradient, hessian, best, lower, upper, 4.0 * step)
             self._keep_best(np.clip(best + np.concatenate([moves, 0.5 * moves[:1]]),
                                     lower, upper))
+
+    def _coupled_pairs(self):
+        """(n_findex, n, n) turbine pairs whose yaws act on a common farm power: one in the
+        other's wake, or both waking a third, by FLORIS's conservative linear wake cone
+        (half-width D + 0.3 x, ``derive_downstream_turbines``); the quadratic model samples
+        the cross terms of these pairs only."""
+        fmodel = self.fmodel_subset
+        angle = np.radians(fmodel.core.flow_field.wind_directions - 270.0)[:, None]
+        x, y = fmodel.layout_x[None, :], fmodel.layout_y[None, :]
+        x_rot = np.cos(angle) * x - np.sin(angle) * y
+        y_rot = np.sin(angle) * x + np.cos(angle) * y
+        diameter = np.broadcast_to(np.asarray(fmodel.core.farm.rotor_diameters, float),
+                                   x_rot.shape)
+        downstream = x_rot[:, None, :] - x_rot[:, :, None]                 # [f, i, j]: x_j - x_i
+        wakes = (downstream > 0.01) & (np.abs(y_rot[:, None, :] - y_rot[:, :, None])
+                                       < diameter[:, :, None] + 0.3 * downstream)
+        common = np.einsum("fik,fjk->fij", wakes.astype(float), wakes.astype(float)) > 0.0
+        return wakes | np.swapaxes(wakes, 1, 2) | common
 
     def _keep_best(self, points):
         """Evaluate (K, n_findex, n_turbines) yaws in one FLORIS run (FLORIS's own tiling and
@@ -222,53 +239,60 @@ class BothSignsRefinement:
         return powers
 
 
-def _quadratic_stencil(centre, lower, upper, step, cross):
-    """(K, n_findex, n_turbines) yaws around ``centre``: per turbine two points ``step`` apart
-    inside its bounds (+-step, or one-sided step and 2 step at a bound), and with ``cross`` one
-    point per turbine pair; turbines whose range is below 3e-3 deg stay put."""
-    reach = np.minimum(step, (upper - lower) / 3.0)
-    first = np.where(centre + reach <= upper, reach, -reach)
-    second = np.where((centre - first >= lower) & (centre - first <= upper), -first, 2.0 * first)
-    n = centre.shape[1]
-    offsets = []
-    for i in range(n):
-        for along in (first, second):
-            offset = np.zeros_like(centre)
-            offset[:, i] = along[:, i]
-            offsets.append(offset)
-    if cross:
-        for i, j in zip(*np.triu_indices(n, 1)):
-            offset = np.zeros_like(centre)
-            offset[:, [i, j]] = first[:, [i, j]]
-            offsets.append(offset)
-    return np.clip(centre + np.stack(offsets), lower, upper)
+class _QuadraticStencil:
+    """Yaws around ``centre`` that determine a quadratic model of the farm power by finite
+    differences: per turbine two points along its yaw inside its bounds (+-step, or step and
+    2 step away from a bound it is within step of), and per coupled pair (``pairs``, (n_findex,
+    n, n) booleans, or None for none) one point moving both. Turbines whose range is below
+    3e-3 deg stay put. ``points`` is (K, n_findex, n); where a condition has fewer coupled
+    pairs than K the remaining points are the centre (which the serial refine's memory does
+    not evaluate again)."""
 
+    def __init__(self, centre, lower, upper, step, pairs=None):
+        reach = np.minimum(step, (upper - lower) / 3.0)
+        self.free = reach >= 1e-3
+        reach = np.where(self.free, reach, 1.0)
+        self.first = np.where(centre + reach <= upper, reach, -reach)
+        back = centre - self.first
+        self.second = np.where((back >= lower) & (back <= upper), -self.first, 2.0 * self.first)
+        n = centre.shape[1]
+        axes = np.zeros((2, n) + centre.shape)
+        axes[0, np.arange(n), :, np.arange(n)] = np.where(self.free, self.first, 0.0).T
+        axes[1, np.arange(n), :, np.arange(n)] = np.where(self.free, self.second, 0.0).T
+        if pairs is None:
+            self.pairs = (np.zeros(0, int),) * 4
+            crossed = np.zeros((0,) + centre.shape)
+        else:
+            both = np.triu(pairs, 1) & self.free[:, :, None] & self.free[:, None, :]
+            condition, i, j = np.nonzero(both)
+            rank = np.arange(condition.size) - np.searchsorted(condition, condition)
+            crossed = np.zeros((rank.max() + 1 if rank.size else 0,) + centre.shape)
+            crossed[rank, condition, i] = self.first[condition, i]
+            crossed[rank, condition, j] = self.first[condition, j]
+            self.pairs = (rank, condition, i, j)
+        self.n = n
+        self.points = np.clip(centre + np.concatenate([axes[0], axes[1], crossed]), lower, upper)
 
-def _quadratic_fit(offsets, gains, hessian=None):
-    """Gradient and Hessian, per condition, of the quadratic fitted (least squares) to
-    ``gains`` (K, n_findex) at ``offsets`` (K, n_findex, n) from the centre; with ``hessian``
-    given, only the gradient and the Hessian's diagonal are fitted (its cross terms kept).
-    Conditions with a non-finite gain get a zero gradient."""
-    d = np.moveaxis(offsets, 0, 1)                                   # (F, K, n)
-    y = np.moveaxis(gains, 0, 1)                                     # (F, K)
-    n_conditions, _, n = d.shape
-    if hessian is None:
-        i, j = np.triu_indices(n)
-    else:
-        i = j = np.arange(n)
-        off_diagonal = hessian * (1.0 - np.eye(n))
-        y = y - 0.5 * np.einsum("fki,fij,fkj->fk", d, off_diagonal, d)
-    columns = np.concatenate(
-        [d, d[:, :, i] * d[:, :, j] * np.where(i == j, 0.5, 1.0)], axis=2)
-    finite = np.all(np.isfinite(y), axis=1)
-    coefficients = np.einsum("fpk,fk->fp", np.linalg.pinv(columns),
-                             np.where(finite[:, None], y, 0.0))
-    fitted = np.zeros((n_conditions, n, n))
-    fitted[:, i, j] = coefficients[:, n:]
-    fitted[:, j, i] = coefficients[:, n:]
-    if hessian is not None:
-        fitted = fitted + off_diagonal
-    return np.where(finite[:, None], coefficients[:, :n], 0.0), fitted
+    def fit(self, gains, hessian=None):
+        """(gradient, Hessian) per condition from ``gains`` (K, n_findex): the farm power at
+        ``points`` less that at the centre. The cross terms of pairs not sampled are those of
+        ``hessian`` (or zero). Conditions with a non-finite gain get a zero gradient."""
+        n, a, b = self.n, self.first, self.second
+        along_a, along_b = gains[:n].T, gains[n:2 * n].T
+        curvature = 2.0 * (along_a / a - along_b / b) / (a - b)
+        gradient = along_a / a - 0.5 * curvature * a
+        fitted = (np.zeros((gains.shape[1], n, n)) if hessian is None
+                  else hessian * (1.0 - np.eye(n)))
+        rank, condition, i, j = self.pairs
+        cross = (gains[2 * n + rank, condition] - along_a[condition, i] - along_a[condition, j]) \
+            / (a[condition, i] * a[condition, j])
+        fitted[condition, i, j] = cross
+        fitted[condition, j, i] = cross
+        fitted[:, np.arange(n), np.arange(n)] = np.where(self.free, curvature, 0.0)
+        finite = np.all(np.isfinite(gradient), axis=1) & np.all(np.isfinite(fitted), axis=(1, 2))
+        gradient = np.where(finite[:, None] & self.free, gradient, 0.0)
+        fitted = np.where(finite[:, None, None], fitted, 0.0)
+        return gradient, fitted
 
 
 def _newton_moves(gradient, hessian, centre, lower, upper, radius):
