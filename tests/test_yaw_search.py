@@ -158,10 +158,14 @@ def test_single_search_is_floris_own_and_loses_the_other_sign(brute_force):
         1.0 - float(both["farm_power_opt"].iloc[0]) / reference
 
 
-@pytest.mark.parametrize("spec", NIGHT_ROWS, ids=[f"{r[2]:.0f}deg" for r in NIGHT_ROWS])
+@pytest.mark.parametrize("spec", [
+    pytest.param(spec, id=f"{spec[2]:.0f}deg", marks=() if k == 0 else pytest.mark.study)
+    for k, spec in enumerate(NIGHT_ROWS)
+])
 def test_night_rows_within_0_05_percent_of_refined_brute_force(spec):
     """The held-out night rows: within 0.05 % of the 1-degree grid refined by Nelder-Mead, and
-    above FLORIS's own serial refine."""
+    above FLORIS's own serial refine (the first row in the fast suite, all three in the study
+    run)."""
     pairs, angles, (table,) = brute_force_tables([spec])
     _, reference = refined_brute_force(spec, table, pairs, angles)
     df = optimize_yaw(row(*spec), YawOptimizationSR, minimum_yaw_angle=-LIMIT,
