@@ -80,8 +80,8 @@ def optimize_yaw(
     result by sign flips and quadratic-model steps in all yaws together, batched over all
     conditions as the serial refine batches its grids (:class:`BothSignsRefinement`): measured
     within 0.05 % of farm power of a brute-force 1-degree search refined by Nelder-Mead on
-    held-out 3-turbine rows (tests/test_yaw_search.py), at 1.8 x the serial refine's own cost
-    (benchmarks/bench_yaw_search.py). Other optimisers reporting farm power
+    held-out 3-turbine rows (tests/test_yaw_search.py), evaluating 1.8 x the conditions of the
+    serial refine's own run on a 3 x 3 farm (benchmarks/bench_yaw_search.py). Other optimisers reporting farm power
     (``YawOptimizationScipy``) run over the given bounds, over their negative and positive
     parts, and once more within +-:data:`REFINE_FRACTION` of each turbine's bound range around
     each result, keeping per condition the best; ``YawOptimizationGeometric`` (no farm power)
