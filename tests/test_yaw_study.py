@@ -1,5 +1,6 @@
 """examples/yaw_study.py at reduced size (no figures): the numbers it prints are consistent and
-show what docs/yaw_steering.md says."""
+show what docs/yaw_steering.md says. A long study (marker ``study``): ``.ci/run`` runs it after the
+README's test command."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ import numpy as np
 import pytest
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "yaw_study.py"
+
+pytestmark = pytest.mark.study
 
 
 @pytest.fixture(scope="module")

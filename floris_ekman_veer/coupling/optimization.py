@@ -23,6 +23,7 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
@@ -43,15 +44,22 @@ SCIPY_METHODS = (
 DEFAULT_CHUNK_SIZE = 256
 
 
-#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) the optimiser over the
-#: given bounds, over their negative and positive halves, and a refinement around
-#: each; ``"single"`` one run of the optimiser as given (FLORIS's own behaviour).
+#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) FLORIS's serial refine over
+#: the given bounds (its first grid spans both signs) refined by sign flips and quadratic-model
+#: steps in all turbines' yaws at once (:class:`BothSignsRefinement`); ``"single"`` one run of
+#: the optimiser as given (FLORIS's own behaviour).
 SEARCHES = ("both_signs", "single")
 
 #: Half-width of the refinement window around the best yaw found, as a fraction of each
-#: turbine's bound range: 1/8 of +-25 deg is +-6.25 deg, which FLORIS's default serial-refine
-#: passes [5, 4] resolve to 0.8 deg (docs/yaw_steering.md#finding-the-optimum).
+#: turbine's bound range, for optimisers other than the serial refine (which
+#: :class:`BothSignsRefinement` refines instead): 1/8 of +-25 deg is +-6.25 deg, which FLORIS's
+#: default serial-refine passes [5, 4] resolve to 0.8 deg.
 REFINE_FRACTION = 1.0 / 8.0
+
+#: Finite-difference steps [deg] of the quadratic-model refinement after the serial refine: one
+#: full model (gradient and Hessian) per step, the last one re-using the previous Hessian's
+#: cross terms (docs/yaw_steering.md#finding-the-optimum).
+QUADRATIC_STEPS = (1.0, 0.5)
 
 
 def optimize_yaw(
@@ -65,14 +73,19 @@ def optimize_yaw(
 ) -> pd.DataFrame:
     """Optimal yaw angles for every condition of ``fmodel`` with a FLORIS yaw optimiser.
 
-    Veer makes the two signs of yaw differ, and FLORIS's serial-refine optimiser, searching
-    -25..25 deg on a coarse first grid (5 angles), can settle on the worse sign. The default
-    ``search="both_signs"`` therefore runs the optimiser over the given bounds, over their
-    negative part and over their positive part (where the bounds straddle 0), runs it once more
-    around each of these results, within +-:data:`REFINE_FRACTION` of each turbine's bound
-    range (and within the bounds), and keeps per condition the best of them all. Measured on held-out 3-turbine rows: within 0.05 % of farm power of a
-    brute-force 1-degree search (tests/test_optimization.py). Optimisers that report no farm
-    power (``YawOptimizationGeometric``) run once.
+    Veer makes the two signs of yaw differ, and FLORIS's serial-refine optimiser, moving one
+    turbine at a time on grids that end 3.1 deg apart (-25..25 deg, [5, 4]), stops short of the
+    optimum where turbines' yaws are coupled. The default ``search="both_signs"`` runs a serial
+    refine (``YawOptimizationSR`` or a subclass) once with the given options and refines its
+    result by sign flips and quadratic-model steps in all yaws together, batched over all
+    conditions as the serial refine batches its grids (:class:`BothSignsRefinement`): measured
+    within 0.05 % of farm power of a brute-force 1-degree search refined by Nelder-Mead on
+    held-out 3-turbine rows (tests/test_yaw_search.py), evaluating 1.8 x the conditions of the
+    serial refine's own run on a 3 x 3 farm (benchmarks/bench_yaw_search.py). Other optimisers reporting farm power
+    (``YawOptimizationScipy``) run over the given bounds, over their negative and positive
+    parts, and once more within +-:data:`REFINE_FRACTION` of each turbine's bound range around
+    each result, keeping per condition the best; ``YawOptimizationGeometric`` (no farm power)
+    runs once.
 
     Args:
         fmodel: FlorisModel, ParFlorisModel or UncertainFlorisModel, with a scalar or a
@@ -101,9 +114,10 @@ def optimize_yaw(
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
-    run = functools.partial(_optimize_once, fmodel, optimizer_class, progress=progress,
-                            chunk_size=chunk_size)
-    first = run(**optimizer_kwargs)
+    run = functools.partial(_optimize_once, fmodel, progress=progress, chunk_size=chunk_size)
+    if search == "both_signs" and issubclass(optimizer_class, YawOptimizationSR):
+        return run(_both_signs_class(optimizer_class), **optimizer_kwargs)
+    first = run(optimizer_class, **optimizer_kwargs)
     if search == "single" or first["farm_power_opt"].isna().any():
         return first
 
@@ -118,7 +132,7 @@ def optimize_yaw(
         # The restricted bounds exclude the zero-yaw baseline by design; FLORIS prints an
         # "INFO: yaw_angles_baseline exceed ... constraints" line for each such run.
         with contextlib.redirect_stdout(io.StringIO()):
-            return run(**_with_bounds(optimizer_kwargs, lower, upper))
+            return run(optimizer_class, **_with_bounds(optimizer_kwargs, lower, upper))
 
     candidates = [first]
     if np.any((lower < 0.0) & (upper > 0.0)):
@@ -127,10 +141,192 @@ def optimize_yaw(
     width = REFINE_FRACTION * (upper - lower)
     refined = []
     for candidate in candidates:
-        centre = np.vstack(candidate["yaw_angles_opt"].to_numpy())
+        centre = np.clip(np.vstack(candidate["yaw_angles_opt"].to_numpy()), lower, upper)
         refined.append(run_within(np.maximum(centre - width, lower),
                                   np.minimum(centre + width, upper)))
     return _best_of(candidates + refined)
+
+
+@functools.cache
+def _both_signs_class(optimizer_class):
+    """``optimizer_class`` (a serial refine) with :class:`BothSignsRefinement` in front."""
+    return type(f"BothSigns{optimizer_class.__name__}", (BothSignsRefinement, optimizer_class),
+                {"__module__": __name__})
+
+
+class BothSignsRefinement:
+    """Mix-in for FLORIS's serial-refine optimiser (``YawOptimizationSR`` or a subclass): its
+    search, started inside the bounds, then refined in all turbines' yaws together.
+
+    The serial refine (Fleming et al. 2022) moves one turbine at a time on grids that end
+    ``(upper - lower) / (Ny_passes[0] - 1) / prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg
+    and [5, 4]); where the best yaws of two turbines are coupled (an upstream turbine's yaw
+    steers the wake the next one steers further) it stops on the ridge between them. After its
+    passes, every condition's best yaws are refined, all conditions in one FLORIS evaluation
+    per step, as the serial refine evaluates its grids:
+
+    1. sign flips: each turbine's yaw mirrored (clipped to its bounds) one at a time, and all
+       of them together (n_turbines + 1 evaluations);
+    2. per step h of :data:`QUADRATIC_STEPS`, a quadratic model of the farm power fitted to
+       the best yaws, two points along each turbine's yaw and one along each pair (the full
+       gradient and Hessian: 1 + n(n+3)/2 evaluations; the last step keeps the cross terms of
+       the previous Hessian and samples the 2n points only), and its maximum, limited to 4 h
+       in each yaw and to the bounds, at full and half length (2 evaluations).
+
+    Every evaluation is kept only where it beats the best so far, so the result is never below
+    the serial refine's. Bounds that exclude zero yaw start the search at the allowed yaw
+    closest to the baseline (FLORIS's own run would return the out-of-bounds baseline when no
+    grid point beats it).
+    """
+
+    def __init__(self, fmodel, *args, **kwargs):
+        super().__init__(fmodel, *args, **kwargs)
+        start = np.clip(self._yaw_angles_baseline_subset, self._minimum_yaw_angle_subset,
+                        self._maximum_yaw_angle_subset)
+        if np.any(start != self._yaw_angles_baseline_subset):
+            self._yaw_angles_opt_subset = start
+            self._farm_power_opt_subset = self._calculate_farm_power(start)
+
+    def _finalize(self, *args, **kwargs):
+        if not args and not kwargs:
+            self._refine_both_signs()
+        return super()._finalize(*args, **kwargs)
+
+    def _refine_both_signs(self):
+        lower, upper = self._minimum_yaw_angle_subset, self._maximum_yaw_angle_subset
+        best = self._yaw_angles_opt_subset
+        n = best.shape[1]
+        flips = np.repeat(best[None], n + 1, axis=0)
+        flips[np.arange(n), :, np.arange(n)] *= -1.0
+        flips[n] *= -1.0
+        self._keep_best(np.clip(flips, lower, upper))
+        coupled = self._coupled_pairs()
+        hessian = None
+        for k, step in enumerate(QUADRATIC_STEPS):
+            best, power = self._yaw_angles_opt_subset, self._farm_power_opt_subset
+            pairs = coupled if hessian is None or k < len(QUADRATIC_STEPS) - 1 else None
+            stencil = _QuadraticStencil(best, lower, upper, step, pairs)
+            gradient, hessian = stencil.fit(self._keep_best(stencil.points) - power, hessian)
+            moves = _newton_moves(gradient, hessian, best, lower, upper, 4.0 * step)
+            self._keep_best(np.clip(best + np.concatenate([moves, 0.5 * moves[:1]]),
+                                    lower, upper))
+
+    def _coupled_pairs(self):
+        """(n_findex, n, n) turbine pairs whose yaws act on a common farm power: one in the
+        other's wake, or both waking a third, by FLORIS's conservative linear wake cone
+        (half-width D + 0.3 x, ``derive_downstream_turbines``); the quadratic model samples
+        the cross terms of these pairs only."""
+        fmodel = self.fmodel_subset
+        angle = np.radians(fmodel.core.flow_field.wind_directions - 270.0)[:, None]
+        x, y = fmodel.layout_x[None, :], fmodel.layout_y[None, :]
+        x_rot = np.cos(angle) * x - np.sin(angle) * y
+        y_rot = np.sin(angle) * x + np.cos(angle) * y
+        diameter = np.broadcast_to(np.asarray(fmodel.core.farm.rotor_diameters, float),
+                                   x_rot.shape)
+        downstream = x_rot[:, None, :] - x_rot[:, :, None]                 # [f, i, j]: x_j - x_i
+        wakes = (downstream > 0.01) & (np.abs(y_rot[:, None, :] - y_rot[:, :, None])
+                                       < diameter[:, :, None] + 0.3 * downstream)
+        common = np.einsum("fik,fjk->fij", wakes.astype(float), wakes.astype(float)) > 0.0
+        return wakes | np.swapaxes(wakes, 1, 2) | common
+
+    def _keep_best(self, points):
+        """Evaluate (K, n_findex, n_turbines) yaws in one FLORIS run (FLORIS's own tiling and
+        memory of the serial refine) and keep per condition the best above the best so far."""
+        powers = self._calc_powers_with_memory(points)
+        finite = np.where(np.isfinite(powers), powers, -np.inf)
+        pick = np.argmax(finite, axis=0)
+        conditions = np.arange(points.shape[1])
+        better = finite[pick, conditions] > self._farm_power_opt_subset
+        self._yaw_angles_opt_subset = np.where(better[:, None], points[pick, conditions],
+                                               self._yaw_angles_opt_subset)
+        self._farm_power_opt_subset = np.where(better, finite[pick, conditions],
+                                               self._farm_power_opt_subset)
+        return powers
+
+
+class _QuadraticStencil:
+    """Yaws around ``centre`` that determine a quadratic model of the farm power by finite
+    differences: per turbine two points along its yaw inside its bounds (+-step, or step and
+    2 step away from a bound it is within step of), and per coupled pair (``pairs``, (n_findex,
+    n, n) booleans, or None for none) one point moving both. Turbines whose range is below
+    3e-3 deg stay put. ``points`` is (K, n_findex, n); where a condition has fewer coupled
+    pairs than K the remaining points are the centre (which the serial refine's memory does
+    not evaluate again)."""
+
+    def __init__(self, centre, lower, upper, step, pairs=None):
+        reach = np.minimum(step, (upper - lower) / 3.0)
+        self.free = reach >= 1e-3
+        reach = np.where(self.free, reach, 1.0)
+        self.first = np.where(centre + reach <= upper, reach, -reach)
+        back = centre - self.first
+        self.second = np.where((back >= lower) & (back <= upper), -self.first, 2.0 * self.first)
+        n = centre.shape[1]
+        axes = np.zeros((2, n) + centre.shape)
+        axes[0, np.arange(n), :, np.arange(n)] = np.where(self.free, self.first, 0.0).T
+        axes[1, np.arange(n), :, np.arange(n)] = np.where(self.free, self.second, 0.0).T
+        if pairs is None:
+            self.pairs = (np.zeros(0, int),) * 4
+            crossed = np.zeros((0,) + centre.shape)
+        else:
+            both = np.triu(pairs, 1) & self.free[:, :, None] & self.free[:, None, :]
+            condition, i, j = np.nonzero(both)
+            rank = np.arange(condition.size) - np.searchsorted(condition, condition)
+            crossed = np.zeros((rank.max() + 1 if rank.size else 0,) + centre.shape)
+            crossed[rank, condition, i] = self.first[condition, i]
+            crossed[rank, condition, j] = self.first[condition, j]
+            self.pairs = (rank, condition, i, j)
+        self.n = n
+        self.points = np.clip(centre + np.concatenate([axes[0], axes[1], crossed]), lower, upper)
+
+    def fit(self, gains, hessian=None):
+        """(gradient, Hessian) per condition from ``gains`` (K, n_findex): the farm power at
+        ``points`` less that at the centre. The cross terms of pairs not sampled are those of
+        ``hessian`` (or zero). Conditions with a non-finite gain get a zero gradient."""
+        n, a, b = self.n, self.first, self.second
+        along_a, along_b = gains[:n].T, gains[n:2 * n].T
+        curvature = 2.0 * (along_a / a - along_b / b) / (a - b)
+        gradient = along_a / a - 0.5 * curvature * a
+        fitted = (np.zeros((gains.shape[1], n, n)) if hessian is None
+                  else hessian * (1.0 - np.eye(n)))
+        rank, condition, i, j = self.pairs
+        cross = (gains[2 * n + rank, condition] - along_a[condition, i] - along_a[condition, j]) \
+            / (a[condition, i] * a[condition, j])
+        fitted[condition, i, j] = cross
+        fitted[condition, j, i] = cross
+        fitted[:, np.arange(n), np.arange(n)] = np.where(self.free, curvature, 0.0)
+        finite = np.all(np.isfinite(gradient), axis=1) & np.all(np.isfinite(fitted), axis=(1, 2))
+        gradient = np.where(finite[:, None] & self.free, gradient, 0.0)
+        fitted = np.where(finite[:, None, None], fitted, 0.0)
+        return gradient, fitted
+
+
+def _newton_moves(gradient, hessian, centre, lower, upper, radius):
+    """(2, n_findex, n) moves towards the maximum of the quadratic model: the full Newton move
+    and the move of each yaw alone (the Hessian's diagonal), both over the yaws not held at a
+    bound and at most ``radius`` along each direction of the Hessian (or each yaw).
+
+    The full move solves the model along the Hessian's eigenvectors, an eigenvalue that would
+    move further than ``radius`` (or is not negative: no maximum) being lowered until the move
+    is ``radius`` uphill; a yaw at a bound that the move would push out is held there and the
+    move recomputed (an active set, twice at most)."""
+    n = centre.shape[1]
+    free = upper - lower >= 1e-3
+    for _ in range(3):
+        both = free[:, :, None] & free[:, None, :]
+        values, vectors = np.linalg.eigh(np.where(both, hessian, -np.eye(n)))
+        along = np.einsum("fkj,fk->fj", vectors, np.where(free, gradient, 0.0))
+        values = np.minimum(values, -np.abs(along) / radius - 1e-300)
+        move = -np.einsum("fij,fj->fi", vectors, along / values)
+        held = free & (((centre <= lower) & (move < 0.0)) | ((centre >= upper) & (move > 0.0)))
+        if not held.any():
+            break
+        free = free & ~held
+    move = np.clip(np.where(free, move, 0.0), -radius, radius)
+    curvature = np.einsum("fii->fi", hessian)
+    alone = np.where(free & (curvature < 0.0),
+                     np.clip(-gradient / np.where(curvature < 0.0, curvature, -1.0),
+                             -radius, radius), 0.0)
+    return np.stack([move, alone])
 
 
 def _with_bounds(options, lower, upper):

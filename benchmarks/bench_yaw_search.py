@@ -1,0 +1,138 @@
+"""Cost and accuracy of optimize_yaw's both-signs search against FLORIS's serial refine
+(docs/yaw_steering.md#finding-the-optimum). Hand-run script, not a test:
+
+    PYTHONPATH=. python benchmarks/bench_yaw_search.py [--repeats 3] [--skip-shortfall]
+
+1. Cost: the 3 x 3 night farm (inputs/farm_night.yaml, NREL 5 MW at 7 D, L = 100 m), 24
+   conditions (wind 255-285 deg in 12 steps x 7 and 9 m/s, TI 6 %), yaw -25..25 deg: FLORIS's
+   YawOptimizationSR run once as FLORIS runs it (Ny_passes [5, 4]) and
+   optimize_yaw(fmodel, YawOptimizationSR, search="both_signs") with the same options,
+   interleaved in this process, best of ``--repeats``; with the FLORIS runs and the conditions
+   they evaluated (counted in YawOptimization._calculate_farm_power), and the mean farm-power
+   gain of the both-signs optimum over FLORIS's.
+2. Shortfall: 3-turbine rows held out from the yaw study (tests/test_yaw_search.py): the farm
+   power of FLORIS's single run and of the both-signs search against a brute-force search on a
+   1-degree grid of all three yaws refined by Nelder-Mead (the reference the tests build), for
+   bounds -25..25 deg.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+from floris import FlorisModel
+from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+import floris_ekman_veer  # noqa: F401
+from floris_ekman_veer import optimize_yaw
+from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+import test_yaw_search as reference  # noqa: E402
+
+OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5, 4])
+
+
+def night_farm() -> FlorisModel:
+    directions, speeds = np.meshgrid(np.linspace(255.0, 285.0, 12), [7.0, 9.0])
+    fmodel = FlorisModel(ROOT / "inputs" / "farm_night.yaml")
+    fmodel.set(wind_directions=directions.ravel(), wind_speeds=speeds.ravel(),
+               turbulence_intensities=np.full(directions.size, 0.06))
+    return fmodel
+
+
+@contextlib.contextmanager
+def counting():
+    """Count FLORIS runs and evaluated conditions of every yaw optimiser."""
+    count = {"runs": 0, "conditions": 0}
+    original = YawOptimization._calculate_farm_power
+
+    def counted(self, yaw_angles=None, *args, **kwargs):
+        count["runs"] += 1
+        count["conditions"] += (self.fmodel_subset.core.flow_field.n_findex if yaw_angles is None
+                                else np.shape(yaw_angles)[0])
+        return original(self, yaw_angles, *args, **kwargs)
+
+    YawOptimization._calculate_farm_power = counted
+    try:
+        yield count
+    finally:
+        YawOptimization._calculate_farm_power = original
+
+
+def floris_single(fmodel):
+    return YawOptimizationSR(fmodel, **OPTIONS).optimize(print_progress=False)
+
+
+def both_signs(fmodel):
+    return optimize_yaw(fmodel, YawOptimizationSR, progress=False, **OPTIONS)
+
+
+def cost(repeats: int):
+    fmodel = night_farm()
+    methods = {"FLORIS YawOptimizationSR, one run": floris_single,
+               "optimize_yaw, both signs": both_signs}
+    times = {name: [] for name in methods}
+    counts, frames = {}, {}
+    for _ in range(repeats):
+        for name, method in methods.items():
+            with counting() as count:
+                start = time.perf_counter()
+                frames[name] = method(fmodel)
+                times[name].append(time.perf_counter() - start)
+            counts[name] = dict(count)
+    floris_time = min(times["FLORIS YawOptimizationSR, one run"])
+    power = {name: frame["farm_power_opt"].to_numpy(float) for name, frame in frames.items()}
+    print(f"cost: 3 x 3 night farm, {fmodel.core.flow_field.n_findex} conditions, -25..25 deg, "
+          f"best of {repeats}, interleaved")
+    print("| search | time [s] | x FLORIS's run | FLORIS runs | evaluated conditions "
+          "| mean farm power vs FLORIS's [%] |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for name in methods:
+        gain = 100.0 * np.mean(power[name] / power["FLORIS YawOptimizationSR, one run"] - 1.0)
+        print(f"| {name} | {min(times[name]):.2f} | {min(times[name]) / floris_time:.2f} | "
+              f"{counts[name]['runs']} | {counts[name]['conditions']:,} | {gain:+.3f} |")
+
+
+def shortfall():
+    rows = reference.NIGHT_ROWS + reference.ROWS
+    pairs, angles, tables = reference.brute_force_tables(rows)
+    print("\nshortfall against the 1-degree grid refined by Nelder-Mead, yaw -25..25 deg")
+    print("| row | reference yaws [deg] | reference [kW] | FLORIS's SR: yaws, shortfall [%] "
+          "| both signs: yaws, shortfall [%] |")
+    print("|---|---|---:|---|---|")
+    for spec, table in zip(rows, tables):
+        yaw, power = reference.refined_brute_force(spec, table, pairs, angles)
+        found = {}
+        for name, method in (("floris", floris_single), ("both", both_signs)):
+            df = method(reference.row(*spec))
+            found[name] = (np.vstack(df["yaw_angles_opt"])[0], float(df["farm_power_opt"].iloc[0]))
+        spacing, atmosphere, direction, speed = spec
+        cells = [f"[{', '.join(f'{a:.1f}' for a in y)}], {100.0 * (1.0 - p / power):.3f}"
+                 for y, p in found.values()]
+        print(f"| {spacing} D, {atmosphere}, {direction:.0f} deg, {speed:.0f} m/s | "
+              f"[{', '.join(f'{a:.1f}' for a in yaw)}] | {power / 1e3:,.1f} | "
+              f"{cells[0]} | {cells[1]} |")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--skip-shortfall", action="store_true")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
+    cost(args.repeats)
+    if not args.skip_shortfall:
+        shortfall()
+
+
+if __name__ == "__main__":
+    main()
