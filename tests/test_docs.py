@@ -339,8 +339,8 @@ def test_readme_quick_start_fits_a_screen_and_links_the_gallery():
 #: Numbers of the README and docs/ that a named script prints: (page, the page's text holding
 #: the number, the script and its arguments, a regular expression of the script's output whose
 #: groups are the number(s) the page's text holds, in the page's order). A page that changes its
-#: text, or a script whose output moves, fails here; each script runs once (slow: they are the
-#: examples themselves).
+#: text, or a script whose output moves, fails here; each script runs once (marker study: they are the
+#: examples themselves, run by .ci/run after the fast suite).
 SCRIPT_NUMBERS = [
     ("README.md", r"P/P0 = ([\d.]+) with M-1, against ([\d.]+) with M-2 and M-3 and ([\d.]+) and "
                   r"([\d.]+) with FLORIS's GCH and cc on the same inflow",
@@ -395,7 +395,7 @@ def script_output(script, tmp_path_factory) -> str:
     return _SCRIPT_OUTPUT[script]
 
 
-@pytest.mark.slow
+@pytest.mark.study
 @pytest.mark.parametrize("page, text, script, output", SCRIPT_NUMBERS,
                          ids=[f"{p}:{s[0]}" for p, _, s, _ in SCRIPT_NUMBERS])
 def test_page_numbers_are_what_their_scripts_print(page, text, script, output, tmp_path_factory):
