@@ -459,6 +459,8 @@ def _run_conditions(template, model, conditions, study, optimizer_class, optimiz
             case.run()
             out["steered"].append(np.sum(case.get_turbine_powers(), axis=1))
             out["optima"].append(df_opt)
+            # FLORIS's set() keeps non-zero yaw angles: the next chunk's baseline is unyawed.
+            case.reset_operation()
         bar.update(rows.size)
     return {k: (pd.concat(v, ignore_index=True) if k == "optima" else np.concatenate(v))
             if v else None for k, v in out.items()}
