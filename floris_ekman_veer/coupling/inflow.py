@@ -511,8 +511,9 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
     U, dUdz = inflow_profile(abl, grid.z_sorted, self.reference_wind_height)
     if isinstance(grid, TurbineGrid):
         # Each rotor point carries the cubic mean of U over its rotor cell (coupling/rotor.py).
+        # (U alone: the gradient's two extra profile evaluations would be discarded.)
         U = turbine_grid_inflow(
-            lambda z: inflow_profile(abl, z, self.reference_wind_height)[0], grid
+            lambda z: ambient_velocity(abl, z, self.reference_wind_height)[0], grid
         )
     shape = self.u_initial_sorted.shape
     if np.any(abl.at_rest):
