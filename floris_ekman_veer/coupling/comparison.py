@@ -35,6 +35,10 @@ FLORIS holds one ``wind_veer`` and one ``wind_shear`` per model, while the atmos
 condition; :func:`fair_builtin_set_kwargs` reduces them over conditions (mean by default). For
 exact per-condition values build one model per condition.
 
+The comparison this package makes (``annual_energy``, ``examples/yaw_study.py``) is
+:func:`comparison_set_kwargs`: I_u(z_h) per condition and ``wind_veer = 0``, for the reason in
+the caution above; the fair scalars are shown beside it only as a flagged reference.
+
 The alternative without the hook, :func:`native_inflow_set_kwargs`, exports the profile to
 FLORIS's own 3-D ``heterogeneous_inflow_config`` (speed multipliers U(z)/U_ref on an x, y, z box,
 with ``wind_shear = 0``). Its limits: it carries the speed only (no V, so no veer at all); the

@@ -11,21 +11,29 @@ classes, each an atmosphere (the ``ekman_veer.atmosphere`` block of the FLORIS i
   class and the class frequencies follow from the records.
 
 For every model (``ekman_veer``, the input's own wake model, and FLORIS's built-ins of
-:data:`~floris_ekman_veer.coupling.comparison.BUILTIN_WAKES`, GCH by default) and class,
-:func:`annual_energy` builds one FLORIS model holding the class's conditions with the class's
-atmosphere, on the same Ekman inflow for all models, and computes with FLORIS's own
-``get_farm_AEP`` (``freq`` = the joint frequency of each condition, so the classes' energies add
-up to the year's)
+:data:`~floris_ekman_veer.coupling.comparison.BUILTIN_WAKES`, GCH by default),
+:func:`annual_energy` runs every condition of every class with non-zero frequency as one
+vectorised FLORIS model, each condition carrying its class's atmosphere (a per-condition
+atmosphere block, docs/coupling.md#annual-energy), in chunks of ``chunk_size`` conditions that
+bound the memory (a condition's numbers do not depend on the chunk it runs in), on the same Ekman
+inflow for all models, and computes, per class, FLORIS's ``get_farm_AEP`` of the class's
+conditions (``freq`` = the joint frequency of each condition, so the classes' energies add up to
+the year's)
 
 * the baseline AEP (every turbine aligned with the hub-height wind: the yaw angles are measured
   from the wind direction at FLORIS's reference height) and
 * the AEP with wake steering: the yaw angles of :func:`~floris_ekman_veer.optimize_yaw` (any
   FLORIS yaw optimiser) per condition.
 
+:func:`record_energy` (``SiteAtmosphere.annual_energy``) does the same for a time series whose
+records each carry their own atmosphere.
+
 Each model sees the atmosphere the way it can (docs/coupling.md#annual-energy): the ekman_veer
-models take their wake expansion from the ABL itself; FLORIS's built-ins get, per condition, the
-turbulence intensity I_u(z_h) of the class's atmosphere and, per class, its rotor-layer veer and
-shear (:func:`~floris_ekman_veer.coupling.comparison.fair_builtin_set_kwargs`). With
+models take their wake expansion from the ABL itself; FLORIS's built-ins get the comparison of
+:func:`~floris_ekman_veer.coupling.comparison.comparison_set_kwargs` (the one
+``examples/yaw_study.py`` uses): per condition the turbulence intensity I_u(z_h) of the class's
+atmosphere, and FLORIS's ``wind_veer`` = 0 (the veer is in the Ekman inflow and the rotor; gauss's
+scalar wind_veer would narrow its wake by cos(wind_veer), docs/yaw_steering.md). With
 ``turbulence_intensities="wind_data"`` every model gets the wind data's turbulence intensities
 instead (then, with one class, the baseline is exactly ``get_farm_AEP`` of the model set with that
 wind data). Every input is checked before any FLORIS run.
