@@ -53,11 +53,26 @@ MOMENTS = ("U1", "U3", "V", "UV", "VV", "UUV", "UVV", "VVV")
 def cell_moments(u_rows, v_rows, row_membership, area):
     """The :data:`MOMENTS` of each cell from U, V at sub-point rows: ``u_rows``, ``v_rows``
     (..., rows); ``row_membership`` (rows, cells) the area weight of each row in each cell."""
+    # Per cell, the rows that weigh in it (a row lies in one band of cells: a third of them).
+    weighing = [np.flatnonzero(row_membership[:, k]) for k in range(row_membership.shape[1])]
+
     def mean(values):
         # A sum per condition, not a matrix product: BLAS may round a row differently with
         # the number of conditions, and a condition's numbers must not depend on its batch
-        # (ParFlorisModel chunks, the optimisers' tiled conditions).
-        return np.sum(values[..., :, None] * row_membership, axis=-2) / area
+        # (ParFlorisModel chunks, the optimisers' tiled conditions). Row by row in order over
+        # the rows weighing in the cell: the sum np.sum(values[..., :, None] * row_membership,
+        # axis=-2) makes (the zero terms add nothing), without its (..., rows, cells) product.
+        rows_first = np.moveaxis(values, -1, 0).copy()
+        out = np.empty(values.shape[:-1] + (row_membership.shape[1],))
+        for k, rows in enumerate(weighing):
+            if not rows.size:
+                out[..., k] = 0.0
+                continue
+            total = rows_first[rows[0]] * row_membership[rows[0], k]
+            for r in rows[1:]:
+                total += rows_first[r] * row_membership[r, k]
+            out[..., k] = total
+        return out / area
 
     return {
         "U1": mean(u_rows), "U3": np.cbrt(mean(u_rows**3)), "V": mean(v_rows),
