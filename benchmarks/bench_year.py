@@ -19,7 +19,7 @@ once, in turn), best of ``--repeats``; peak memory by tracemalloc
   (one run, with its progress bar).
 
 The records are synthetic: directions uniform, speeds 5-14 m/s at 90 m, the stability of each
-record one of ``N_CLASSES`` Obukhov lengths (stable nights to near-neutral days).
+record one of ``--classes`` Obukhov lengths, 100-2000 m (stable nights to near-neutral days).
 """
 
 from __future__ import annotations
@@ -39,7 +39,6 @@ from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
 
 INPUT = Path(__file__).resolve().parents[1] / "inputs" / "farm_night.yaml"
 N_CLASSES = 6
-OBUKHOV_LENGTHS = np.geomspace(100.0, 2000.0, N_CLASSES)
 
 
 def farm(side: int) -> FlorisModel:
@@ -50,11 +49,11 @@ def farm(side: int) -> FlorisModel:
     return fmodel
 
 
-def records(n: int, seed: int = 0):
+def records(n: int, n_classes: int, seed: int = 0):
     rng = np.random.default_rng(seed)
     series = TimeSeries(rng.uniform(0.0, 360.0, n), rng.uniform(5.0, 14.0, n),
                         turbulence_intensities=0.06)
-    return series, rng.integers(0, N_CLASSES, n)
+    return series, rng.permutation(np.arange(n) % n_classes)
 
 
 def timed(function) -> float:
@@ -77,6 +76,9 @@ def main():
     parser.add_argument("--records", type=int, default=8760)
     parser.add_argument("--side", type=int, default=10)
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--classes", type=int, default=N_CLASSES,
+                        help="distinct atmospheres (Obukhov lengths 100-2000 m); = --records "
+                             "for one per record, as fit_site gives")
     parser.add_argument("--chunk-size", type=int, default=None)
     parser.add_argument("--steered", action="store_true")
     parser.add_argument("--memory", action=argparse.BooleanOptionalAction, default=True)
@@ -85,10 +87,10 @@ def main():
     floris_ekman_veer.silence_warnings()
 
     fmodel = farm(args.side)
-    series, classes = records(args.records)
+    series, classes = records(args.records, args.classes)
     block = atmosphere_of(fmodel.core).sliced(slice(None))
-    stability = {f"L={length:.0f}": {"atmosphere": dict(block, obukhov_length=float(length))}
-                 for length in OBUKHOV_LENGTHS}
+    stability = {f"L={length:.6g}": {"atmosphere": dict(block, obukhov_length=float(length))}
+                 for length in np.geomspace(100.0, 2000.0, args.classes)}
     names = np.array(list(stability))[classes]
     directions, speeds, _, _ = series.unpack_for_reinitialize()
     gauss = builtin_model(fmodel, "gauss")
@@ -109,8 +111,8 @@ def main():
                                       models=["gch"], **options)),
     }
     chosen = [k for k in args.lines.split(",") if k in lines]
-    print(f"{args.records} records, {args.side} x {args.side} farm, best of {args.repeats}, "
-          "interleaved")
+    print(f"{args.records} records ({args.classes} atmospheres), {args.side} x {args.side} farm, "
+          f"best of {args.repeats}, interleaved")
     best = {k: np.inf for k in chosen}
     for repeat in range(args.repeats):
         for key in chosen:

@@ -31,7 +31,7 @@ def records_row():
     return fmodel
 
 
-OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5, 4],
+OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5],
                progress=False)
 
 
@@ -68,3 +68,27 @@ def test_row_following_subset_refuses_a_mismatched_set(records_row):
     subset.set(yaw_angles=np.zeros((3, 3)))
     mu = atmosphere_of(subset.core).inputs["stability_parameter"].reshape(-1)
     np.testing.assert_array_equal(mu, [148.49, 0.0, 50.0])
+
+
+def test_record_energy_is_annual_energy_of_the_site_classes(records_row):
+    """SiteAtmosphere.annual_energy's path (an atmosphere per record, classes by distinct
+    atmosphere named by their first record) gives annual_energy's numbers with those classes."""
+    from floris import TimeSeries
+
+    from floris_ekman_veer import annual_energy
+    from floris_ekman_veer.coupling.energy import record_energy
+
+    flow_field = records_row.core.flow_field
+    series = TimeSeries(flow_field.wind_directions, flow_field.wind_speeds,
+                        turbulence_intensities=flow_field.turbulence_intensities)
+    block = atmosphere_of(records_row.core).sliced(slice(None))
+    labels = [f"t{i}" for i in range(6)]
+    mu = block["stability_parameter"]
+    first = {m: labels[mu.index(m)] for m in mu}
+    classes = {first[m]: {"atmosphere": dict(block, stability_parameter=m)} for m in mu}
+    by_class = annual_energy(records_row, series, classes, records=[first[m] for m in mu],
+                             models=["ekman_veer", "gch"])
+    by_record = record_energy(records_row, series, block, labels, models=["ekman_veer", "gch"])
+    assert list(by_record.table["stability"]) == list(by_class.table["stability"])
+    for column in ("frequency", "n_conditions", "aep_baseline_gwh"):
+        np.testing.assert_array_equal(by_record.table[column], by_class.table[column])
