@@ -230,13 +230,13 @@ def _rows_follow(fmodel, optimizer_class, options) -> bool:
     """Whether ``optimizer_class`` on ``fmodel`` can run conditions of different atmospheres
     together (:func:`row_following_subset`): FLORIS's serial refine (which tiles a model's
     per-condition heterogeneous speed-ups with its conditions) without a heterogeneous map of
-    its own or a convergence check (which re-evaluates without them), on a FlorisModel or
-    ParFlorisModel."""
+    its own or a convergence check (which re-evaluates without them), on a FlorisModel (a
+    ParFlorisModel hands its workers the heterogeneous configuration as a map)."""
     from floris import FlorisModel, ParFlorisModel
     from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
     return (issubclass(optimizer_class, YawOptimizationSR)
-            and type(fmodel).set in (FlorisModel.set, ParFlorisModel.set)
+            and type(fmodel).set is FlorisModel.set and not isinstance(fmodel, ParFlorisModel)
             and fmodel.core.flow_field.heterogeneous_inflow_config is None
             and not options.get("verify_convergence", False))
 
