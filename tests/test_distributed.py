@@ -127,13 +127,14 @@ SCRIPT = textwrap.dedent(
             # atmosphere of a chunk in one optimiser run) on the cluster: bitwise the serial.
             from floris import TimeSeries
 
-            series = TimeSeries(np.array([266.0, 270.0, 274.0, 268.0]),
-                                np.array([8.0, 9.0, 10.0, 11.0]), turbulence_intensities=0.06)
+            series = TimeSeries(np.array([266.0, 274.0]), np.array([8.0, 10.0]),
+                                turbulence_intensities=0.06)
             classes = {"night": {"atmosphere": atmosphere},
                        "day": {"atmosphere": dict(atmosphere, stability_parameter=0.0)}}
             years = [annual_energy(model, series, classes, YawOptimizationSR,
-                                   records=["night", "day", "day", "night"],
-                                   models=["ekman_veer"], progress=False, **kwargs)
+                                   records=["night", "day"], models=["ekman_veer"],
+                                   progress=False, minimum_yaw_angle=-20.0,
+                                   maximum_yaw_angle=20.0, Ny_passes=[3])
                      for model in (row, par_row)]
             powers = [y.conditions["ekman_veer"][["farm_power_baseline", "farm_power_steered"]]
                       .to_numpy() for y in years]
