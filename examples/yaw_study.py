@@ -50,7 +50,11 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import annual_energy, optimize_yaw  # noqa: E402
-from floris_ekman_veer.coupling.comparison import builtin_model, fair_builtin_set_kwargs  # noqa: E402
+from floris_ekman_veer.coupling.comparison import (  # noqa: E402
+    builtin_model,
+    comparison_set_kwargs,
+    fair_builtin_set_kwargs,
+)
 from floris_ekman_veer.coupling.inflow import set_atmosphere  # noqa: E402
 from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
@@ -126,11 +130,14 @@ def model_on(fmodel, name: str, atmosphere: dict, speeds, yaw=None):
     set_atmosphere(model, atmosphere, wind_directions=np.full(n, 270.0),
                    wind_speeds=np.asarray(speeds, float), turbulence_intensities=np.full(n, 0.06),
                    yaw_angles=yaw)
-    fair = fair_builtin_set_kwargs(model)
     if name == "gch_fair_veer":
-        model.set(**fair)
-    else:  # ekman_veer reads neither FLORIS's veer nor its shear; GCH gets wind_veer 0
-        model.set(turbulence_intensities=fair["turbulence_intensities"], wind_veer=0.0)
+        model.set(**fair_builtin_set_kwargs(model))
+    else:  # annual_energy's comparison (ekman_veer reads neither veer nor shear)
+        farm = model.core.farm
+        model.set(**comparison_set_kwargs(atmosphere, speeds,
+                                          model.core.flow_field.reference_wind_height,
+                                          float(farm.hub_heights.flat[0]),
+                                          float(farm.rotor_diameters.flat[0])))
     return model
 
 

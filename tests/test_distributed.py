@@ -123,6 +123,23 @@ SCRIPT = textwrap.dedent(
             out["aep"] = np.max(np.abs(tables[1][columns].to_numpy()
                                        - tables[0][columns].to_numpy())).item()
             out["aep_gain"] = tables[0]["gain_percent"].iloc[-1].item()
+            # A steered year of per-record atmospheres (one vectorised model per chunk, every
+            # atmosphere of a chunk in one optimiser run) on the cluster: bitwise the serial.
+            from floris import TimeSeries
+
+            series = TimeSeries(np.array([266.0, 274.0]), np.array([8.0, 10.0]),
+                                turbulence_intensities=0.06)
+            classes = {"night": {"atmosphere": atmosphere},
+                       "day": {"atmosphere": dict(atmosphere, stability_parameter=0.0)}}
+            years = [annual_energy(model, series, classes, YawOptimizationSR,
+                                   records=["night", "day"], models=["ekman_veer"],
+                                   progress=False, minimum_yaw_angle=-20.0,
+                                   maximum_yaw_angle=20.0, Ny_passes=[3])
+                     for model in (row, par_row)]
+            powers = [y.conditions["ekman_veer"][["farm_power_baseline", "farm_power_steered"]]
+                      .to_numpy() for y in years]
+            out["records_aep"] = np.max(np.abs(powers[1] - powers[0])).item()
+            out["records_steered"] = bool(np.all(powers[0][:, 1] >= powers[0][:, 0]))
         out["seconds"] = time.perf_counter() - started
         print("RESULT " + json.dumps(out))
 
@@ -172,6 +189,9 @@ def test_dask_model_in_floris_optimiser(cluster_results):
 def test_dask_model_in_annual_energy(cluster_results):
     assert cluster_results["aep_gain"] > 0.0
     assert cluster_results["aep"] == 0.0
+    # Per-record atmospheres, steered, on the cluster: bitwise the serial study.
+    assert cluster_results["records_aep"] == 0.0
+    assert cluster_results["records_steered"]
     assert cluster_results["floris_aep"] == 0.0  # FLORIS's get_farm_AEP on a wind rose
 
 

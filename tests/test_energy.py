@@ -113,9 +113,8 @@ def test_steered_energy_is_the_optimisers_power(row, atmospheres):
         for model in ("ekman_veer", "gch"):
             np.testing.assert_allclose(result.inflow[model, name]["turbulence_intensities"],
                                        expected["turbulence_intensities"], rtol=1e-12)
-        assert result.inflow["gch", name]["wind_veer"] == pytest.approx(
-            np.mean(expected["wind_veer"]), rel=1e-12)
-    assert result.inflow["gch", "night"]["wind_veer"] > 20.0 > result.inflow["gch", "day"]["wind_veer"]
+        # The comparison: GCH without FLORIS's scalar veer (the Ekman inflow carries the veer).
+        assert result.inflow["gch", name]["wind_veer"] == 0.0
     ax = result.plot()
     assert len(ax.patches) == 2 * 2 * 3  # (baseline, gain) x models x (day, night, all)
 
@@ -129,7 +128,7 @@ def no_work(monkeypatch):
     def fail(*args, **kwargs):
         raise AssertionError("a FLORIS model was built before the input was checked")
 
-    monkeypatch.setattr(energy, "_class_model", fail)
+    monkeypatch.setattr(energy, "_chunk_model", fail)
 
 
 def _classes(atmospheres, **changes):
@@ -188,3 +187,93 @@ def test_bad_models_and_options(row, atmospheres, no_work):
         annual_energy(row, ROSE, stability, turbulence_intensities="input")
     with pytest.raises(ValueError, match="WindRose or floris.TimeSeries"):
         annual_energy(row, {"wind_speeds": [8.0]}, stability)
+
+
+# ------------------------------------------------------------ one vectorised model per chunk
+
+
+def _per_class_reference(row, atmospheres, series, records, model):
+    """The per-class path (one FLORIS model per class, before the vectorised study): each
+    class's conditions with its scalar atmosphere, I_u(z_h) per condition and the comparison's
+    wind_veer for the built-ins; AEP by FLORIS's get_farm_AEP."""
+    from floris_ekman_veer.coupling.comparison import comparison_set_kwargs
+
+    directions, speeds, ti, _ = series.unpack_for_reinitialize()
+    freq = series.unpack_freq()
+    out = {}
+    for name, atmosphere in atmospheres.items():
+        index = np.flatnonzero(np.asarray(records) == name)
+        case = row.copy() if model == "ekman_veer" else builtin_model(row, model)
+        set_atmosphere(case, atmosphere, wind_directions=directions[index],
+                       wind_speeds=speeds[index], turbulence_intensities=ti[index])
+        kwargs = comparison_set_kwargs(atmosphere, speeds[index], 90.0, 90.0,
+                                       float(row.core.farm.rotor_diameters.flat[0]))
+        if model == "ekman_veer":
+            kwargs.pop("wind_veer")
+        case.set(**kwargs)
+        case.run()
+        out[name] = case.get_farm_AEP(freq=freq[index]) / 1e9
+    return out
+
+
+@pytest.mark.parametrize("model", ["ekman_veer", "gch"])
+def test_vectorised_study_equals_per_class_models(row, atmospheres, model):
+    directions = np.array([270.0, 268.0, 272.0, 270.0, 275.0, 270.0, 266.0])
+    speeds = np.array([8.0, 9.0, 10.0, 11.0, 8.0, 9.0, 12.0])
+    series = TimeSeries(directions, speeds, turbulence_intensities=0.06)
+    records = ["night", "day", "day", "night", "night", "day", "night"]
+    result = annual_energy(row, series, {k: {"atmosphere": a} for k, a in atmospheres.items()},
+                           records=records, models=[model], chunk_size=3)
+    expected = _per_class_reference(row, atmospheres, series, records, model)
+    table = result.table.set_index("stability")["aep_baseline_gwh"]
+    for name, aep in expected.items():
+        assert table[name] == pytest.approx(aep, rel=1e-12, abs=0.0)
+    assert table["all"] == pytest.approx(sum(expected.values()), rel=1e-12)
+
+
+def test_chunking_is_bitwise_invariant(row, atmospheres):
+    rng = np.random.default_rng(3)
+    n = 7
+    series = TimeSeries(rng.uniform(260.0, 280.0, n), rng.uniform(6.0, 13.0, n),
+                        turbulence_intensities=0.06)
+    records = list(rng.choice(["day", "night"], n))
+    stability = {k: {"atmosphere": a} for k, a in atmospheres.items()}
+    results = [annual_energy(row, series, stability, YawOptimizationSR, records=records,
+                             models=["ekman_veer", "gch"], chunk_size=size, progress=False,
+                             minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[3])
+               for size in (2, n)]
+    first = results[0]
+    for other in results[1:]:
+        for model in ("ekman_veer", "gch"):
+            a, b = first.conditions[model], other.conditions[model]
+            assert np.array_equal(a.index, b.index)
+            assert np.array_equal(a["farm_power_baseline"], b["farm_power_baseline"])
+            assert np.array_equal(a["farm_power_steered"], b["farm_power_steered"])
+        assert np.array_equal(first.table["aep_baseline_gwh"], other.table["aep_baseline_gwh"])
+        assert np.array_equal(first.table["aep_steered_gwh"], other.table["aep_steered_gwh"])
+    # Per record, the steered power is the optimiser's and never below the baseline.
+    powers = first.conditions["ekman_veer"]
+    assert np.all(powers["farm_power_steered"] >= powers["farm_power_baseline"] * (1 - 1e-12))
+
+
+def test_gch_comparison_is_the_yaw_studys(row, atmospheres):
+    """One comparison everywhere: annual_energy's GCH is the yaw study's GCH (wind_veer 0 and
+    I_u(z_h) of the atmosphere per condition)."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "yaw_study.py"
+    spec = importlib.util.spec_from_file_location("yaw_study_comparison", path)
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    speeds = np.array([8.0, 10.0])
+    series = TimeSeries(np.full(2, 270.0), speeds, turbulence_intensities=0.06)
+    night = atmospheres["night"]
+    result = annual_energy(row, series, {"night": {"atmosphere": night}},
+                           records=["night", "night"], models=["gch"])
+    model = study.model_on(row, "gch", night, speeds)
+    assert model.core.flow_field.wind_veer == 0.0
+    model.run()
+    np.testing.assert_array_equal(result.conditions["gch"]["farm_power_baseline"],
+                                  np.sum(model.get_turbine_powers(), axis=1))
+    np.testing.assert_array_equal(result.inflow["gch", "night"]["turbulence_intensities"],
+                                  model.core.flow_field.turbulence_intensities)

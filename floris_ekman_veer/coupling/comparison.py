@@ -35,6 +35,10 @@ FLORIS holds one ``wind_veer`` and one ``wind_shear`` per model, while the atmos
 condition; :func:`fair_builtin_set_kwargs` reduces them over conditions (mean by default). For
 exact per-condition values build one model per condition.
 
+The comparison this package makes (``annual_energy``, ``examples/yaw_study.py``) is
+:func:`comparison_set_kwargs`: I_u(z_h) per condition and ``wind_veer = 0``, for the reason in
+the caution above; the fair scalars are shown beside it only as a flagged reference.
+
 The alternative without the hook, :func:`native_inflow_set_kwargs`, exports the profile to
 FLORIS's own 3-D ``heterogeneous_inflow_config`` (speed multipliers U(z)/U_ref on an x, y, z box,
 with ``wind_shear = 0``). Its limits: it carries the speed only (no V, so no veer at all); the
@@ -107,6 +111,29 @@ def builtin_inflow_settings(
         "wind_veer": np.broadcast_to(veer, (n, 1, 1, 1)).reshape(n),
         "wind_shear": np.broadcast_to(shear, (n, 1, 1)).reshape(n),
     }
+
+
+#: FLORIS's scalar ``wind_veer`` [deg] the built-ins get in every comparison of this package
+#: (:func:`comparison_set_kwargs`): gauss rotates and, by cos(wind_veer), narrows its wake with
+#: it, which at the rotor-layer veer of stable nights measures that narrowing, not veer (see the
+#: module docstring); FLORIS's default, 0, leaves the veer to the Ekman inflow and the rotor.
+COMPARISON_WIND_VEER = 0.0
+
+
+def comparison_set_kwargs(atmosphere: dict, wind_speeds, reference_height: float,
+                          hub_height: float, rotor_diameter: float) -> dict:
+    """``set()`` keywords of the comparison with FLORIS's built-ins on the same Ekman inflow,
+    the one ``annual_energy`` and ``examples/yaw_study.py`` use (docs/coupling.md#annual-energy):
+    ``turbulence_intensities`` = I_u(z_h) of the atmosphere per condition (as in
+    :func:`builtin_inflow_settings`) and ``wind_veer`` = :data:`COMPARISON_WIND_VEER`. FLORIS's
+    ``wind_shear`` is left as the input gives it (with the atmosphere block the inflow is the
+    exact U(z)). Elementwise per condition, so a condition's values do not depend on the
+    others it is computed with.
+    """
+    settings = builtin_inflow_settings(atmosphere, wind_speeds, reference_height, hub_height,
+                                       rotor_diameter)
+    return {"turbulence_intensities": settings["turbulence_intensities"],
+            "wind_veer": COMPARISON_WIND_VEER}
 
 
 def _atmosphere_mapping(fmodel) -> dict:

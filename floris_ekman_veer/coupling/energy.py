@@ -11,21 +11,29 @@ classes, each an atmosphere (the ``ekman_veer.atmosphere`` block of the FLORIS i
   class and the class frequencies follow from the records.
 
 For every model (``ekman_veer``, the input's own wake model, and FLORIS's built-ins of
-:data:`~floris_ekman_veer.coupling.comparison.BUILTIN_WAKES`, GCH by default) and class,
-:func:`annual_energy` builds one FLORIS model holding the class's conditions with the class's
-atmosphere, on the same Ekman inflow for all models, and computes with FLORIS's own
-``get_farm_AEP`` (``freq`` = the joint frequency of each condition, so the classes' energies add
-up to the year's)
+:data:`~floris_ekman_veer.coupling.comparison.BUILTIN_WAKES`, GCH by default),
+:func:`annual_energy` runs every condition of every class with non-zero frequency as one
+vectorised FLORIS model, each condition carrying its class's atmosphere (a per-condition
+atmosphere block, docs/coupling.md#annual-energy), in chunks of ``chunk_size`` conditions that
+bound the memory (a condition's numbers do not depend on the chunk it runs in), on the same Ekman
+inflow for all models, and computes, per class, FLORIS's ``get_farm_AEP`` of the class's
+conditions (``freq`` = the joint frequency of each condition, so the classes' energies add up to
+the year's)
 
 * the baseline AEP (every turbine aligned with the hub-height wind: the yaw angles are measured
   from the wind direction at FLORIS's reference height) and
 * the AEP with wake steering: the yaw angles of :func:`~floris_ekman_veer.optimize_yaw` (any
   FLORIS yaw optimiser) per condition.
 
+:func:`record_energy` (``SiteAtmosphere.annual_energy``) does the same for a time series whose
+records each carry their own atmosphere.
+
 Each model sees the atmosphere the way it can (docs/coupling.md#annual-energy): the ekman_veer
-models take their wake expansion from the ABL itself; FLORIS's built-ins get, per condition, the
-turbulence intensity I_u(z_h) of the class's atmosphere and, per class, its rotor-layer veer and
-shear (:func:`~floris_ekman_veer.coupling.comparison.fair_builtin_set_kwargs`). With
+models take their wake expansion from the ABL itself; FLORIS's built-ins get the comparison of
+:func:`~floris_ekman_veer.coupling.comparison.comparison_set_kwargs` (the one
+``examples/yaw_study.py`` uses): per condition the turbulence intensity I_u(z_h) of the class's
+atmosphere, and FLORIS's ``wind_veer`` = 0 (the veer is in the Ekman inflow and the rotor; gauss's
+scalar wind_veer would narrow its wake by cos(wind_veer), docs/yaw_steering.md). With
 ``turbulence_intensities="wind_data"`` every model gets the wind data's turbulence intensities
 instead (then, with one class, the baseline is exactly ``get_farm_AEP`` of the model set with that
 wind data). Every input is checked before any FLORIS run.
@@ -44,7 +52,7 @@ from floris.wind_data import TimeSeries, WindRose
 from floris_ekman_veer.coupling.comparison import (
     BUILTIN_WAKES,
     builtin_model,
-    fair_builtin_set_kwargs,
+    comparison_set_kwargs,
 )
 from floris_ekman_veer.coupling.inflow import AtmosphereSpec, set_atmosphere
 from floris_ekman_veer.coupling.names import VELOCITY_MODEL_NAME as MODEL_NAME
@@ -57,6 +65,9 @@ FREQUENCY_TOLERANCE = 1e-9
 #: Where turbulence intensities come from (see the module docstring).
 TURBULENCE_SOURCES = ("atmosphere", "wind_data")
 HOURS_PER_YEAR = 8760.0
+#: Conditions per FLORIS model of a study: enough to keep FLORIS's vectorisation efficient, few
+#: enough to bound the memory of a 100-turbine farm to a few hundred MB.
+DEFAULT_CHUNK_SIZE = 1024
 
 COLUMNS = ("model", "stability", "frequency", "n_conditions", "aep_baseline_gwh",
            "aep_steered_gwh", "gain_percent")
@@ -187,6 +198,10 @@ class AnnualEnergy:
     table: pd.DataFrame
     optima: dict
     inflow: dict
+    #: ``{model: DataFrame}``, one row per condition run (index: the condition's position in the
+    #: wind data), columns ``stability``, ``frequency``, ``farm_power_baseline`` and
+    #: ``farm_power_steered`` [W] (NaN without an optimiser).
+    conditions: dict = attrs.field(factory=dict)
 
     def plot(self, ax=None):
         """Bar chart of the AEP per class and model, baseline and steered; returns the Axes."""
@@ -232,13 +247,14 @@ def annual_energy(
     models: Sequence[str] = (MODEL_NAME, "gch"),
     turbulence_intensities: str = "atmosphere",
     progress: bool | None = None,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
     **optimizer_kwargs,
 ) -> AnnualEnergy:
     """AEP per stability class and model, baseline and with optimised yaw (module docstring).
 
     Args:
         fmodel: FlorisModel or ParFlorisModel with the farm (and, for ``"ekman_veer"``, the
-            ekman_veer wake models); its conditions and atmosphere are replaced per class.
+            ekman_veer wake models); its conditions and atmosphere are replaced per chunk.
         wind_data: FLORIS ``WindRose`` or ``TimeSeries``.
         stability: Stability classes (see :func:`stability_classes`).
         optimizer_class: A FLORIS yaw optimiser class for the steered AEP, or None (baseline
@@ -247,10 +263,96 @@ def annual_energy(
         models: ``"ekman_veer"`` (``fmodel`` itself) and/or keys of ``BUILTIN_WAKES``.
         turbulence_intensities: ``"atmosphere"`` (I_u(z_h) of each class's atmosphere) or
             ``"wind_data"``.
-        progress: tqdm bars (None: when more than one optimiser run).
+        progress: tqdm bar over the study's conditions (None: with an optimiser).
+        chunk_size: Conditions per FLORIS model (bounds the memory; results do not depend on
+            it).
         **optimizer_kwargs: Options of ``optimizer_class`` (checked before any run).
     """
     classes = stability_classes(stability, wind_data, records)
+    study = _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
+                         chunk_size, optimizer_kwargs)
+    groups = {}
+    for k, c in enumerate(classes):
+        # Classes giving the same EkmanABL inputs run together, one atmosphere per condition.
+        groups.setdefault(tuple(sorted(c.atmosphere)), []).append(k)
+    conditions = []
+    for members in groups.values():
+        index = [np.flatnonzero(classes[k].condition_frequencies > 0.0) for k in members]
+        owner = np.concatenate([np.full(i.size, k) for k, i in zip(members, index)])
+        wind_index = np.concatenate(index)
+        if len(members) == 1:
+            atmosphere = classes[members[0]].atmosphere
+        else:
+            atmosphere = {name: np.array([classes[k].atmosphere[name] for k in members])[
+                np.searchsorted(members, owner)] for name in classes[members[0]].atmosphere}
+        freq = np.concatenate([classes[k].condition_frequencies[i]
+                               for k, i in zip(members, index)])
+        conditions.append(_Conditions(atmosphere, wind_index, owner, freq))
+    return _run_study(fmodel, wind_data, [c.name for c in classes],
+                      [c.frequency for c in classes], conditions, optimizer_class, study,
+                      progress, optimizer_kwargs)
+
+
+def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Sequence[str],
+                  optimizer_class=None, *, models: Sequence[str] = (MODEL_NAME, "gch"),
+                  turbulence_intensities: str = "atmosphere", progress: bool | None = None,
+                  chunk_size: int = DEFAULT_CHUNK_SIZE, **optimizer_kwargs) -> AnnualEnergy:
+    """:func:`annual_energy` of a ``TimeSeries`` whose records each have their own atmosphere
+    (``atmosphere``: the block with one value per record, as ``SiteAtmosphere.atmosphere``).
+
+    One class per distinct atmosphere, named by the label of its first record (as
+    ``SiteAtmosphere.stability``); the numbers are those of ``annual_energy`` with these
+    classes and records, without a class mapping per record.
+    """
+    study = _check_study(fmodel, series, optimizer_class, models, turbulence_intensities,
+                         chunk_size, optimizer_kwargs)
+    wind_frequencies = np.asarray(series.unpack_freq(), dtype=float).reshape(-1)
+    n = wind_frequencies.size
+    spec = AtmosphereSpec.from_mapping(atmosphere)
+    spec.check_conditions(n)
+    per_record = sorted(k for k, v in spec.inputs.items() if not isinstance(v, float))
+    if per_record:
+        rows = np.stack([spec.inputs[k].reshape(-1) for k in per_record], axis=1)
+        _, first, owner = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        owner = owner.reshape(-1)
+    else:
+        first, owner = np.zeros(1, dtype=int), np.zeros(n, dtype=int)
+    # Classes in order of their first record.
+    rank = np.empty(first.size, dtype=int)
+    rank[np.argsort(first, kind="stable")] = np.arange(first.size)
+    owner, first = rank[owner], np.sort(first)
+    names = [str(labels[j]) for j in first]
+    order = np.argsort(owner, kind="stable")
+    bounds = np.searchsorted(owner[order], np.arange(first.size + 1))
+    frequencies = [float(np.sum(wind_frequencies[np.sort(order[bounds[k]:bounds[k + 1]])]))
+                   for k in range(first.size)]
+    keep = np.flatnonzero(wind_frequencies > 0.0)
+    conditions = _Conditions(
+        {k: v if isinstance(v, float) else v.reshape(-1)[keep] for k, v in spec.inputs.items()},
+        keep, owner[keep], wind_frequencies[keep])
+    return _run_study(fmodel, series, names, frequencies, [conditions], optimizer_class, study,
+                      progress, optimizer_kwargs)
+
+
+@attrs.frozen(eq=False)
+class _Conditions:
+    """Conditions of a study sharing one set of EkmanABL inputs: per condition its atmosphere
+    (scalars, or arrays of one value per condition), its index in the wind data, its class
+    (position in the study's classes) and its frequency."""
+
+    atmosphere: dict
+    wind_index: np.ndarray
+    owner: np.ndarray
+    freq: np.ndarray
+
+    def atmosphere_of(self, rows) -> dict:
+        return {k: v if np.ndim(v) == 0 else np.asarray(v, dtype=float)[rows].tolist()
+                for k, v in self.atmosphere.items()}
+
+
+def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
+                 chunk_size, optimizer_kwargs) -> dict:
+    """Check a study's options before any FLORIS run; the wind data's arrays and models."""
     models = list(models)
     allowed = [MODEL_NAME, *BUILTIN_WAKES]
     if not models or any(m not in allowed for m in models) or len(set(models)) < len(models):
@@ -263,6 +365,10 @@ def annual_energy(
     if turbulence_intensities not in TURBULENCE_SOURCES:
         raise ValueError(f"annual energy: turbulence_intensities must be one of "
                          f"{list(TURBULENCE_SOURCES)}, got {turbulence_intensities!r}")
+    if (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
+            or chunk_size < 1):
+        raise ValueError(f"annual energy: chunk_size must be an integer >= 1; got "
+                         f"{chunk_size!r}")
     directions, speeds, wind_ti, heterogeneous = wind_data.unpack_for_reinitialize()
     if heterogeneous is not None:
         raise ValueError("annual energy: wind data with a heterogeneous inflow map is not "
@@ -273,39 +379,52 @@ def annual_energy(
     elif optimizer_kwargs:
         raise ValueError(f"annual energy: optimiser options {sorted(optimizer_kwargs)} given "
                          "without an optimizer_class")
+    return dict(models=models, directions=directions, speeds=speeds, wind_ti=wind_ti,
+                turbulence_intensities=turbulence_intensities, chunk_size=int(chunk_size))
 
+
+def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_class, study,
+               progress, optimizer_kwargs) -> AnnualEnergy:
+    """Run every model over the study's conditions in chunks, one vectorised FLORIS model per
+    chunk (each condition with its own atmosphere), and sum the energies per class."""
     from tqdm.auto import tqdm
 
-    cases = [(model, c) for model in models for c in classes]
+    steered = optimizer_class is not None
+    n_classes = len(names)
+    total = sum(c.wind_index.size for c in conditions)
+    per_model = {}
+    with tqdm(total=total * len(study["models"]), desc="annual energy", unit="condition",
+              disable=not (progress if progress is not None else steered)) as bar:
+        for model in study["models"]:
+            bar.set_postfix_str(model)
+            template = fmodel.copy() if model == MODEL_NAME else builtin_model(fmodel, model)
+            parts = [_run_conditions(template, model, c, study, optimizer_class,
+                                     optimizer_kwargs, bar) for c in conditions]
+            per_model[model] = {k: np.concatenate([p[k] for p in parts]) if k != "optima"
+                                else pd.concat([p[k] for p in parts], ignore_index=True)
+                                for k in parts[0] if parts[0][k] is not None}
+    owner = np.concatenate([c.owner for c in conditions])
+    freq = np.concatenate([c.freq for c in conditions])
+    order = np.argsort(owner, kind="stable")
+    bounds = np.searchsorted(owner[order], np.arange(n_classes + 1))
     rows, optima, inflow = [], {}, {}
-    with tqdm(cases, desc="annual energy", unit="case",
-              disable=not (progress if progress is not None else optimizer_class is not None)
-              ) as bar:
-        for model, c in bar:
-            bar.set_postfix_str(f"{model}, {c.name}")
-            index = np.flatnonzero(c.condition_frequencies > 0.0)
-            row = dict(model=model, stability=c.name, frequency=c.frequency,
-                       n_conditions=index.size, aep_baseline_gwh=0.0,
-                       aep_steered_gwh=0.0 if optimizer_class is not None else np.nan)
-            if index.size:
-                case = _class_model(fmodel, model, c.atmosphere, directions[index],
-                                    speeds[index], wind_ti[index], turbulence_intensities)
-                flow_field = case.core.flow_field
-                inflow[model, c.name] = {
-                    "turbulence_intensities": flow_field.turbulence_intensities.copy(),
-                    "wind_veer": float(flow_field.wind_veer),
-                    "wind_shear": float(flow_field.wind_shear),
+    for model, result in per_model.items():
+        for k, name in enumerate(names):
+            rows_k = order[bounds[k]:bounds[k + 1]]
+            row = dict(model=model, stability=name, frequency=frequencies[k],
+                       n_conditions=rows_k.size, aep_baseline_gwh=0.0,
+                       aep_steered_gwh=0.0 if steered else np.nan)
+            if rows_k.size:
+                # As FLORIS's get_farm_AEP of a model holding the class's conditions.
+                row["aep_baseline_gwh"] = _aep(freq[rows_k], result["baseline"][rows_k])
+                if steered:
+                    row["aep_steered_gwh"] = _aep(freq[rows_k], result["steered"][rows_k])
+                    optima[model, name] = result["optima"].iloc[rows_k].reset_index(drop=True)
+                inflow[model, name] = {
+                    "turbulence_intensities": result["turbulence_intensities"][rows_k],
+                    "wind_veer": float(result["wind_veer"][rows_k[0]]),
+                    "wind_shear": float(result["wind_shear"][rows_k[0]]),
                 }
-                freq = c.condition_frequencies[index]
-                case.run()
-                row["aep_baseline_gwh"] = case.get_farm_AEP(freq=freq) / 1e9
-                if optimizer_class is not None:
-                    df_opt = optimize_yaw(case, optimizer_class, progress=progress,
-                                          **optimizer_kwargs)
-                    case.set(yaw_angles=np.vstack(df_opt["yaw_angles_opt"]))
-                    case.run()
-                    row["aep_steered_gwh"] = case.get_farm_AEP(freq=freq) / 1e9
-                    optima[model, c.name] = df_opt
             rows.append(row)
     table = pd.DataFrame(rows)
     year = table.groupby("model", sort=False)[
@@ -314,20 +433,80 @@ def annual_energy(
     year.insert(1, "stability", "all")
     table = pd.concat([table, year], ignore_index=True)
     table["gain_percent"] = 100.0 * (table["aep_steered_gwh"] / table["aep_baseline_gwh"] - 1.0)
-    return AnnualEnergy(table=table[list(COLUMNS)], optima=optima, inflow=inflow)
+    wind_index = np.concatenate([c.wind_index for c in conditions])
+    per_condition = {
+        model: pd.DataFrame({
+            "stability": np.asarray(names, dtype=object)[owner], "frequency": freq,
+            "farm_power_baseline": result["baseline"],
+            "farm_power_steered": result["steered"] if steered else np.nan,
+        }, index=pd.Index(wind_index, name="condition")).sort_index()
+        for model, result in per_model.items()
+    }
+    return AnnualEnergy(table=table[list(COLUMNS)], optima=optima, inflow=inflow,
+                        conditions=per_condition)
 
 
-def _class_model(fmodel, model: str, atmosphere: dict, directions, speeds, wind_ti,
-                 turbulence_intensities: str):
-    """``model`` (ekman_veer = ``fmodel``, or a built-in) on these conditions and atmosphere."""
-    case = fmodel.copy() if model == MODEL_NAME else builtin_model(fmodel, model)
-    set_atmosphere(case, atmosphere, wind_directions=directions, wind_speeds=speeds,
-                   turbulence_intensities=wind_ti)
-    if turbulence_intensities == "atmosphere":
-        fair = fair_builtin_set_kwargs(case)
-        if model != MODEL_NAME:  # only FLORIS's built-ins read wind_veer and wind_shear
-            case.set(turbulence_intensities=fair["turbulence_intensities"],
-                     wind_veer=fair["wind_veer"], wind_shear=fair["wind_shear"])
-        else:
-            case.set(turbulence_intensities=fair["turbulence_intensities"])
-    return case
+def _aep(freq, farm_power) -> float:
+    """FLORIS's ``get_farm_AEP(freq=freq)`` [GWh] from the farm power per condition."""
+    return float(np.nansum(np.multiply(freq, farm_power)) * HOURS_PER_YEAR) / 1e9
+
+
+def _run_conditions(template, model, conditions, study, optimizer_class, optimizer_kwargs, bar):
+    """Farm powers (baseline and steered), optima and inflow of ``conditions``, chunk by chunk."""
+    out = {k: [] for k in ("baseline", "steered", "optima", "turbulence_intensities",
+                           "wind_veer", "wind_shear")}
+    n = conditions.wind_index.size
+    for rows in np.array_split(np.arange(n), max(1, -(-n // study["chunk_size"]))):
+        if not rows.size:
+            continue
+        case = _chunk_model(template, model, conditions, rows, study)
+        flow_field = case.core.flow_field
+        out["turbulence_intensities"].append(flow_field.turbulence_intensities.copy())
+        out["wind_veer"].append(np.full(rows.size, float(flow_field.wind_veer)))
+        out["wind_shear"].append(np.full(rows.size, float(flow_field.wind_shear)))
+        case.run()
+        out["baseline"].append(np.sum(case.get_turbine_powers(), axis=1))
+        if optimizer_class is not None:
+            df_opt = optimize_yaw(case, optimizer_class, progress=False, **_rows_of(
+                optimizer_kwargs, conditions.wind_index[rows]))
+            case.set(yaw_angles=np.vstack(df_opt["yaw_angles_opt"]))
+            case.run()
+            out["steered"].append(np.sum(case.get_turbine_powers(), axis=1))
+            out["optima"].append(df_opt)
+            # FLORIS's set() keeps non-zero yaw angles: the next chunk's baseline is unyawed.
+            case.reset_operation()
+        bar.update(rows.size)
+    return {k: (pd.concat(v, ignore_index=True) if k == "optima" else np.concatenate(v))
+            if v else None for k, v in out.items()}
+
+
+def _rows_of(optimizer_kwargs, index):
+    """The optimiser's options for the wind data's conditions ``index`` (per-condition arrays
+    cut to them)."""
+    from floris_ekman_veer.coupling.optimization import PER_CONDITION_OPTIONS
+
+    return {name: np.asarray(value, dtype=float)[index]
+            if name in PER_CONDITION_OPTIONS and np.ndim(value) == 2 else value
+            for name, value in optimizer_kwargs.items()}
+
+
+def _chunk_model(template, model: str, conditions, rows, study):
+    """``template`` set to the conditions ``rows`` of ``conditions``, each with its atmosphere,
+    and the inflow scalars of the comparison (:func:`comparison_set_kwargs`): one model build."""
+    index = conditions.wind_index[rows]
+    atmosphere = conditions.atmosphere_of(rows)
+    speeds = study["speeds"][index]
+    kwargs = dict(wind_directions=study["directions"][index], wind_speeds=speeds,
+                  turbulence_intensities=study["wind_ti"][index])
+    if study["turbulence_intensities"] == "atmosphere" or model != MODEL_NAME:
+        farm = template.core.farm
+        fair = comparison_set_kwargs(
+            atmosphere, speeds, template.core.flow_field.reference_wind_height,
+            float(farm.hub_heights.reshape(-1, farm.n_turbines)[0, 0]),
+            float(farm.rotor_diameters.reshape(-1, farm.n_turbines)[0, 0]))
+        if study["turbulence_intensities"] == "atmosphere":
+            kwargs["turbulence_intensities"] = fair["turbulence_intensities"]
+        if model != MODEL_NAME:  # only FLORIS's built-ins read wind_veer
+            kwargs["wind_veer"] = fair["wind_veer"]
+    set_atmosphere(template, atmosphere, **kwargs)
+    return template

@@ -415,12 +415,40 @@ def _distinct_heights(z: np.ndarray):
     return heights, inverse, reduced.shape
 
 
+#: The last few (ABL, heights, reference height) -> (U, V) of :func:`ambient_velocity` on small
+#: height sets: a solve's rotor cells are evaluated for the inflow (coupling/rotor.py) and again
+#: for the crossflow (coupling/yawed_rotor.py) at the same heights.
+_AMBIENT_CACHE: OrderedDict = OrderedDict()
+_AMBIENT_CACHE_SIZE = 2
+_AMBIENT_CACHED_HEIGHTS = 4096
+
+
 def ambient_velocity(abl, z, reference_height: float):
     """Hub-aligned ambient (U, V)(z) on a FLORIS grid: the profile of
     :meth:`EkmanABL.hub_aligned_velocity` at z >= 0 (with its roughness sublayer,
     docs/atmosphere.md#roughness-sublayer, so U > 0 for every z > 0), and 0 below the ground
-    (z < 0, where FLORIS's power law has no value either)."""
+    (z < 0, where FLORIS's power law has no value either). Results for at most
+    ``_AMBIENT_CACHED_HEIGHTS`` heights are kept for the next call with the same ABL and heights
+    (read-only arrays)."""
     z = np.asarray(z, dtype=float)
+    if z.size > _AMBIENT_CACHED_HEIGHTS:
+        return _ambient_velocity(abl, z, reference_height)
+    key = (id(abl), z.shape, z.tobytes(), float(reference_height))
+    with _SOLVE_LOCK:
+        entry = _AMBIENT_CACHE.get(key)
+    if entry is not None and entry[0]() is abl:
+        return entry[1], entry[2]
+    U, V = _ambient_velocity(abl, z, reference_height)
+    U.flags.writeable = False
+    V.flags.writeable = False
+    with _SOLVE_LOCK:
+        _AMBIENT_CACHE[key] = (weakref.ref(abl), U, V)
+        while len(_AMBIENT_CACHE) > _AMBIENT_CACHE_SIZE:
+            _AMBIENT_CACHE.popitem(last=False)
+    return U, V
+
+
+def _ambient_velocity(abl, z, reference_height: float):
     above = z >= 0.0
     U, V = abl.hub_aligned_velocity(np.where(above, z, 0.0), reference_height)
     return np.where(above, U, 0.0), np.where(above, V, 0.0)
@@ -512,8 +540,9 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
     U, dUdz = inflow_profile(abl, grid.z_sorted, self.reference_wind_height)
     if isinstance(grid, TurbineGrid):
         # Each rotor point carries the cubic mean of U over its rotor cell (coupling/rotor.py).
+        # (U alone: the gradient's two extra profile evaluations would be discarded.)
         U = turbine_grid_inflow(
-            lambda z: inflow_profile(abl, z, self.reference_wind_height)[0], grid
+            lambda z: ambient_velocity(abl, z, self.reference_wind_height)[0], grid
         )
     shape = self.u_initial_sorted.shape
     if np.any(abl.at_rest):

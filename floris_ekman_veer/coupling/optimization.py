@@ -17,6 +17,7 @@ import contextlib
 import functools
 import io
 import inspect
+import types
 import warnings
 from collections.abc import Mapping
 
@@ -356,9 +357,14 @@ def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1:
         raise ValueError(f"optimize_yaw: chunk_size must be an integer >= 1; got {chunk_size!r}")
 
+    groups = atmosphere_groups(fmodel)
+    if len(groups) > 1 and _rows_follow(fmodel, optimizer_class, optimizer_kwargs):
+        # Every atmosphere in one run per chunk (FLORIS's serial refine carries the condition
+        # rows through its tiling, see row_following_subset): no model per atmosphere.
+        groups = [(ROWS, np.arange(n_findex))]
     runs = [
         (atmosphere, chunk)
-        for atmosphere, index in atmosphere_groups(fmodel)
+        for atmosphere, index in groups
         for chunk in np.array_split(index, -(-index.size // chunk_size))
     ]
     if progress is None:
@@ -374,7 +380,8 @@ def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer
         # (tiled, masked condition sets) would repeat that count in ever different numbers.
         warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
         for atmosphere, index in runs:
-            subset = condition_subset(fmodel, index, atmosphere)
+            subset = (row_following_subset(fmodel, index) if atmosphere is ROWS
+                      else condition_subset(fmodel, index, atmosphere))
             kwargs = {
                 name: np.asarray(value, dtype=float)[index]
                 if name in PER_CONDITION_OPTIONS and np.ndim(value) == 2 else value
@@ -409,6 +416,77 @@ def atmosphere_groups(fmodel) -> list[tuple[Mapping | None, np.ndarray]]:
         index = np.flatnonzero(inverse == label)
         groups.append((spec.sliced(index[0]), index))
     return groups
+
+
+#: Marks the run of :func:`_optimize_once` holding conditions of different atmospheres.
+ROWS = object()
+
+
+def _rows_follow(fmodel, optimizer_class, options) -> bool:
+    """Whether ``optimizer_class`` on ``fmodel`` can run conditions of different atmospheres
+    together (:func:`row_following_subset`): FLORIS's serial refine (which tiles a model's
+    per-condition heterogeneous speed-ups with its conditions) without a heterogeneous map of
+    its own or a convergence check (which re-evaluates without them), on a FlorisModel (a
+    ParFlorisModel hands its workers the heterogeneous configuration as a map)."""
+    from floris import FlorisModel, ParFlorisModel
+    from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+    return (issubclass(optimizer_class, YawOptimizationSR)
+            and type(fmodel).set is FlorisModel.set and not isinstance(fmodel, ParFlorisModel)
+            and fmodel.core.flow_field.heterogeneous_inflow_config is None
+            and not options.get("verify_convergence", False))
+
+
+def row_following_subset(fmodel, index):
+    """:func:`condition_subset` of conditions ``index`` with their per-condition atmosphere,
+    whose atmosphere follows its conditions through FLORIS's serial-refine optimiser.
+
+    The serial refine evaluates tiled and masked copies of its model's conditions, and carries
+    per-condition heterogeneous speed-ups the same way (``speed_multipliers`` tiled with the
+    conditions). The subset holds, in that place, the row of each of its conditions (one
+    column, never read as speed-ups: FLORIS builds its map only at construction), and its
+    ``set()`` gives each condition set the atmosphere rows of the rows it carries. One model
+    per chunk of conditions, whatever their atmospheres.
+    """
+    index = np.asarray(index)
+    spec = atmosphere_of(fmodel.core)
+    subset = condition_subset(fmodel, index, spec.sliced(index))
+    subset._atmosphere_rows = {k: v if isinstance(v, float) else v.reshape(-1)[index]
+                               for k, v in spec.inputs.items()}
+    _mark_rows(subset, np.arange(index.size))
+    subset.set = types.MethodType(_set_following_rows, subset)
+    return subset
+
+
+def _mark_rows(fmodel, rows) -> None:
+    # Past FlowField's validator (which wants a map's x and y): the rows are no map.
+    object.__setattr__(fmodel.core.flow_field, "heterogeneous_inflow_config",
+                       {"speed_multipliers": np.asarray(rows, dtype=float).reshape(-1, 1)})
+
+
+def _set_following_rows(self, **kwargs):
+    """``set()`` of a :func:`row_following_subset`: the atmosphere of the rows it carries."""
+    rows = np.asarray(self.core.flow_field.heterogeneous_inflow_config["speed_multipliers"],
+                      dtype=float).reshape(-1).astype(int)
+    n = np.size(kwargs.get("wind_directions", rows))
+    if n != rows.size:
+        raise ValueError(f"optimize_yaw: the optimiser set {n} conditions on a model "
+                         f"carrying the atmospheres of {rows.size}")
+    atmosphere = {k: v if isinstance(v, float) else v[rows].tolist()
+                  for k, v in self._atmosphere_rows.items()}
+    object.__setattr__(self.core.flow_field, "heterogeneous_inflow_config", None)
+    set_atmosphere(_Plain(self), atmosphere, **kwargs)
+    _mark_rows(self, rows)
+
+
+class _Plain:
+    """A model seen through its class's own ``set()`` (for :func:`set_atmosphere`)."""
+
+    def __init__(self, fmodel):
+        self.core, self._fmodel = fmodel.core, fmodel
+
+    def set(self, **kwargs):
+        type(self._fmodel).set(self._fmodel, **kwargs)
 
 
 def condition_subset(fmodel, index, atmosphere: Mapping | None):
@@ -575,7 +653,8 @@ def _dispatching_optimize(original):
     @functools.wraps(original)
     def wrapper(self, *args, **kwargs):
         spec = atmosphere_of(self.fmodel.core)
-        if spec is None or spec.n_conditions is None:
+        if (spec is None or spec.n_conditions is None
+                or "_atmosphere_rows" in self.fmodel.__dict__):  # a row_following_subset
             return original(self, *args, **kwargs)
         options = self.__dict__.get("_optimize_yaw_options")
         if options is None:

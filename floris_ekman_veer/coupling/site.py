@@ -21,7 +21,7 @@ import pandas as pd
 from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling.energy import annual_energy
+from floris_ekman_veer.coupling.energy import record_energy
 from floris_ekman_veer.coupling.inflow import set_atmosphere
 
 #: Column names of the measured speeds and directions: the height in metres is in the name.
@@ -152,10 +152,13 @@ class SiteAtmosphere:
 
     def annual_energy(self, fmodel, optimizer_class=None, **options):
         """:func:`~floris_ekman_veer.annual_energy` of ``fmodel`` for these records, each record
-        with its fitted atmosphere (``options``: annual_energy's and the optimiser's)."""
-        classes, records = self.stability()
-        return annual_energy(fmodel, self.time_series(), classes, optimizer_class,
-                             records=records, **options)
+        with its fitted atmosphere (``options``: annual_energy's and the optimiser's).
+
+        The classes are those of :meth:`stability`; the records run as chunks of one vectorised
+        FLORIS model each, with the per-record atmosphere block (as :meth:`apply`), never a
+        model per class."""
+        return record_energy(fmodel, self.time_series(), self.atmosphere,
+                             [str(label) for label in self.labels], optimizer_class, **options)
 
 
 def fit_site(records: pd.DataFrame, reference_height: float, *,
