@@ -207,3 +207,11 @@ def test_bounds_that_exclude_zero(bounds):
         assert found == pytest.approx(best, rel=1e-12)
     else:
         assert 1.0 - found / best < 5e-4, (found, best)
+
+
+def test_a_model_without_conditions_is_refused_naming_it():
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+    fmodel.set(wind_directions=np.array([]), wind_speeds=np.array([]),
+               turbulence_intensities=np.array([]))
+    with pytest.raises(ValueError, match=r"optimize_yaw: the model has no conditions \(n_findex = 0\)"):
+        optimize_yaw(fmodel, YawOptimizationSR)

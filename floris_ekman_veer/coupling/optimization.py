@@ -107,11 +107,16 @@ def optimize_yaw(
         ``yaw_angles_opt``, ``farm_power_opt`` and ``farm_power_baseline``.
 
     Raises:
-        ValueError: for options the optimiser does not accept or would reject, before any
-            FLORIS evaluation.
+        ValueError: for a model without conditions, and for options the optimiser does not
+            accept or would reject, before any FLORIS evaluation.
     """
     n_findex = fmodel.core.flow_field.n_findex
     n_turbines = fmodel.core.farm.n_turbines
+    if n_findex == 0:
+        raise ValueError(
+            "optimize_yaw: the model has no conditions (n_findex = 0): give at least one wind "
+            "direction, wind speed and turbulence intensity with fmodel.set(...)"
+        )
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
