@@ -650,7 +650,7 @@ def _validating_post_init(method):
     def wrapper(self: Core) -> None:
         spec = atmosphere_of(self)
         if input_checks.uses_package(self, spec):
-            input_checks.check_core(self)
+            input_checks.check_core(self, spec)
         method(self)
         if spec is not None and self.flow_field.n_findex:
             _check_solved_conditions(self, spec)

@@ -19,6 +19,7 @@ import floris_ekman_veer.warnings as package_warnings
 
 from floris_ekman_veer._validation import number, require_each
 from floris_ekman_veer.coupling.names import (
+    ATMOSPHERE_PATH,
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
@@ -57,38 +58,37 @@ def _turbine_path(farm, index: int) -> str:
     return f"farm.turbine_type[{index if len(farm.turbine_type) > 1 else 0}]"
 
 
-def check_core(core) -> None:
-    """Layout, conditions and turbine definitions of a Core that uses the package."""
+def check_core(core, atmosphere=None) -> None:
+    """Layout, conditions and turbine definitions of a Core that uses the package, and the FLORIS
+    flow inputs its ``atmosphere`` (the validated atmosphere of the input, or None) replaces."""
     _check_layout(core.farm)
     check_reference_height(core.flow_field)
     _check_conditions(core.flow_field)
     _check_turbines(core.farm)
-    warn_ignored_flow_inputs(core)
+    warn_ignored_flow_inputs(core, atmosphere)
 
 
-def warn_ignored_flow_inputs(core) -> None:
+def warn_ignored_flow_inputs(core, atmosphere) -> None:
     """With an atmosphere, FLORIS's ``flow_field.wind_shear`` is not used (the atmosphere gives
     the inflow's shear), and ``flow_field.wind_veer`` is not used by the ekman_veer models
     (the atmosphere gives the veer; FLORIS's gauss models still read it as they do without the
     package, docs/user_guide.md#floris-inputs-the-atmosphere-replaces): one
     :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per value per study, so that a
     value the user set is never silently without effect. Zero (the shipped inputs') is silent."""
-    from floris_ekman_veer.coupling.inflow import CONFIG_PATH, read_atmosphere
-
-    if read_atmosphere(core.wake.wake_velocity_parameters) is None:
+    if atmosphere is None:
         return
     flow_field = core.flow_field
     shear, veer = float(flow_field.wind_shear), float(flow_field.wind_veer)
     if shear != 0.0:
         package_warnings.warn(
-            f"flow_field.wind_shear = {shear:g} is not used: the atmosphere ({CONFIG_PATH}) "
+            f"flow_field.wind_shear = {shear:g} is not used: the atmosphere ({ATMOSPHERE_PATH}) "
             "gives the inflow's shear; set wind_shear: 0.0 to say so "
             "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
             package_warnings.ModelSettingsWarning, items=(("wind_shear", shear),))
     if veer != 0.0 and uses_wake_models(core):
         package_warnings.warn(
             f"flow_field.wind_veer = {veer:g} deg is not used by the "
-            f"{VELOCITY_MODEL_NAME} models: the atmosphere ({CONFIG_PATH}) gives the veer; set "
+            f"{VELOCITY_MODEL_NAME} models: the atmosphere ({ATMOSPHERE_PATH}) gives the veer; set "
             "wind_veer: 0.0 to say so (FLORIS's gauss models read it, "
             "docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
             package_warnings.ModelSettingsWarning, items=(("wind_veer", veer),))

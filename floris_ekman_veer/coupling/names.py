@@ -9,3 +9,5 @@ all read them without importing one another.
 VELOCITY_MODEL_NAME = "ekman_veer"
 DEFLECTION_MODEL_NAME = "ekman_veer"
 GAUSSIAN_2014_NAME = "bastankhah2014"
+#: Where a FLORIS input gives the atmosphere.
+ATMOSPHERE_PATH = f"wake.wake_velocity_parameters.{VELOCITY_MODEL_NAME}.atmosphere"
