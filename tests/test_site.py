@@ -195,6 +195,7 @@ def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
     np.testing.assert_allclose(vector.profile_fit.obukhov_length, lengths[::2], rtol=1e-6)
 
 
+@pytest.mark.study
 def test_site_fit_example_reduced(tmp_path):
     """examples/site_fit.py on four records: the fit, the FLORIS run from the YAML it writes,
     annual energy with and without steering, the figure."""
