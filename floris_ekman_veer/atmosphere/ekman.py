@@ -227,6 +227,9 @@ def stability_term(mu, xi, xi0, kappa, gamma=BUSINGER_DYER_GAMMA):
     mu = np.asarray(mu, dtype=float)
     unstable = mu < 0
     stable = 5.0 * np.maximum(mu, 0.0) * (xi - xi0)
+    if not unstable.any():
+        # Nights and neutral days skip the Businger-Dyer evaluation, the profile's largest cost.
+        return stable
     k_mu = kappa * np.minimum(mu, 0.0)
     convective = -(unstable_psi_m(k_mu * xi, gamma) - unstable_psi_m(k_mu * xi0, gamma)) / kappa
     return np.where(unstable, convective, stable)

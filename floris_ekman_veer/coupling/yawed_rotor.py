@@ -106,6 +106,11 @@ def _veer_aware(original, kind):
     def wrapper(*args, **kwargs):
         arguments = signature.bind(*args, **kwargs).arguments
         extra = arguments.pop("_", {})
+        if not np.any(arguments["yaw_angles"]):
+            # The ratios are exactly 1 on un-yawed rotors (veer_ratio): the rotor cells' V
+            # moments, the hook's largest cost on small farms with many conditions, are not
+            # needed where no rotor of the batch is yawed.
+            return original(*args, **kwargs)
         velocities = np.asarray(arguments["velocities"], dtype=float)
         crossflow = ambient_crossflow(arguments["power_thrust_table"], velocities)
         if crossflow is None:
