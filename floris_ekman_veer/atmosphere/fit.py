@@ -49,7 +49,11 @@ from floris_ekman_veer._validation import real_array, require_at
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
-               "on_misfit", "labels", "max_iterations", "stability", "chunk_size")
+               "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
+               "turbulence_intensity", "turbulence_noise")
+#: Default noise of a measured turbulence intensity, relative to its value: the order of the
+#: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
+DEFAULT_TURBULENCE_NOISE = 0.1
 #: Records iterated together by default: the work arrays stay below about 100 MB.
 DEFAULT_CHUNK_SIZE = 4096
 #: Stability inputs the fit determines (refused as fixed inputs).
@@ -321,8 +325,11 @@ class _ProfileModel:
     x = (ln u*, lam = 100 m/L, [ln z0]) per record, and the normalised residuals."""
 
     def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
-                 speed_noise, direction_noise, sign=1.0):
+                 speed_noise, direction_noise, sign=1.0, turbulence=None):
         self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        # A measured turbulence intensity per record: (heights (n,), values (n,) NaN missing,
+        # relative noise), or None (docs/measurements.md#measured-turbulence).
+        self.turbulence = turbulence
         # The sign of 1/L: the unknown lam >= 0 is 100 m/|L| (convective fits: sign -1).
         self.sign = float(sign)
         self.z, self.s, self.d = heights, speeds, directions
@@ -406,7 +413,20 @@ class _ProfileModel:
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
             self.sigma_s, self.sigma_d, offset=True)
+        if self.turbulence is not None:
+            r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
+
+
+def _turbulence_residual(abl, turbulence, index):
+    """(k, 1): the model's I_u = sigma_u/U at the measured height (Eq. Iu_model, with the
+    convective variance of docs/atmosphere.md#convective-turbulence) minus the measured one,
+    divided by its noise; 0 where none is measured."""
+    heights, values, noise = (np.asarray(a)[index] for a in turbulence)
+    measured = np.isfinite(values)
+    model = np.asarray(abl.turbulence_intensity(heights), float).reshape(-1)
+    return np.where(measured, (model - np.where(measured, values, 0.0))
+                    / (noise * np.where(measured, values, 1.0)), 0.0)[:, None]
 
 
 def _normalised_residuals(speed, angle, speeds, directions, sigma_s, sigma_d, offset=False):
@@ -526,6 +546,35 @@ def _check_degrees(directions):
             "be given as 360 + direction")
 
 
+def _checked_turbulence(turbulence_intensity, noise, n, z0, fit_roughness):
+    """(heights (n,), values (n,), relative noise (n,)) of ``turbulence_intensity=(height,
+    value)``, or None; ValueError naming what is wrong."""
+    if turbulence_intensity is None:
+        return None
+    if isinstance(noise, bool) or not np.isscalar(noise) or not np.isfinite(noise) or noise <= 0:
+        raise ValueError(f"fit_profile: turbulence_noise must be a number > 0 (relative to the "
+                         f"measured value); got {noise!r}")
+    try:
+        height, value = turbulence_intensity
+    except (TypeError, ValueError):
+        raise ValueError("fit_profile: turbulence_intensity must be (height [m], value), each a "
+                         f"number or one per record ({n}); got {turbulence_intensity!r}") from None
+    arrays = []
+    for name, v in (("turbulence_intensity height", height), ("turbulence_intensity value", value)):
+        array = real_array(name, v)
+        if array.ndim > 1 or (array.ndim == 1 and array.size != n):
+            raise ValueError(f"fit_profile: {name} must be a number or one per record ({n}); got "
+                             f"shape {array.shape}")
+        arrays.append(np.broadcast_to(array, (n,)).astype(float))
+    height, value = arrays
+    lowest = 0.0 if fit_roughness else np.broadcast_to(z0, (n,))
+    require_at(np.isfinite(height) & (height > lowest), "turbulence_intensity height",
+               "finite and > roughness_length z0", height)
+    require_at(np.isnan(value) | ((value > 0) & (value < 1)), "turbulence_intensity value",
+               "in (0, 1) (sigma_u/U; NaN: none for that record)", value)
+    return height, value, np.full(n, float(noise))
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -539,8 +588,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
                 on_misfit="raise", labels=None, max_iterations=100, stability="stable",
-                chunk_size=DEFAULT_CHUNK_SIZE,
-                **fixed_inputs):
+                chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
+                turbulence_noise=DEFAULT_TURBULENCE_NOISE, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -562,6 +611,12 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
             both, each record taking the sign whose fit misses its data less
             (``ProfileFit.stability_class`` says which).
+        turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
+            sigma_u divided by the measured speed at its height): ``(height, value)``, each a
+            number or one per record (NaN: none for that record); an extra residual, the
+            model's I_u at that height (Eq. Iu_model) against it, which constrains u* and the
+            stability (docs/measurements.md#measured-turbulence).
+        turbulence_noise: its noise relative to its value (default 0.1).
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
             it: each record's iteration is its own).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
@@ -582,7 +637,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             abl_class, heights, speeds, directions, speed_noise=speed_noise,
             direction_noise=direction_noise, fit_roughness=fit_roughness,
             refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
-            max_iterations=max_iterations, chunk_size=chunk_size, **fixed_inputs)
+            max_iterations=max_iterations, chunk_size=chunk_size,
+            turbulence_intensity=turbulence_intensity, turbulence_noise=turbulence_noise,
+            **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -665,10 +722,14 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         low = heights <= np.reshape(z0_array, (-1, 1))
         require_at(~low, "heights", "> roughness_length z0", heights)
 
+    turbulence = _checked_turbulence(turbulence_intensity, turbulence_noise, n, z0_array,
+                                     fit_roughness)
     valid_speeds = np.sum(np.isfinite(speeds), axis=1)
     n_unknowns = 3 if fit_roughness else 2
     observations = valid_speeds + (0 if directions is None
                                    else np.maximum(np.sum(np.isfinite(directions), axis=1) - 1, 0))
+    if turbulence is not None:
+        observations = observations + np.isfinite(turbulence[1])
     short = (valid_speeds < 1) | (observations < n_unknowns)
     if np.any(short):
         i = int(np.argmax(short))
@@ -680,7 +741,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
 
     sign = -1.0 if stability == "convective" else 1.0
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise), sign)
+                          float(speed_noise), float(direction_noise), sign, turbulence)
     from scipy.stats import chi2
 
     dof = np.maximum(observations - n_unknowns, 1)
@@ -694,7 +755,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             None if directions is None else directions[chunk],
             {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
             z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
-            float(speed_noise), float(direction_noise), sign)
+            float(speed_noise), float(direction_noise), sign,
+            None if turbulence is None else tuple(a[chunk] for a in turbulence))
         result = _multistart(part, chunk.size, max_iterations)
         _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
         parts.append(result)
@@ -708,7 +770,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         direction_rms = np.full(n, np.nan)
     else:
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
-        direction_rms = np.sqrt(np.sum(r[:, m:] ** 2, axis=1) / count) * direction_noise
+        direction_rms = np.sqrt(np.sum(r[:, m:2 * m] ** 2, axis=1) / count) * direction_noise
     fits = misfit <= misfit_tolerance
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
