@@ -86,12 +86,23 @@ def mixed_layer_record(length=-100.0, top=100.0):
 
 
 def test_a_mixed_layer_is_not_a_shallow_stable_layer():
-    """The surface layer to 100 m with a well-mixed layer above (L = -100 m): the stable-only fit
-    makes it a stable layer shallower than the lowest measurement; stability="either" fits it
-    as convective, with the boundary layer at z_i, within 2 % at the hub."""
+    """The surface layer to 100 m with a well-mixed layer above (L = -100 m): the stable-only
+    fit's best state is a stable layer shallower than the lowest measurement (L = 3.3 m, h =
+    26 m), which the data do not show (no speed maximum, no veer): refused, saying what the data
+    look like; stability="either" fits it as convective, with the boundary layer at z_i,
+    within 2 % at the hub."""
     speeds, directions = mixed_layer_record()
     stable = EkmanABL.fit_profile(Z, speeds, directions, on_misfit="flag", **SITE)
-    assert stable.boundary_layer_height < Z[0]
+    assert stable.boundary_layer_height < Z[0] and not stable.profile_fit.fits
+    kind, text = stable.profile_fit.reason(0)
+    assert kind == "no top"
+    with pytest.raises(ValueError, match=r"record 0 fits no atmosphere of the model: its best fit "
+                                         r"is a stable layer only 2\d\.?\d* m deep, below the "
+                                         r"highest measurement \(150 m\), but the data show no "
+                                         r"top there .* the speed grows from "
+                                         rf"{speeds[0]:.3g} m/s at 30 m to {speeds[-1]:.3g} m/s "
+                                         r"at 150 m and the direction turns \+0 deg"):
+        EkmanABL.fit_profile(Z, speeds, directions, **SITE)
     abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
     fit = abl.profile_fit
     assert fit.stability_class == "convective" and fit.misfit < stable.profile_fit.misfit

@@ -256,6 +256,14 @@ class ProfileFit:
         for a record that fits, its kind is whatever its data look like)."""
         hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
                                                         np.shape(self.misfit)), -1)[i])
+        depth = np.reshape(self.boundary_layer_height, -1)[i : i + 1]
+        directions = None if self.directions is None else self.directions[i : i + 1]
+        if (np.reshape(self.obukhov_length, -1)[i] > 0
+                and np.reshape(self.misfit, -1)[i] <= np.reshape(self.misfit_tolerance, -1)[i]
+                and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
+                                depth, self.speed_noise, self.direction_noise)[0]):
+            return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
+                                                depth[0], self.speed_noise, self.direction_noise)
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
                              self.speed_noise, self.direction_noise, hemisphere,
@@ -772,10 +780,16 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
         direction_rms = np.sqrt(np.sum(r[:, m:2 * m] ** 2, axis=1) / count) * direction_noise
     fits = misfit <= misfit_tolerance
+    if sign > 0:
+        # A stable layer shallower than the highest measurement only where the data show its
+        # top (docs/measurements.md#a-top-the-data-show).
+        _, _, _, _, depth = model.state(x, index)
+        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
+                                      float(direction_noise)))
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, misfit, model, misfit_tolerance,
-                            float(refusal_probability))
+                            float(refusal_probability), depth if sign > 0 else None)
 
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
@@ -830,7 +844,9 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         for sign in ("stable", "convective")
     ]
     stable, convective = fits
-    take = np.asarray(convective.misfit) < np.asarray(stable.misfit)
+    passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
+    take = np.where(passes_s == passes_c, np.asarray(convective.misfit) < np.asarray(stable.misfit),
+                    passes_c)
     chosen = {}
     for field in attrs.fields(ProfileFit):
         a, b = getattr(stable, field.name), getattr(convective, field.name)
@@ -1035,12 +1051,88 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                       "or directions turning more than its stability allows with that shear)")
 
 
+def _top_changes(heights, speeds, directions, depth):
+    """Per record: the speed and direction changes from the lowest height to the lowest one at
+    or above ``depth`` (across the layer) and from there to the highest (above it), the largest
+    speed minus the highest one's, and whether a measurement lies below ``depth``."""
+    z = np.where(np.isfinite(speeds), heights, np.nan)
+    rows = np.arange(len(z))
+    low = np.nanargmin(z, axis=1)
+    high = np.nanargmax(z, axis=1)
+    above = np.where(z >= depth[:, None], z, np.inf)
+    cross = np.where(np.isfinite(np.min(above, axis=1)), np.argmin(above, axis=1), high)
+    s = np.where(np.isfinite(speeds), speeds, np.nan)
+    changes = {
+        "speed_below": s[rows, cross] - s[rows, low],
+        "speed_above": s[rows, high] - s[rows, cross],
+        "peak": np.nanmax(s, axis=1) - s[rows, high],
+        "below": z[rows, low] < depth,
+    }
+    if directions is not None:
+        d = np.where(np.isfinite(directions), directions, np.nan)
+        changes["turn_below"] = _wrap(d[rows, cross] - d[rows, low])
+        changes["turn_above"] = _wrap(d[rows, high] - d[rows, cross])
+    return changes
+
+
+def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
+    """Records whose boundary layer top ``depth`` lies below their highest measurement although
+    their data show no top there: none of a speed maximum below the highest height (by more
+    than two noise standard deviations), the shear stopping at the top (the speed grows across
+    the layer by more than three standard deviations of a difference and changes less above it)
+    or the veer stopping (the direction turns across the layer by more than three standard
+    deviations of a difference and less above it)."""
+    top = np.nanmax(np.where(np.isfinite(speeds), heights, np.nan), axis=1)
+    shallow = np.isfinite(depth) & (depth < top)
+    if not np.any(shallow):
+        return shallow
+    c = _top_changes(heights, speeds, directions, np.where(shallow, depth, np.inf))
+    step_s, step_d = 3.0 * np.sqrt(2.0) * sigma_s, 3.0 * np.sqrt(2.0) * sigma_d
+    shown = c["peak"] > 2.0 * sigma_s
+    shown |= c["below"] & (c["speed_below"] > step_s) & (np.abs(c["speed_above"]) <= step_s)
+    if directions is not None:
+        shown |= (c["below"] & (np.abs(c["turn_below"]) > step_d)
+                  & (np.abs(c["turn_above"]) <= step_d))
+    return shallow & ~shown
+
+
+def _hidden_top_reason(heights, speeds, directions, depth, sigma_s, sigma_d):
+    """What the data of a record refused by `_hidden_top` look like, as a sentence."""
+    z = heights[np.isfinite(speeds)]
+    s = speeds[np.isfinite(speeds)]
+    order = np.argsort(z)
+    z, s = z[order], s[order]
+    turn = ""
+    if directions is not None:
+        okd = np.isfinite(directions[0])
+        zd, dd = heights[okd], directions[0][okd]
+        o = np.argsort(zd)
+        if zd.size >= 2:
+            turn = (f" and the direction turns {_wrap(dd[o][-1] - dd[o][0]):+.3g} deg from "
+                    f"{zd[o][0]:.4g} to {zd[o][-1]:.4g} m")
+    return (f"its best fit is a stable layer only {float(depth):.3g} m deep, below the highest "
+            f"measurement ({z[-1]:.4g} m), but the data show no top there (no speed maximum, "
+            f"and neither the shear nor the veer stops at it): the speed grows from "
+            f"{s[0]:.3g} m/s at {z[0]:.4g} m to {s[-1]:.3g} m/s at {z[-1]:.4g} m{turn}. A layer "
+            "mixed above its surface layer (a convective afternoon) looks like this: "
+            "stability=\"either\" fits convective layers too "
+            "(docs/measurements.md#a-top-the-data-show)")
+
+
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability):
+                  model, tolerance, probability, depth=None):
     i = int(failing[0])
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
     _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
                               model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
+    if depth is not None and misfit[i] <= tolerance[i]:
+        d = None if directions is None else directions[i:i + 1]
+        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], model.sigma_s,
+                                    model.sigma_d)
+        return ValueError(
+            f"fit_profile: record {labels[i]} fits no atmosphere of the model: {reason}"
+            + (f"; {failing.size - 1} more record(s) fail" if failing.size > 1 else "")
+            + ". Give on_misfit='flag' to keep the fits and read profile_fit.fits")
     more = ""
     if failing.size > 1:
         shown = ", ".join(str(labels[k]) for k in failing[1:6])
