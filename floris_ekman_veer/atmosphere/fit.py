@@ -1078,10 +1078,10 @@ def _top_changes(heights, speeds, directions, depth):
 def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
     """Records whose boundary layer top ``depth`` lies below their highest measurement although
     their data show no top there: none of a speed maximum below the highest height (by more
-    than two noise standard deviations), the shear stopping at the top (the speed grows across
-    the layer by more than three standard deviations of a difference and changes less above it)
-    or the veer stopping (the direction turns across the layer by more than three standard
-    deviations of a difference and less above it)."""
+    than two noise standard deviations), the shear stopping at the top (the speed grows from the
+    lowest height to the first one at or above the top by more than three standard deviations of
+    a difference more than it changes from there to the highest) or the veer stopping (the same
+    for the direction's turning)."""
     top = np.nanmax(np.where(np.isfinite(speeds), heights, np.nan), axis=1)
     shallow = np.isfinite(depth) & (depth < top)
     if not np.any(shallow):
@@ -1089,10 +1089,9 @@ def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
     c = _top_changes(heights, speeds, directions, np.where(shallow, depth, np.inf))
     step_s, step_d = 3.0 * np.sqrt(2.0) * sigma_s, 3.0 * np.sqrt(2.0) * sigma_d
     shown = c["peak"] > 2.0 * sigma_s
-    shown |= c["below"] & (c["speed_below"] > step_s) & (np.abs(c["speed_above"]) <= step_s)
+    shown |= c["below"] & (c["speed_below"] - np.abs(c["speed_above"]) > step_s)
     if directions is not None:
-        shown |= (c["below"] & (np.abs(c["turn_below"]) > step_d)
-                  & (np.abs(c["turn_above"]) <= step_d))
+        shown |= c["below"] & (np.abs(c["turn_below"]) - np.abs(c["turn_above"]) > step_d)
     return shallow & ~shown
 
 
