@@ -154,3 +154,25 @@ def test_turbulence_intensity_option_is_checked():
     with pytest.raises(ValueError, match=r"turbulence_noise must be a number > 0"):
         EkmanABL.fit_profile(Z, speeds, turbulence_intensity=(90.0, 0.1), turbulence_noise=0.0,
                              **SITE)
+
+
+def test_fit_site_takes_a_measured_intensity_per_record():
+    """fit_site passes ``turbulence_intensity=(height, column)`` through, one value per record
+    (NaN: none): the records it has pinned to the model's own I_u, the others fitted without."""
+    import pandas as pd
+
+    from floris_ekman_veer import fit_site
+
+    site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    heights = np.array([40.0, 100.0])
+    lengths = np.array([-200.0, 200.0, -200.0])
+    true = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=lengths, **site)
+    speeds = true.speed(heights[:, None]).T
+    records = pd.DataFrame({"time": ["a", "b", "c"], "speed_40m": speeds[:, 0],
+                            "speed_100m": speeds[:, 1]})
+    measured = np.asarray(true.turbulence_intensity(100.0), float)
+    measured[2] = np.nan
+    fitted = fit_site(records, 90.0, stability="either",
+                      turbulence_intensity=(100.0, measured), **site).profile_fit
+    np.testing.assert_allclose(fitted.obukhov_length[:2], lengths[:2], rtol=1e-6)
+    assert fitted.stability_class[2] == "stable"  # speeds alone: the ambiguity of the test above
