@@ -176,3 +176,21 @@ def test_fit_site_takes_a_measured_intensity_per_record():
                       turbulence_intensity=(100.0, measured), **site).profile_fit
     np.testing.assert_allclose(fitted.obukhov_length[:2], lengths[:2], rtol=1e-6)
     assert fitted.stability_class[2] == "stable"  # speeds alone: the ambiguity of the test above
+
+
+def test_neutral_speeds_with_five_degrees_of_turning_are_refused_saying_so():
+    """The log law (u* = 0.4 m/s) with the direction turning linearly by 5 deg from 30 to 150 m:
+    the model's neutral layer at this site turns by less than 2 deg there (its surface layer
+    does not turn), so no state of either sign meets both (docs/measurements.md#convective-records);
+    the refusal says what the data look like."""
+    site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    speeds = U_STAR / KAPPA * np.log(Z / Z0)
+    directions = 250.0 + 5.0 * (Z - Z[0]) / (Z[-1] - Z[0])
+    fit = EkmanABL.fit_profile(Z, speeds, directions, stability="either", on_misfit="flag",
+                               speed_noise=0.1, direction_noise=0.5, **site).profile_fit
+    assert not fit.fits
+    kind, text = fit.reason(0)
+    log_law = np.log(150.0 / Z0) / np.log(30.0 / Z0)
+    assert kind == "misfit" and text.endswith(
+        f"the speed grows {log_law:.3g} times from 30 m to 150 m (the neutral log law "
+        f"{log_law:.3g} times) and the direction turns +5 deg from 30 m to 150 m")

@@ -1046,9 +1046,17 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                     f"{'veers' if north else 'backs'}: the direction turns "
                     f"{'clockwise' if north else 'anticlockwise'} with height)"
                 )
+    looks = ""
+    if zs.size >= 2 and ss[0] > 0:
+        looks = (f": the speed grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to "
+                 f"{zs[-1]:.4g} m (the neutral log law {log_law:.3g} times)")
+        if directions is not None and zd.size >= 2:
+            looks += (f" and the direction turns {_wrap(dd[-1] - dd[0]):+.3g} deg from "
+                      f"{zd[0]:.4g} m to {zd[-1]:.4g} m")
     return "misfit", ("the shape of its profile is outside the model's (speed and direction "
                       "change together set u*, L and z0; a profile kinked beyond the model's, "
-                      "or directions turning more than its stability allows with that shear)")
+                      "or directions turning more than its stability allows with that shear)"
+                      + looks)
 
 
 def _top_changes(heights, speeds, directions, depth):
