@@ -94,6 +94,7 @@ def test_a_mixed_layer_is_not_a_shallow_stable_layer():
     speeds, directions = mixed_layer_record()
     stable = EkmanABL.fit_profile(Z, speeds, directions, on_misfit="flag", **SITE)
     assert stable.boundary_layer_height < Z[0] and not stable.profile_fit.fits
+    assert stable.profile_fit.obukhov_length == pytest.approx(3.26, rel=0.01)
     kind, text = stable.profile_fit.reason(0)
     assert kind == "no top"
     with pytest.raises(ValueError, match=r"record 0 fits no atmosphere of the model: its best fit "
@@ -116,6 +117,9 @@ def test_a_mixed_layer_with_a_measured_intensity_has_the_convective_turbulence()
     docs/measurements.md#measured-turbulence)."""
     speeds, directions = mixed_layer_record()
     measured = panofsky_intensity(90.0, -100.0)
+    alone = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
+    assert alone.profile_fit.obukhov_length == pytest.approx(-24.2, rel=0.01)
+    assert float(alone.turbulence_intensity(90.0)) / measured == pytest.approx(1.32, abs=0.005)
     abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either",
                                turbulence_intensity=(90.0, measured), **SITE)
     _check_convective(abl.profile_fit, abl, np.array([-100.0]),
