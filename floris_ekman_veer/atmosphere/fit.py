@@ -25,6 +25,13 @@ stacked array; 1/L kept >= 0 by an active bound), from the best of a few startin
 (L = inf, 400, 200, 100, 50, 25 m); records that have converged are frozen. No Python loop runs
 over records.
 
+Optionally a measured turbulence intensity per record (``turbulence_intensity=(height, value)``)
+adds one residual, the model's I_u there against it (docs/measurements.md#measured-turbulence).
+
+A stable fit whose ABL top lies below the highest measurement is kept only where the data show
+that top (a speed maximum, or the shear or the veer stopping at it); otherwise it is refused as
+"no top" (docs/measurements.md#a-top-the-data-show).
+
 Refusal: a record whose best fit misses the data by more than the model plus the stated noise
 would with probability ``refusal_probability`` (1e-6; a chi-square test) fits no atmosphere of
 the model (directions backing with height in the northern
