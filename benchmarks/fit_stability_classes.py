@@ -10,6 +10,16 @@ Records: n_per_class (default 200) per class of the model's own profiles driven 
 Gaussian noise (seed 1), fitted in one call with those noises. Printed: per true class, the
 fitted classes (convective -500 m <= L < 0, neutral |L| > 500 m, stable 0 < L <= 500 m), the
 records refused by the chi-square test, and the largest hub-height (90 m) speed error.
+
+Then the same for n_per_class records per class written from published forms, not by the model
+(``published_records``): convective, a Businger-Dyer surface layer (Paulson 1970's psi_m with
+gamma 16) up to a top log-uniform in 50..200 m with a well-mixed layer above it (uniform speed
+and direction), L log-uniform in -400..-20 m; neutral, the log law with a constant direction
+(no stable class: a surface-layer form does not reach 150 m in a stable layer, which is
+shallow); u* uniform in 0.2..0.6 m/s; mixed_layer_height 1000 m; the same noise. Printed as
+above plus, for the convective class, the share and the largest of the relative errors of the
+fitted I_u(90 m) against Panofsky et al. (1977)'s sigma_u/u* = (12 - 0.5 z_i/L)^(1/3), z_i =
+1000 m, without and with that I_u given as measured (``turbulence_intensity``).
 """
 
 import sys
@@ -50,9 +60,67 @@ def confusion(n=200):
     }
 
 
+def _psi_m(z, length):
+    x = (1.0 - 16.0 * z / length) ** 0.25
+    return 2 * np.log((1 + x) / 2) + np.log((1 + x * x) / 2) - 2 * np.arctan(x) + np.pi / 2
+
+
+def published_records(n, seed=2):
+    """(true class, hub speed, speeds, directions, true L, u*) from the published forms."""
+    rng = np.random.default_rng(seed)
+    z0, kappa = SITE["roughness_length"], 0.4
+    u_star = rng.uniform(0.2, 0.6, 2 * n)[:, None]
+    convective = -np.exp(rng.uniform(np.log(20.0), np.log(400.0), n))
+    top = np.exp(rng.uniform(np.log(50.0), np.log(200.0), n))[:, None]
+    z = np.minimum(HEIGHTS[None, :], top)
+    L = convective[:, None]
+    shapes = [np.log(z / z0) - _psi_m(z, L) + _psi_m(z0, L),
+              np.broadcast_to(np.log(HEIGHTS / z0), (n, HEIGHTS.size))]
+    speeds = u_star / kappa * np.concatenate(shapes)
+    hub_shapes = [np.log(np.minimum(90.0, top[:, 0]) / z0) - _psi_m(np.minimum(90.0, top[:, 0]), convective)
+                  + _psi_m(z0, convective), np.full(n, np.log(90.0 / z0))]
+    hub = u_star[:, 0] / kappa * np.concatenate(hub_shapes)
+    speeds = speeds + rng.normal(0.0, 0.1, speeds.shape)
+    directions = 250.0 + rng.normal(0.0, 0.5, speeds.shape)
+    lengths = np.concatenate([convective, np.full(n, np.inf)])
+    return np.repeat(CLASSES[:2], n), hub, speeds, directions, lengths, u_star[:, 0]
+
+
+def published_confusion(n=200):
+    """As :func:`confusion` for :func:`published_records`, and the convective class's largest
+    |I_u(90 m) / Panofsky - 1| without and with the measured I_u."""
+    truth, hub, speeds, directions, lengths, u_star = published_records(n)
+    conv = truth == "convective"
+    panofsky = u_star[conv] * (12.0 - 0.5 * 1000.0 / lengths[conv]) ** (1 / 3) / hub[conv]
+    measured = np.full(truth.size, np.nan)
+    measured[conv] = panofsky
+    out = []
+    for given in (None, (90.0, measured)):
+        abl = EkmanABL.fit_profile(HEIGHTS, speeds, directions, on_misfit="flag",
+                                   stability="either", speed_noise=0.1, direction_noise=0.5,
+                                   mixed_layer_height=1000.0, turbulence_intensity=given, **SITE)
+        fit = abl.profile_fit
+        error = np.abs(fit.speed(np.array([90.0]))[:, 0] / hub - 1.0)
+        intensity = np.reshape(abl.turbulence_intensity(90.0), -1)[conv]
+        out.append(({
+            c: ({k: int(np.sum(fit.stability_class[truth == c] == k)) for k in CLASSES},
+                int(np.sum(~fit.fits[truth == c])), float(np.max(error[truth == c])))
+            for c in CLASSES[:2]
+        }, np.abs(intensity / panofsky - 1.0)))
+    return out
+
+
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 200
     print(f"{n} records per class; fitted class counts, refused, max hub speed error")
     for true, (counts, refused, error) in confusion(n).items():
         print(f"  {true:10s} " + "  ".join(f"{k} {v:3d}" for k, v in counts.items())
               + f"  refused {refused}  max error {100 * error:.2f} %")
+    for title, (table, intensity) in zip(("published forms", "published forms, I_u(90 m) given"),
+                                         published_confusion(n)):
+        print(f"{title}: convective class |I_u(90 m)/Panofsky - 1| <= 20 % in "
+              f"{int(np.sum(intensity <= 0.2))} of {intensity.size}, largest "
+              f"{100 * np.max(intensity):.1f} %")
+        for true, (counts, refused, error) in table.items():
+            print(f"  {true:10s} " + "  ".join(f"{k} {v:3d}" for k, v in counts.items())
+                  + f"  refused {refused}  max error {100 * error:.2f} %")

@@ -5,17 +5,18 @@ Run it from anywhere (after ``pip install .``, or from a checkout):
     python examples/site_fit.py [--output DIR] [--with-gch]
 
 1. Reads ``inputs/site/synthetic_mast.csv``: 24 hourly records of speed and direction at 30, 50,
-   ..., 150 m. The records are SYNTHETIC: profiles of the package's own EkmanABL with 0.1 m/s and
-   0.5 deg of noise (made by ``inputs/site/generate_synthetic_mast.py``, true inputs in its
+   ..., 150 m: a stable night, a near-neutral morning and evening, a convective afternoon. The
+   records are SYNTHETIC: profiles of the package's own EkmanABL with 0.1 m/s and 0.5 deg of noise (made by ``inputs/site/generate_synthetic_mast.py``, true inputs in its
    ``true_*`` columns), standing in for a mast or a lidar.
 2. Fits every record (``floris_ekman_veer.fit_site``: ``EkmanABL.fit_profile`` in one call) at a
-   site at 52 N with z0 = 0.05 m, and prints the fitted Obukhov length, hub wind and misfit
-   against the true inputs.
+   site at 52 N with z0 = 0.05 m, L of either sign (``stability="either"``), and prints the
+   fitted Obukhov length, stability class, hub wind and misfit against the true inputs.
 3. Runs a row of three NREL 5 MW turbines at 7 D along 270 deg (the turbines, solver and wake
    models of ``inputs/farm_sbl6.yaml``) on the 24 records, each with its fitted atmosphere (one FLORIS
    TimeSeries run), and gives the annual energy of that climate with and without wake steering
    (``floris_ekman_veer.annual_energy``: FLORIS's YawOptimizationSR per record); with
-   ``--with-gch`` also for FLORIS's GCH on the same inflow.
+   ``--with-gch`` also for FLORIS's GCH on the same inflow; the year and its parts by fitted
+   stability class (convective, neutral, stable: ``ProfileFit.stability_class``).
 4. Writes the figure of measured vs fitted profiles and the FLORIS input with the per-record
    atmosphere block (PNG and YAML to DIR, default ./output).
 
@@ -63,12 +64,14 @@ def run_example(reduced: bool = False, models=("ekman_veer",)) -> dict:
     if reduced:
         records = records.iloc[[3, 12, 21, 23]].reset_index(drop=True)
     start = time.perf_counter()
-    site = fit_site(records, HUB_HEIGHT, stability_input="obukhov_length", **NOISE, **SITE)
+    site = fit_site(records, HUB_HEIGHT, stability_input="obukhov_length", stability="either",
+                    **NOISE, **SITE)
     fit_seconds = time.perf_counter() - start
     fit = site.profile_fit
     table = pd.DataFrame({
         "time": site.labels,
         "L_fit_m": fit.obukhov_length, "L_true_m": records["true_obukhov_length"],
+        "class": fit.stability_class,
         "hub_speed_fit": site.wind_speeds, "hub_speed_true": records["true_hub_speed"],
         "hub_direction_fit": site.wind_directions,
         "hub_direction_true": records["true_hub_direction"],
@@ -86,7 +89,24 @@ def run_example(reduced: bool = False, models=("ekman_veer",)) -> dict:
         warnings.simplefilter("ignore")
         energy = site.annual_energy(fmodel, YawOptimizationSR, models=models,
                                     progress=False, **YAW)
-    return dict(site=site, table=table, energy=energy, fmodel=fmodel, fit_seconds=fit_seconds)
+    return dict(site=site, table=table, energy=energy, fmodel=fmodel, fit_seconds=fit_seconds,
+                by_class=energy_by_class(energy.table, table))
+
+
+def energy_by_class(energy, table) -> pd.DataFrame:
+    """The annual energy per model and fitted stability class (convective, neutral, stable):
+    the records' own classes of ``annual_energy`` (one per record, named by its time) summed
+    over the records of each class, and the steering gain of that part of the year."""
+    per_record = energy[energy["stability"] != "all"]
+    classes = dict(zip(table["time"].astype(str), table["class"]))
+    grouped = per_record.assign(fitted_class=per_record["stability"].astype(str).map(classes))
+    summed = grouped.groupby(["model", "fitted_class"], sort=False)[
+        ["aep_baseline_gwh", "aep_steered_gwh"]].sum()
+    summed["hours"] = grouped.groupby(["model", "fitted_class"], sort=False).size() * 365
+    summed["gain_percent"] = 100.0 * (summed["aep_steered_gwh"] / summed["aep_baseline_gwh"] - 1.0)
+    order = {"convective": 0, "neutral": 1, "stable": 2}
+    return summed.reset_index().sort_values(
+        ["model", "fitted_class"], key=lambda c: c.map(order) if c.name == "fitted_class" else c)
 
 
 def plot_profiles(site, output: Path) -> Path:
@@ -155,6 +175,8 @@ def main(argv=None) -> None:
     print("\nannual energy of the 24-record climate, 3 x NREL 5 MW at 7 D:")
     print(year[year["stability"] == "all"][["model", "aep_baseline_gwh", "aep_steered_gwh",
                                              "gain_percent"]].round(4).to_string(index=False))
+    print("\nthe same by fitted stability class (hours a year: 365 per record of the class):")
+    print(result["by_class"].round(4).to_string(index=False))
     print(f"\nwrote {plot_profiles(result['site'], args.output)}")
     print(f"wrote {write_input(result['site'], args.output)}")
     print(f"total {time.perf_counter() - start:.1f} s")

@@ -352,11 +352,11 @@ SCRIPT_NUMBERS = [
      ("examples/paper_power.py",),
      r"beta = \+0 deg.*?CNBL\s+M-1(?:\s+\S+ \(\S+\)){3}\s+([\d.]+) "),
     ("docs/measurements.md", r"\| zero reading \| (\d+) \| \| calm \| (\d+) \| \| convective \| "
-                             r"(\d+) \| \| backing \| (\d+) \| \| misfit \| (\d+) \| \| fitted \| "
-                             r"(\d+) \|",
+                             r"(\d+) \| \| backing \| (\d+) \| \| no top \| (\d+) \| \| misfit \| "
+                             r"(\d+) \| \| fitted \| (\d+) \|",
      ("examples/site_year.py",),
      r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?convective\s+(\d+) .*?backing\s+(\d+) .*?"
-     r"misfit\s+(\d+) .*?fitted\s+(\d+) "),
+     r"no top\s+(\d+) .*?misfit\s+(\d+) .*?fitted\s+(\d+) "),
     ("docs/measurements.md", r"\| ekman_veer \| ([\d.]+) \| ([\d.]+) \| ([+\-][\d.]+) % \|",
      ("examples/site_fit.py",),
      r"ekman_veer\s+([\d.]+)\s+([\d.]+)\s+([+\-]?[\d.]+)"),

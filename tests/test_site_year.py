@@ -20,10 +20,13 @@ from tests.data.generate_mast_year import HEIGHTS, main as generate
 YEAR = Path(__file__).resolve().parent / "data" / "mast_year.csv.gz"
 SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5)
 #: What each true kind of record becomes: the fit's kinds it may be given (a convective hour
-#: with little shear deficit is a neutral fit, a front's slight backing may read as a misfit).
+#: with little shear deficit is a neutral fit, a front's slight backing may read as a misfit; a
+#: convective hour whose stable fit is a layer below the heights that its data do not show, and
+#: one neutral hour with two heights left whose exact stable fit is such a layer, are "no top").
 EXPECTED = {
-    "neutral": {"fitted", "misfit"}, "stable": {"fitted"}, "calm": {"calm"}, "zero": {"zero reading"},
-    "backing": {"backing", "misfit"}, "convective": {"convective", "fitted", "backing", "misfit"},
+    "neutral": {"fitted", "misfit", "no top"}, "stable": {"fitted"}, "calm": {"calm"},
+    "zero": {"zero reading"}, "backing": {"backing", "misfit"},
+    "convective": {"convective", "fitted", "backing", "misfit", "no top"},
 }
 
 

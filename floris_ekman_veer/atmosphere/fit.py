@@ -25,6 +25,13 @@ stacked array; 1/L kept >= 0 by an active bound), from the best of a few startin
 (L = inf, 400, 200, 100, 50, 25 m); records that have converged are frozen. No Python loop runs
 over records.
 
+Optionally a measured turbulence intensity per record (``turbulence_intensity=(height, value)``)
+adds one residual, the model's I_u there against it (docs/measurements.md#measured-turbulence).
+
+A stable fit whose ABL top lies below the highest measurement is kept only where the data show
+that top (a speed maximum, or the shear or the veer stopping at it); otherwise it is refused as
+"no top" (docs/measurements.md#a-top-the-data-show).
+
 Refusal: a record whose best fit misses the data by more than the model plus the stated noise
 would with probability ``refusal_probability`` (1e-6; a chi-square test) fits no atmosphere of
 the model (directions backing with height in the northern
@@ -49,7 +56,11 @@ from floris_ekman_veer._validation import real_array, require_at
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
-               "on_misfit", "labels", "max_iterations", "stability", "chunk_size")
+               "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
+               "turbulence_intensity", "turbulence_noise")
+#: Default noise of a measured turbulence intensity, relative to its value: the order of the
+#: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
+DEFAULT_TURBULENCE_NOISE = 0.1
 #: Records iterated together by default: the work arrays stay below about 100 MB.
 DEFAULT_CHUNK_SIZE = 4096
 #: Stability inputs the fit determines (refused as fixed inputs).
@@ -252,6 +263,14 @@ class ProfileFit:
         for a record that fits, its kind is whatever its data look like)."""
         hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
                                                         np.shape(self.misfit)), -1)[i])
+        depth = np.reshape(self.boundary_layer_height, -1)[i : i + 1]
+        directions = None if self.directions is None else self.directions[i : i + 1]
+        if (np.reshape(self.obukhov_length, -1)[i] > 0
+                and np.reshape(self.misfit, -1)[i] <= np.reshape(self.misfit_tolerance, -1)[i]
+                and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
+                                depth, self.speed_noise, self.direction_noise)[0]):
+            return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
+                                                depth[0], self.speed_noise, self.direction_noise)
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
                              self.speed_noise, self.direction_noise, hemisphere,
@@ -321,8 +340,11 @@ class _ProfileModel:
     x = (ln u*, lam = 100 m/L, [ln z0]) per record, and the normalised residuals."""
 
     def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
-                 speed_noise, direction_noise, sign=1.0):
+                 speed_noise, direction_noise, sign=1.0, turbulence=None):
         self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        # A measured turbulence intensity per record: (heights (n,), values (n,) NaN missing,
+        # relative noise), or None (docs/measurements.md#measured-turbulence).
+        self.turbulence = turbulence
         # The sign of 1/L: the unknown lam >= 0 is 100 m/|L| (convective fits: sign -1).
         self.sign = float(sign)
         self.z, self.s, self.d = heights, speeds, directions
@@ -406,7 +428,20 @@ class _ProfileModel:
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
             self.sigma_s, self.sigma_d, offset=True)
+        if self.turbulence is not None:
+            r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
+
+
+def _turbulence_residual(abl, turbulence, index):
+    """(k, 1): the model's I_u = sigma_u/U at the measured height (Eq. Iu_model, with the
+    convective variance of docs/atmosphere.md#convective-turbulence) minus the measured one,
+    divided by its noise; 0 where none is measured."""
+    heights, values, noise = (np.asarray(a)[index] for a in turbulence)
+    measured = np.isfinite(values)
+    model = np.asarray(abl.turbulence_intensity(heights), float).reshape(-1)
+    return np.where(measured, (model - np.where(measured, values, 0.0))
+                    / (noise * np.where(measured, values, 1.0)), 0.0)[:, None]
 
 
 def _normalised_residuals(speed, angle, speeds, directions, sigma_s, sigma_d, offset=False):
@@ -526,6 +561,35 @@ def _check_degrees(directions):
             "be given as 360 + direction")
 
 
+def _checked_turbulence(turbulence_intensity, noise, n, z0, fit_roughness):
+    """(heights (n,), values (n,), relative noise (n,)) of ``turbulence_intensity=(height,
+    value)``, or None; ValueError naming what is wrong."""
+    if turbulence_intensity is None:
+        return None
+    if isinstance(noise, bool) or not np.isscalar(noise) or not np.isfinite(noise) or noise <= 0:
+        raise ValueError(f"fit_profile: turbulence_noise must be a number > 0 (relative to the "
+                         f"measured value); got {noise!r}")
+    try:
+        height, value = turbulence_intensity
+    except (TypeError, ValueError):
+        raise ValueError("fit_profile: turbulence_intensity must be (height [m], value), each a "
+                         f"number or one per record ({n}); got {turbulence_intensity!r}") from None
+    arrays = []
+    for name, v in (("turbulence_intensity height", height), ("turbulence_intensity value", value)):
+        array = real_array(name, v)
+        if array.ndim > 1 or (array.ndim == 1 and array.size != n):
+            raise ValueError(f"fit_profile: {name} must be a number or one per record ({n}); got "
+                             f"shape {array.shape}")
+        arrays.append(np.broadcast_to(array, (n,)).astype(float))
+    height, value = arrays
+    lowest = 0.0 if fit_roughness else np.broadcast_to(z0, (n,))
+    require_at(np.isfinite(height) & (height > lowest), "turbulence_intensity height",
+               "finite and > roughness_length z0", height)
+    require_at(np.isnan(value) | ((value > 0) & (value < 1)), "turbulence_intensity value",
+               "in (0, 1) (sigma_u/U; NaN: none for that record)", value)
+    return height, value, np.full(n, float(noise))
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -539,8 +603,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
                 on_misfit="raise", labels=None, max_iterations=100, stability="stable",
-                chunk_size=DEFAULT_CHUNK_SIZE,
-                **fixed_inputs):
+                chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
+                turbulence_noise=DEFAULT_TURBULENCE_NOISE, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -562,6 +626,12 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
             both, each record taking the sign whose fit misses its data less
             (``ProfileFit.stability_class`` says which).
+        turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
+            sigma_u divided by the measured speed at its height): ``(height, value)``, each a
+            number or one per record (NaN: none for that record); an extra residual, the
+            model's I_u at that height (Eq. Iu_model) against it, which constrains u* and the
+            stability (docs/measurements.md#measured-turbulence).
+        turbulence_noise: its noise relative to its value (default 0.1).
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
             it: each record's iteration is its own).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
@@ -582,7 +652,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             abl_class, heights, speeds, directions, speed_noise=speed_noise,
             direction_noise=direction_noise, fit_roughness=fit_roughness,
             refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
-            max_iterations=max_iterations, chunk_size=chunk_size, **fixed_inputs)
+            max_iterations=max_iterations, chunk_size=chunk_size,
+            turbulence_intensity=turbulence_intensity, turbulence_noise=turbulence_noise,
+            **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -665,10 +737,14 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         low = heights <= np.reshape(z0_array, (-1, 1))
         require_at(~low, "heights", "> roughness_length z0", heights)
 
+    turbulence = _checked_turbulence(turbulence_intensity, turbulence_noise, n, z0_array,
+                                     fit_roughness)
     valid_speeds = np.sum(np.isfinite(speeds), axis=1)
     n_unknowns = 3 if fit_roughness else 2
     observations = valid_speeds + (0 if directions is None
                                    else np.maximum(np.sum(np.isfinite(directions), axis=1) - 1, 0))
+    if turbulence is not None:
+        observations = observations + np.isfinite(turbulence[1])
     short = (valid_speeds < 1) | (observations < n_unknowns)
     if np.any(short):
         i = int(np.argmax(short))
@@ -680,7 +756,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
 
     sign = -1.0 if stability == "convective" else 1.0
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise), sign)
+                          float(speed_noise), float(direction_noise), sign, turbulence)
     from scipy.stats import chi2
 
     dof = np.maximum(observations - n_unknowns, 1)
@@ -694,7 +770,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             None if directions is None else directions[chunk],
             {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
             z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
-            float(speed_noise), float(direction_noise), sign)
+            float(speed_noise), float(direction_noise), sign,
+            None if turbulence is None else tuple(a[chunk] for a in turbulence))
         result = _multistart(part, chunk.size, max_iterations)
         _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
         parts.append(result)
@@ -708,12 +785,18 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         direction_rms = np.full(n, np.nan)
     else:
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
-        direction_rms = np.sqrt(np.sum(r[:, m:] ** 2, axis=1) / count) * direction_noise
+        direction_rms = np.sqrt(np.sum(r[:, m:2 * m] ** 2, axis=1) / count) * direction_noise
     fits = misfit <= misfit_tolerance
+    if sign > 0:
+        # A stable layer shallower than the highest measurement only where the data show its
+        # top (docs/measurements.md#a-top-the-data-show).
+        _, _, _, _, depth = model.state(x, index)
+        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
+                                      float(direction_noise)))
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, misfit, model, misfit_tolerance,
-                            float(refusal_probability))
+                            float(refusal_probability), depth if sign > 0 else None)
 
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
@@ -768,7 +851,9 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         for sign in ("stable", "convective")
     ]
     stable, convective = fits
-    take = np.asarray(convective.misfit) < np.asarray(stable.misfit)
+    passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
+    take = np.where(passes_s == passes_c, np.asarray(convective.misfit) < np.asarray(stable.misfit),
+                    passes_c)
     chosen = {}
     for field in attrs.fields(ProfileFit):
         a, b = getattr(stable, field.name), getattr(convective, field.name)
@@ -968,17 +1053,100 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                     f"{'veers' if north else 'backs'}: the direction turns "
                     f"{'clockwise' if north else 'anticlockwise'} with height)"
                 )
+    looks = ""
+    if zs.size >= 2 and ss[0] > 0:
+        looks = (f": the speed grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to "
+                 f"{zs[-1]:.4g} m (the neutral log law {log_law:.3g} times)")
+        if directions is not None and zd.size >= 2:
+            looks += (f" and the direction turns {_wrap(dd[-1] - dd[0]):+.3g} deg from "
+                      f"{zd[0]:.4g} m to {zd[-1]:.4g} m")
     return "misfit", ("the shape of its profile is outside the model's (speed and direction "
                       "change together set u*, L and z0; a profile kinked beyond the model's, "
-                      "or directions turning more than its stability allows with that shear)")
+                      "or directions turning more than its stability allows with that shear)"
+                      + looks)
+
+
+def _top_changes(heights, speeds, directions, depth):
+    """Per record: the speed and direction changes from the lowest height to the lowest one at
+    or above ``depth`` (across the layer) and from there to the highest (above it), the largest
+    speed minus the highest one's, and whether a measurement lies below ``depth``."""
+    z = np.where(np.isfinite(speeds), heights, np.nan)
+    rows = np.arange(len(z))
+    low = np.nanargmin(z, axis=1)
+    high = np.nanargmax(z, axis=1)
+    above = np.where(z >= depth[:, None], z, np.inf)
+    cross = np.where(np.isfinite(np.min(above, axis=1)), np.argmin(above, axis=1), high)
+    s = np.where(np.isfinite(speeds), speeds, np.nan)
+    changes = {
+        "speed_below": s[rows, cross] - s[rows, low],
+        "speed_above": s[rows, high] - s[rows, cross],
+        "peak": np.nanmax(s, axis=1) - s[rows, high],
+        "below": z[rows, low] < depth,
+    }
+    if directions is not None:
+        d = np.where(np.isfinite(directions), directions, np.nan)
+        changes["turn_below"] = _wrap(d[rows, cross] - d[rows, low])
+        changes["turn_above"] = _wrap(d[rows, high] - d[rows, cross])
+    return changes
+
+
+def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
+    """Records whose boundary layer top ``depth`` lies below their highest measurement although
+    their data show no top there: none of a speed maximum below the highest height (by more
+    than two noise standard deviations), the shear stopping at the top (the speed grows from the
+    lowest height to the first one at or above the top by more than three standard deviations of
+    a difference more than it changes from there to the highest) or the veer stopping (the same
+    for the direction's turning)."""
+    top = np.nanmax(np.where(np.isfinite(speeds), heights, np.nan), axis=1)
+    shallow = np.isfinite(depth) & (depth < top)
+    if not np.any(shallow):
+        return shallow
+    c = _top_changes(heights, speeds, directions, np.where(shallow, depth, np.inf))
+    step_s, step_d = 3.0 * np.sqrt(2.0) * sigma_s, 3.0 * np.sqrt(2.0) * sigma_d
+    shown = c["peak"] > 2.0 * sigma_s
+    shown |= c["below"] & (c["speed_below"] - np.abs(c["speed_above"]) > step_s)
+    if directions is not None:
+        shown |= c["below"] & (np.abs(c["turn_below"]) - np.abs(c["turn_above"]) > step_d)
+    return shallow & ~shown
+
+
+def _hidden_top_reason(heights, speeds, directions, depth, sigma_s, sigma_d):
+    """What the data of a record refused by `_hidden_top` look like, as a sentence."""
+    z = heights[np.isfinite(speeds)]
+    s = speeds[np.isfinite(speeds)]
+    order = np.argsort(z)
+    z, s = z[order], s[order]
+    turn = ""
+    if directions is not None:
+        okd = np.isfinite(directions[0])
+        zd, dd = heights[okd], directions[0][okd]
+        o = np.argsort(zd)
+        if zd.size >= 2:
+            turn = (f" and the direction turns {_wrap(dd[o][-1] - dd[o][0]):+.3g} deg from "
+                    f"{zd[o][0]:.4g} to {zd[o][-1]:.4g} m")
+    return (f"its best fit is a stable layer only {float(depth):.3g} m deep, below the highest "
+            f"measurement ({z[-1]:.4g} m), but the data show no top there (no speed maximum, "
+            f"and neither the shear nor the veer stops at it): the speed grows from "
+            f"{s[0]:.3g} m/s at {z[0]:.4g} m to {s[-1]:.3g} m/s at {z[-1]:.4g} m{turn}. A layer "
+            "mixed above its surface layer (a convective afternoon) looks like this: "
+            "stability=\"either\" fits convective layers too "
+            "(docs/measurements.md#a-top-the-data-show)")
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability):
+                  model, tolerance, probability, depth=None):
     i = int(failing[0])
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
     _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
                               model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
+    if depth is not None and misfit[i] <= tolerance[i]:
+        d = None if directions is None else directions[i:i + 1]
+        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], model.sigma_s,
+                                    model.sigma_d)
+        return ValueError(
+            f"fit_profile: record {labels[i]} fits no atmosphere of the model: {reason}"
+            + (f"; {failing.size - 1} more record(s) fail" if failing.size > 1 else "")
+            + ". Give on_misfit='flag' to keep the fits and read profile_fit.fits")
     more = ""
     if failing.size > 1:
         shown = ", ".join(str(labels[k]) for k in failing[1:6])

@@ -212,12 +212,17 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         raise ValueError(f"fit_site: record {labels[row]} cannot be fitted: {text}"
                          + _more(excluded, labels, row) + ". Give on_misfit='drop' to leave out "
                          "such records (SiteAtmosphere.summary() tells what was left out and why)")
-    per_record = {k: v for k, v in fit_options_and_inputs.items() if np.ndim(v) == 1}
     fit_inputs = dict(fit_options_and_inputs)
+    # (a measured turbulence intensity is a pair (height, value), each one number or a column)
+    turbulence = fit_inputs.pop("turbulence_intensity", None)
+    per_record = {k: v for k, v in fit_inputs.items() if np.ndim(v) == 1}
     candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
     if candidates.size == 0:
         raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
     inputs = {**fit_inputs, **{k: np.asarray(v)[candidates] for k, v in per_record.items()}}
+    if turbulence is not None:
+        inputs["turbulence_intensity"] = tuple(
+            np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
     abl = EkmanABL.fit_profile(
         heights, speeds[candidates], None if directions is None else directions[candidates],
         on_misfit="raise" if on_misfit == "raise" else "flag",
@@ -266,7 +271,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
 
 #: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
 EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "missing data",
-                   "calm", "falling speeds", "convective", "backing", "misfit", "two states")
+                   "calm", "falling speeds", "convective", "backing", "no top", "misfit",
+                   "two states")
 
 
 def _screen(records, labels, heights, speeds, directions, unknowns):

@@ -1,8 +1,11 @@
 """Generate inputs/site/synthetic_mast.csv: SYNTHETIC met-mast records, made by the model itself.
 
 One day of hourly records (24) of a 150 m mast at 52 N over grass (z0 = 0.05 m): a stable night
-(Obukhov length 133 to 400 m), a near-neutral day (L = inf and 2,000 m), the hub-height (90 m) wind
-5 to 11 m/s from 255 to 290 degrees. Each record's profile is the EkmanABL of those inputs
+(Obukhov length 133 to 400 m), a near-neutral morning and evening (L = inf and 2,000 m) and a
+convective afternoon, 10:00 to 16:00 (L = -40 m at 13:00 and -40 m / sin(pi (hour - 9) / 8) on
+either side, -105 m at 10:00 and 16:00: surface heating, the model's convective layer of
+docs/atmosphere.md#convective-boundary-layer with its default mixed-layer depth), the hub-height
+(90 m) wind 5 to 11 m/s from 255 to 290 degrees. Each record's profile is the EkmanABL of those inputs
 (``EkmanABL.from_reference_wind``), sampled at 30, 50, ..., 150 m, plus Gaussian measurement noise
 of 0.1 m/s and 0.5 deg (seeded). The true inputs are kept in the columns ``true_*`` so that the
 fit can be checked against them; they are not measurements.
@@ -37,6 +40,8 @@ def true_records() -> pd.DataFrame:
     depth = np.clip(np.cos((hours - 4) / 24 * 2 * np.pi), 0.0, 1.0)
     obukhov = np.where(night, 400.0 / (1.0 + 2.0 * depth), np.inf)
     obukhov[(hours == 8) | (hours == 17)] = 2000.0
+    afternoon = (hours >= 10) & (hours <= 16)
+    obukhov[afternoon] = -40.0 / np.sin(np.pi * (hours[afternoon] - 9) / 8.0)
     hub_speed = 8.0 + 3.0 * np.sin((hours - 10) / 24 * 2 * np.pi)
     hub_direction = 272.0 + 15.0 * np.sin((hours - 2) / 24 * 2 * np.pi)
     time = pd.date_range("2026-06-01 00:00", periods=24, freq="h")
@@ -62,7 +67,8 @@ def main() -> None:
     with open(OUTPUT, "w") as file:
         file.write(
             "# SYNTHETIC met-mast records, not measurements: profiles of the floris-ekman-veer\n"
-            "# EkmanABL model (latitude 52, z0 0.05 m) plus noise of 0.1 m/s and 0.5 deg, made by\n"
+            "# EkmanABL model (latitude 52, z0 0.05 m; stable night, convective afternoon) plus\n"
+            "# noise of 0.1 m/s and 0.5 deg, made by\n"
             "# inputs/site/generate_synthetic_mast.py; true_* columns are the model inputs.\n"
         )
         table.to_csv(file, index=False)

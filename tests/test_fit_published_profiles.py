@@ -1,0 +1,200 @@
+"""fit_profile(stability="either") on convective profiles written here from their published
+formulas, independent of the package (docs/measurements.md#convective-records), and the measured
+turbulence intensity option (docs/measurements.md#measured-turbulence).
+
+Surface layer: Monin-Obukhov similarity with the Businger-Dyer phi_m = (1 - 16 z/L)^(-1/4)
+(Dyer 1974) integrated by Paulson (1970): U = (u*/kappa) [ln(z/z0) - psi_m(z/L) + psi_m(z0/L)],
+psi_m(zeta) = 2 ln((1+x)/2) + ln((1+x^2)/2) - 2 atan(x) + pi/2, x = (1 - 16 zeta)^(1/4); no turning
+of the wind in it. Convective turbulence: Panofsky et al. (1977), sigma_u/u* = (12 - 0.5 z_i/L)^(1/3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from floris_ekman_veer import EkmanABL
+
+KAPPA = 0.4
+Z0 = 0.1
+U_STAR = 0.4
+MIXED_LAYER = 1000.0  # z_i [m] of the Panofsky scaling, a fixed site input of the fit
+Z = np.arange(30.0, 151.0, 20.0)
+SITE = dict(coriolis_parameter=1e-4, brunt_vaisala_frequency=6.1e-3,
+            reference_potential_temperature=265.0, roughness_length=Z0,
+            mixed_layer_height=MIXED_LAYER)
+
+
+def paulson_psi_m(z, obukhov_length):
+    x = (1.0 - 16.0 * z / obukhov_length) ** 0.25
+    return (2.0 * np.log((1.0 + x) / 2.0) + np.log((1.0 + x * x) / 2.0) - 2.0 * np.arctan(x)
+            + np.pi / 2.0)
+
+
+def businger_dyer_speed(z, obukhov_length):
+    z, length = np.asarray(z, float), np.asarray(obukhov_length, float)
+    return U_STAR / KAPPA * (np.log(z / Z0) - paulson_psi_m(z, length)
+                             + paulson_psi_m(Z0, length))
+
+
+def panofsky_intensity(height, obukhov_length):
+    """sigma_u / U(height) with sigma_u/u* = (12 - 0.5 z_i/L)^(1/3)."""
+    sigma_u = U_STAR * (12.0 - 0.5 * MIXED_LAYER / np.asarray(obukhov_length, float)) ** (1 / 3)
+    return sigma_u / businger_dyer_speed(height, obukhov_length)
+
+
+LENGTHS = -np.geomspace(1000.0, 20.0, 12)
+
+
+def _check_convective(fit, abl, lengths, hub, intensity_tolerance=0.2):
+    cls = np.atleast_1d(fit.stability_class)
+    fitted = np.atleast_1d(fit.obukhov_length)
+    # convective, or neutral only where |L| > 500 m (the documented class rule)
+    assert np.all((cls == "convective") | ((cls == "neutral") & (np.abs(fitted) > 500.0)))
+    assert np.all(np.atleast_1d(fit.fits))
+    speed = fit.speed(np.array([90.0]))[:, 0]
+    np.testing.assert_array_less(np.abs(speed / hub - 1.0), 0.02)
+    intensity = np.reshape(abl.turbulence_intensity(90.0), -1)
+    np.testing.assert_array_less(np.abs(intensity / panofsky_intensity(90.0, lengths) - 1.0),
+                                 intensity_tolerance)
+
+
+def test_businger_dyer_surface_layers_are_fitted_as_convective():
+    """Twelve unstable surface layers (L = -1000 ... -20 m, u* = 0.4 m/s, z0 = 0.1 m), speeds
+    and a constant direction at 30-150 m, the fit's default noise: convective (or neutral for
+    |L| > 500 m), hub-speed error <= 2 %, I_u(90 m) within 20 % of Panofsky's scaling."""
+    speeds = businger_dyer_speed(Z[None, :], LENGTHS[:, None])
+    directions = np.full(speeds.shape, 250.0)
+    abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
+    _check_convective(abl.profile_fit, abl, LENGTHS, businger_dyer_speed(90.0, LENGTHS))
+
+
+def test_businger_dyer_speeds_with_a_measured_intensity():
+    """Speeds alone at 30-150 m leave L of a strongly convective surface layer loose (its I_u
+    follows it); a measured sigma_u/U at 90 m pins it: I_u within 2 % of the measured value."""
+    speeds = businger_dyer_speed(Z[None, :], LENGTHS[:, None])
+    measured = panofsky_intensity(90.0, LENGTHS)
+    abl = EkmanABL.fit_profile(Z, speeds, stability="either",
+                               turbulence_intensity=(90.0, measured), **SITE)
+    _check_convective(abl.profile_fit, abl, LENGTHS, businger_dyer_speed(90.0, LENGTHS), 0.02)
+
+
+def mixed_layer_record(length=-100.0, top=100.0):
+    """A Businger-Dyer surface layer to ``top`` and a well-mixed layer above it (uniform speed
+    and direction)."""
+    return businger_dyer_speed(np.minimum(Z, top), length), np.full(Z.size, 250.0)
+
+
+def test_a_mixed_layer_is_not_a_shallow_stable_layer():
+    """The surface layer to 100 m with a well-mixed layer above (L = -100 m): the stable-only
+    fit's best state is a stable layer shallower than the lowest measurement (L = 3.3 m, h =
+    26 m), which the data do not show (no speed maximum, no veer): refused, saying what the data
+    look like; stability="either" fits it as convective, with the boundary layer at z_i,
+    within 2 % at the hub."""
+    speeds, directions = mixed_layer_record()
+    stable = EkmanABL.fit_profile(Z, speeds, directions, on_misfit="flag", **SITE)
+    assert stable.boundary_layer_height < Z[0] and not stable.profile_fit.fits
+    assert stable.profile_fit.obukhov_length == pytest.approx(3.26, rel=0.01)
+    kind, text = stable.profile_fit.reason(0)
+    assert kind == "no top"
+    with pytest.raises(ValueError, match=r"record 0 fits no atmosphere of the model: its best fit "
+                                         r"is a stable layer only 2\d\.?\d* m deep, below the "
+                                         r"highest measurement \(150 m\), but the data show no "
+                                         r"top there .* the speed grows from "
+                                         rf"{speeds[0]:.3g} m/s at 30 m to {speeds[-1]:.3g} m/s "
+                                         r"at 150 m and the direction turns \+0 deg"):
+        EkmanABL.fit_profile(Z, speeds, directions, **SITE)
+    abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
+    fit = abl.profile_fit
+    assert fit.stability_class == "convective" and fit.misfit < stable.profile_fit.misfit
+    assert abl.boundary_layer_height == pytest.approx(MIXED_LAYER)
+    assert abs(fit.speed([90.0])[0, 0] / businger_dyer_speed(90.0, -100.0) - 1.0) <= 0.02
+
+
+def test_a_mixed_layer_with_a_measured_intensity_has_the_convective_turbulence():
+    """The same record with its sigma_u/U at 90 m measured: I_u(90 m) within 20 % of Panofsky's
+    scaling (speeds and directions alone leave it 32 % high, L = -24 m:
+    docs/measurements.md#measured-turbulence)."""
+    speeds, directions = mixed_layer_record()
+    measured = panofsky_intensity(90.0, -100.0)
+    alone = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
+    assert alone.profile_fit.obukhov_length == pytest.approx(-24.2, rel=0.01)
+    assert float(alone.turbulence_intensity(90.0)) / measured == pytest.approx(1.32, abs=0.005)
+    abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either",
+                               turbulence_intensity=(90.0, measured), **SITE)
+    _check_convective(abl.profile_fit, abl, np.array([-100.0]),
+                      businger_dyer_speed(90.0, -100.0))
+
+
+def test_a_measured_intensity_is_recovered_exactly_and_picks_the_sign():
+    """The model's own profiles at two heights (speeds only: two data, two unknowns, a stable
+    and a convective state fit each exactly) with the model's I_u at 100 m: the true L of either
+    sign comes back to 1e-6, where without it a convective record is fitted as stable."""
+    site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    heights = np.array([40.0, 100.0])
+    lengths = np.array([-60.0, -200.0, 200.0, 80.0])
+    true = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=lengths, **site)
+    speeds = true.speed(heights[:, None]).T
+    alone = EkmanABL.fit_profile(heights, speeds, stability="either", **site).profile_fit
+    assert alone.stability_class[1] == "stable"
+    abl = EkmanABL.fit_profile(heights, speeds, stability="either",
+                               turbulence_intensity=(100.0, true.turbulence_intensity(100.0)),
+                               **site)
+    fit = abl.profile_fit
+    np.testing.assert_allclose(fit.obukhov_length, lengths, rtol=1e-6)
+    np.testing.assert_allclose(fit.friction_velocity, true.friction_velocity, rtol=1e-6)
+    assert list(fit.stability_class) == ["convective", "convective", "stable", "stable"]
+    np.testing.assert_array_less(fit.misfit, 1e-6)
+
+
+def test_turbulence_intensity_option_is_checked():
+    speeds = businger_dyer_speed(Z, -100.0)
+    with pytest.raises(ValueError, match=r"turbulence_intensity must be \(height \[m\], value\)"):
+        EkmanABL.fit_profile(Z, speeds, turbulence_intensity=0.1, **SITE)
+    with pytest.raises(ValueError, match=r"turbulence_intensity value.*in \(0, 1\)"):
+        EkmanABL.fit_profile(Z, speeds, turbulence_intensity=(90.0, 1.5), **SITE)
+    with pytest.raises(ValueError, match=r"turbulence_intensity height.*> roughness_length"):
+        EkmanABL.fit_profile(Z, speeds, turbulence_intensity=(0.05, 0.1), **SITE)
+    with pytest.raises(ValueError, match=r"turbulence_noise must be a number > 0"):
+        EkmanABL.fit_profile(Z, speeds, turbulence_intensity=(90.0, 0.1), turbulence_noise=0.0,
+                             **SITE)
+
+
+def test_fit_site_takes_a_measured_intensity_per_record():
+    """fit_site passes ``turbulence_intensity=(height, column)`` through, one value per record
+    (NaN: none): the records it has pinned to the model's own I_u, the others fitted without."""
+    import pandas as pd
+
+    from floris_ekman_veer import fit_site
+
+    site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    heights = np.array([40.0, 100.0])
+    lengths = np.array([-200.0, 200.0, -200.0])
+    true = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=lengths, **site)
+    speeds = true.speed(heights[:, None]).T
+    records = pd.DataFrame({"time": ["a", "b", "c"], "speed_40m": speeds[:, 0],
+                            "speed_100m": speeds[:, 1]})
+    measured = np.asarray(true.turbulence_intensity(100.0), float)
+    measured[2] = np.nan
+    fitted = fit_site(records, 90.0, stability="either",
+                      turbulence_intensity=(100.0, measured), **site).profile_fit
+    np.testing.assert_allclose(fitted.obukhov_length[:2], lengths[:2], rtol=1e-6)
+    assert fitted.stability_class[2] == "stable"  # speeds alone: the ambiguity of the test above
+
+
+def test_neutral_speeds_with_five_degrees_of_turning_are_refused_saying_so():
+    """The log law (u* = 0.4 m/s) with the direction turning linearly by 5 deg from 30 to 150 m:
+    the model's neutral layer at this site turns by less than 2 deg there (its surface layer
+    does not turn), so no state of either sign meets both (docs/measurements.md#convective-records);
+    the refusal says what the data look like."""
+    site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    speeds = U_STAR / KAPPA * np.log(Z / Z0)
+    directions = 250.0 + 5.0 * (Z - Z[0]) / (Z[-1] - Z[0])
+    fit = EkmanABL.fit_profile(Z, speeds, directions, stability="either", on_misfit="flag",
+                               speed_noise=0.1, direction_noise=0.5, **site).profile_fit
+    assert not fit.fits
+    kind, text = fit.reason(0)
+    log_law = np.log(150.0 / Z0) / np.log(30.0 / Z0)
+    assert kind == "misfit" and text.endswith(
+        f"the speed grows {log_law:.3g} times from 30 m to 150 m (the neutral log law "
+        f"{log_law:.3g} times) and the direction turns +5 deg from 30 m to 150 m")
