@@ -111,3 +111,27 @@ def test_the_fitted_year_runs_as_one_floris_model(site):
     abl = floris_ekman_veer.coupling.inflow.solved_atmosphere(fmodel.core.flow_field)
     np.testing.assert_allclose(np.ravel(abl.geostrophic_wind),
                                site.profile_fit.geostrophic_wind, rtol=1e-3)
+
+
+@pytest.mark.study
+def test_the_fitted_year_gives_its_annual_energy_in_one_call(site):
+    """fit_site(...).annual_energy(...) on the whole year: one call, every fitted record a
+    condition of one vectorised study, its baseline the plain per-record FLORIS run's."""
+    import warnings
+
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", floris_ekman_veer.FlorisEkmanVeerWarning)
+        energy = site.annual_energy(fmodel)
+        direct = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+        site.apply(direct)
+        direct.run()
+    for model in ("ekman_veer", "gch"):
+        conditions = energy.conditions[model]
+        assert len(conditions) == len(site.labels)
+        assert np.all(np.isfinite(conditions["farm_power_baseline"]))
+    np.testing.assert_allclose(
+        energy.conditions["ekman_veer"]["farm_power_baseline"].sort_index().to_numpy(),
+        direct.get_farm_power(), rtol=1e-12)
+    year = energy.table[energy.table["stability"] == "all"].set_index("model")
+    assert np.all(year["aep_baseline_gwh"] > 0.0)

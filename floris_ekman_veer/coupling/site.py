@@ -169,9 +169,9 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     Records a mast logs that no atmosphere of the model describes (docs/measurements.md#a-year-of-records)
     are named by their time stamp and a reason: a zero (or negative) speed reading, too few
     data, calm, a direction backing with height (a front), speeds falling with height, less
-    shear than a neutral layer (convective: the model has neutral and stable layers only), a
-    profile the model cannot follow (misfit), a repeated time stamp, or a fitted state the
-    atmosphere block cannot give back. One record never aborts the others' fits.
+    shear than a neutral layer (convective, with the default stable fit; ``stability="either"``
+    fits convective layers), a profile the model cannot follow (misfit), a repeated time
+    stamp, or a fitted state the atmosphere block cannot give back. One record never aborts the others' fits.
 
     Args:
         records: DataFrame with ``speed_<h>m``, ``direction_<h>m`` and optionally ``time``.
