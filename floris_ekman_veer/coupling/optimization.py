@@ -121,13 +121,16 @@ def optimize_yaw(
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
     run = functools.partial(_optimize_once, fmodel, progress=progress, chunk_size=chunk_size)
-    if search == "both_signs" and issubclass(optimizer_class, YawOptimizationSR):
-        return run(_both_signs_class(optimizer_class), **optimizer_kwargs)
+    # A serial refine refines its own result in all yaws together (BothSignsRefinement); other
+    # optimisers are refined by runs within a window around each result below.
+    refines_itself = search == "both_signs" and issubclass(optimizer_class, YawOptimizationSR)
+    defaults = inspect.signature(optimizer_class.__init__).parameters
+    if refines_itself:
+        optimizer_class = _both_signs_class(optimizer_class)
     first = run(optimizer_class, **optimizer_kwargs)
     if search == "single" or first["farm_power_opt"].isna().any():
         return first
 
-    defaults = inspect.signature(optimizer_class.__init__).parameters
     shape = (n_findex, n_turbines)
     lower, upper = (
         np.broadcast_to(np.asarray(optimizer_kwargs.get(name, defaults[name].default),
@@ -144,6 +147,8 @@ def optimize_yaw(
     if np.any((lower < 0.0) & (upper > 0.0)):
         for bounds in ((lower, np.minimum(upper, 0.0)), (np.maximum(lower, 0.0), upper)):
             candidates.append(run_within(*bounds))
+    if refines_itself:
+        return _best_of(candidates)
     width = REFINE_FRACTION * (upper - lower)
     refined = []
     for candidate in candidates:
@@ -206,7 +211,10 @@ class BothSignsRefinement:
         flips[np.arange(n), :, np.arange(n)] *= -1.0
         flips[n] *= -1.0
         self._keep_best(np.clip(flips, lower, upper))
-        coupled = self._coupled_pairs()
+        wakes = self._wake_pairs()
+        self._keep_best(self._steering_seeds(best, lower, upper, wakes))
+        coupled = wakes | np.swapaxes(wakes, 1, 2) | (
+            np.einsum("fik,fjk->fij", wakes.astype(float), wakes.astype(float)) > 0.0)
         hessian = None
         for k, step in enumerate(QUADRATIC_STEPS):
             best, power = self._yaw_angles_opt_subset, self._farm_power_opt_subset
@@ -217,11 +225,23 @@ class BothSignsRefinement:
             self._keep_best(np.clip(best + np.concatenate([moves, 0.5 * moves[:1]]),
                                     lower, upper))
 
-    def _coupled_pairs(self):
-        """(n_findex, n, n) turbine pairs whose yaws act on a common farm power: one in the
-        other's wake, or both waking a third, by FLORIS's conservative linear wake cone
-        (half-width D + 0.3 x, ``derive_downstream_turbines``); the quadratic model samples
-        the cross terms of these pairs only."""
+    def _steering_seeds(self, best, lower, upper, wakes):
+        """(K, n_findex, n) yaws where every turbine that wakes another takes one common yaw,
+        K values from lower to upper (the serial refine's first grid, halved in step), the
+        others keeping ``best``: the serial refine moves one turbine at a time, and where
+        steering pays only when two upstream turbines turn together (a row in a neutral day)
+        it stays at zero; the quadratic steps start from the best of these where it beats it."""
+        n_values = 2 * (int(self.Ny_passes[0]) - 1) + 1
+        fractions = np.linspace(0.0, 1.0, n_values)[:, None, None]
+        steering = wakes.any(axis=2)[None]
+        common = lower[None] + fractions * (upper - lower)[None]
+        return np.clip(np.where(steering, common, best[None]), lower, upper)
+
+    def _wake_pairs(self):
+        """(n_findex, n, n): turbine i wakes turbine j, by FLORIS's conservative linear wake cone
+        (half-width D + 0.3 x, ``derive_downstream_turbines``). The quadratic model samples the
+        cross terms of turbine pairs whose yaws act on a common farm power only: one in the
+        other's wake, or both waking a third."""
         fmodel = self.fmodel_subset
         angle = np.radians(fmodel.core.flow_field.wind_directions - 270.0)[:, None]
         x, y = fmodel.layout_x[None, :], fmodel.layout_y[None, :]
@@ -232,8 +252,7 @@ class BothSignsRefinement:
         downstream = x_rot[:, None, :] - x_rot[:, :, None]                 # [f, i, j]: x_j - x_i
         wakes = (downstream > 0.01) & (np.abs(y_rot[:, None, :] - y_rot[:, :, None])
                                        < diameter[:, :, None] + 0.3 * downstream)
-        common = np.einsum("fik,fjk->fij", wakes.astype(float), wakes.astype(float)) > 0.0
-        return wakes | np.swapaxes(wakes, 1, 2) | common
+        return wakes
 
     def _keep_best(self, points):
         """Evaluate (K, n_findex, n_turbines) yaws in one FLORIS run (FLORIS's own tiling and
