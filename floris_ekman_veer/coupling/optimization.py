@@ -77,12 +77,14 @@ def optimize_yaw(
     Veer makes the two signs of yaw differ, and FLORIS's serial-refine optimiser, moving one
     turbine at a time on grids that end 3.1 deg apart (-25..25 deg, [5, 4]), stops short of the
     optimum where turbines' yaws are coupled. The default ``search="both_signs"`` runs a serial
-    refine (``YawOptimizationSR`` or a subclass) once with the given options and refines its
-    result by sign flips and quadratic-model steps in all yaws together, batched over all
-    conditions as the serial refine batches its grids (:class:`BothSignsRefinement`): measured
-    within 0.05 % of farm power of a brute-force 1-degree search refined by Nelder-Mead on
-    held-out 3-turbine rows (tests/test_yaw_search.py), evaluating 1.8 x the conditions of the
-    serial refine's own run on a 3 x 3 farm (benchmarks/bench_yaw_search.py). Other optimisers reporting farm power
+    refine (``YawOptimizationSR`` or a subclass) with the given options over the given bounds and
+    over their negative and positive parts, each run refining its result by sign flips, steering
+    seeds and quadratic-model steps in all yaws together, batched over all conditions as the
+    serial refine batches its grids (:class:`BothSignsRefinement`), and keeps per condition the
+    best: measured within 0.05 % of farm power of a brute-force 1-degree search refined by
+    Nelder-Mead on held-out 3-turbine rows (tests/test_yaw_search.py), evaluating 5.6 x the
+    conditions of the serial refine's own run on a 3 x 3 farm (benchmarks/bench_yaw_search.py,
+    docs/yaw_steering.md#finding-the-optimum). Other optimisers reporting farm power
     (``YawOptimizationScipy``) run over the given bounds, over their negative and positive
     parts, and once more within +-:data:`REFINE_FRACTION` of each turbine's bound range around
     each result, keeping per condition the best; ``YawOptimizationGeometric`` (no farm power)
