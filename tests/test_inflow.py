@@ -566,3 +566,23 @@ def test_velocity_deficit_profiles_use_the_inflow():
     z = profiles[0].z.to_numpy()
     upstream = 8.0 * (1.0 - profiles[0].velocity_deficit.to_numpy())
     np.testing.assert_allclose(upstream, expected_profile(fmodel, z)[0, 0, 0], rtol=1e-12)
+
+
+def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
+    """The rotor cells' rows of heights for many conditions are evaluated a few heights at a time
+    (inflow._PROFILE_PIECE): elementwise in height, the pieces give the same bits, stable and
+    convective alike, below the ground included."""
+    from floris_ekman_veer import EkmanABL
+    from floris_ekman_veer.coupling import inflow
+
+    speeds = np.random.default_rng(0).uniform(3.0, 20.0, 3000).reshape(-1, 1, 1, 1)
+    z = np.concatenate([[-1.0, 0.0, 0.01], np.linspace(1.0, 400.0, 253)]).reshape(1, 1, 1, -1)
+    for stability in ({"obukhov_length": 100.0}, {"obukhov_length": -50.0}):
+        abl = EkmanABL.from_reference_wind(speeds, 90.0, latitude=52.0, roughness_length=0.1,
+                                           **stability)
+        pieces = inflow._ambient_velocity(abl, z, 90.0)
+        assert speeds.size * z.size > 2 * inflow._PROFILE_PIECE  # evaluated in pieces
+        whole = abl.hub_aligned_velocity(np.maximum(z, 0.0), 90.0)
+        for piece, one, name in zip(pieces, whole, "UV"):
+            np.testing.assert_array_equal(piece[..., 1:], one[..., 1:], err_msg=name)
+            assert np.all(piece[..., 0] == 0.0)  # below the ground
