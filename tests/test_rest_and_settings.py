@@ -36,6 +36,10 @@ def test_calm_rows_are_at_rest_with_no_boundary_layer():
     assert list(both["inside_envelope"]) == [False, False, True]
     assert list(both["wind_speed"]) == [0.0, 0.001, 10.0]
     assert not alone["at_rest"].any()
+    from floris_ekman_veer.coupling.validity import validity_summary
+
+    line = validity_summary(both)
+    assert "1 of 3 conditions inside" in line and "2 at rest" in line and "OUTSIDE" not in line
 
 
 def test_a_bad_warnings_setting_is_refused_at_import():

@@ -117,22 +117,14 @@ def wake_validated_stability(mu) -> np.ndarray:
 _CONDITION_COLUMNS = ("wind_direction", "wind_speed", "rotor_top")
 
 
-def _rest_rows_marked(report_function):
+def _mark_rest(report: pd.DataFrame, rest: np.ndarray) -> pd.DataFrame:
     """Rows of conditions at rest (calm, or below every cut-in where no ABL reaches their speed,
     docs/user_guide.md#calm-and-weak-winds) have no boundary layer: an ``at_rest`` column, NaN
     (False, for flags; "at rest", for names) in the boundary layer's columns, and never
     inside the envelope. (The solve gives them a moving condition's ABL as a stand-in.)"""
-    import functools
-
-    @functools.wraps(report_function)
-    def report_with_rest(fmodel, *args, **kwargs):
-        report = report_function(fmodel, *args, **kwargs)
-        flow_field = fmodel.core.flow_field
-        abl = solve(atmosphere_of(fmodel.core), flow_field.wind_speeds,
-                    flow_field.reference_wind_height)  # (cached: the report's own solve)
-        rest = np.asarray(getattr(abl, "at_rest", np.zeros(len(report), bool))).reshape(-1)
+    if rest.any():
         for column in report.columns:
-            if column in _CONDITION_COLUMNS or not rest.any():
+            if column in _CONDITION_COLUMNS:
                 continue
             values = report[column]
             if pd.api.types.is_bool_dtype(values):
@@ -141,13 +133,10 @@ def _rest_rows_marked(report_function):
                 report[column] = values.astype(float).where(~rest, np.nan)
             else:
                 report[column] = values.where(~rest, "at rest")
-        report.insert(2, "at_rest", rest)
-        return report
-
-    return report_with_rest
+    report.insert(2, "at_rest", rest)
+    return report
 
 
-@_rest_rows_marked
 def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     """One row per condition of ``fmodel``: the atmosphere against the paper's envelope.
 
@@ -198,7 +187,9 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     validated = wake_validated_stability(mu)
     deep = h / top >= MIN_H_OVER_ROTOR_TOP * (1 - 1e-12)
     in_range = (rossby >= low * (1 - 1e-9)) & (rossby <= high * (1 + 1e-9))
-    return pd.DataFrame({
+    rest = np.broadcast_to(np.asarray(getattr(abl, "at_rest", False), dtype=bool).reshape(-1),
+                           h.shape)
+    return _mark_rest(pd.DataFrame({
         "wind_direction": np.asarray(flow_field.wind_directions, dtype=float),
         "wind_speed": np.asarray(flow_field.wind_speeds, dtype=float),
         "boundary_layer_height": h,
@@ -216,7 +207,7 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         "deep_enough": deep,
         "rossby_in_range": in_range,
         "inside_envelope": validated & deep & in_range,
-    })
+    }), rest)
 
 
 def validity_summary(report: pd.DataFrame, label: str = "") -> str:
@@ -232,7 +223,10 @@ def validity_summary(report: pd.DataFrame, label: str = "") -> str:
         f"I_u {100 * report.turbulence_intensity.min():.1f}-"
         f"{100 * report.turbulence_intensity.max():.1f} %)"
     )
-    outside = report[~report["inside_envelope"]]
+    at_rest = report["at_rest"] if "at_rest" in report else pd.Series(False, index=report.index)
+    if at_rest.any():
+        line += f"; {int(at_rest.sum())} at rest (calm: no boundary layer)"
+    outside = report[~report["inside_envelope"] & ~at_rest]
     if len(outside):
         speeds = ", ".join(f"{s:g}" for s in sorted(set(outside.wind_speed)))
         line += f"; OUTSIDE at {speeds} m/s (results there are extrapolated, not validated"
