@@ -45,10 +45,11 @@ SCIPY_METHODS = (
 DEFAULT_CHUNK_SIZE = 256
 
 
-#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) FLORIS's serial refine over
-#: the given bounds (its first grid spans both signs) refined by sign flips and quadratic-model
-#: steps in all turbines' yaws at once (:class:`BothSignsRefinement`); ``"single"`` one run of
-#: the optimiser as given (FLORIS's own behaviour).
+#: The searches :func:`optimize_yaw` runs: ``"both_signs"`` (default) one run of FLORIS's serial
+#: refine over the given bounds, started from steering seeds of both signs and refined by
+#: quadratic-model steps in all turbines' yaws at once, its mirror beside it
+#: (:class:`BothSignsRefinement`); ``"single"`` one run of the optimiser as given (FLORIS's own
+#: behaviour).
 SEARCHES = ("both_signs", "single")
 
 #: Half-width of the refinement window around the best yaw found, as a fraction of each
@@ -57,9 +58,21 @@ SEARCHES = ("both_signs", "single")
 #: default serial-refine passes [5, 4] resolve to 0.8 deg.
 REFINE_FRACTION = 1.0 / 8.0
 
+#: Steering seeds of the both-signs search, per sign, as fractions of each turbine's reach (its
+#: largest |bound|): 9 common yaws from 5 to 25 deg for +-25 deg, each sign
+#: (docs/yaw_steering.md#how-both-signs-are-searched).
+SEED_FRACTIONS = np.linspace(0.2, 1.0, 9)
+
+#: Single-turbine moves from the best seed, as a fraction of the reach: +-6.25 deg for +-25 deg.
+SEED_MOVE_FRACTION = 0.25
+
+#: The mirror of the best yaws (all signs flipped) is refined beside them where its farm power
+#: is within this fraction of the best (0.2 %).
+MIRROR_WINDOW = 2e-3
+
 #: Finite-difference steps [deg] of the quadratic-model refinement after the serial refine: one
 #: full model (gradient and Hessian) per step, the last one re-using the previous Hessian's
-#: cross terms (docs/yaw_steering.md#finding-the-optimum).
+#: cross terms (docs/yaw_steering.md#how-both-signs-are-searched).
 QUADRATIC_STEPS = (1.0, 0.5)
 
 
@@ -75,20 +88,21 @@ def optimize_yaw(
     """Optimal yaw angles for every condition of ``fmodel`` with a FLORIS yaw optimiser.
 
     Veer makes the two signs of yaw differ, and FLORIS's serial-refine optimiser, moving one
-    turbine at a time on grids that end 3.1 deg apart (-25..25 deg, [5, 4]), stops short of the
+    turbine at a time from zero yaw on grids that end 3.1 deg apart (-25..25 deg, [5, 4]),
+    stays at zero where steering pays only when turbines turn together and stops short of the
     optimum where turbines' yaws are coupled. The default ``search="both_signs"`` runs a serial
-    refine (``YawOptimizationSR`` or a subclass) with the given options over the given bounds and
-    over their negative and positive parts, each run refining its result by sign flips, steering
-    seeds and quadratic-model steps in all yaws together, batched over all conditions as the
-    serial refine batches its grids (:class:`BothSignsRefinement`), and keeps per condition the
-    best: measured within 0.05 % of farm power of a brute-force 1-degree search refined by
-    Nelder-Mead on held-out 3-turbine rows (tests/test_yaw_search.py), evaluating 5.6 x the
-    conditions of the serial refine's own run on a 3 x 3 farm (benchmarks/bench_yaw_search.py,
-    docs/yaw_steering.md#finding-the-optimum). Other optimisers reporting farm power
-    (``YawOptimizationScipy``) run over the given bounds, over their negative and positive
-    parts, and once more within +-:data:`REFINE_FRACTION` of each turbine's bound range around
-    each result, keeping per condition the best; ``YawOptimizationGeometric`` (no farm power)
-    runs once.
+    refine (``YawOptimizationSR`` or a subclass) once, with the given options, started per
+    condition and turbine from the best steering seed of either sign, refined by quadratic-model
+    steps in all yaws together and beside them from its mirror, batched over all conditions as
+    the serial refine batches its grids (:class:`BothSignsRefinement`,
+    docs/yaw_steering.md#how-both-signs-are-searched): measured within 0.05 % of farm power of
+    a brute-force 1-degree search refined by Nelder-Mead on held-out 3-turbine rows
+    (tests/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
+    own run on a 3 x 3 farm (tests/test_yaw_search.py, benchmarks/bench_yaw_search.py). Other
+    optimisers reporting farm power (``YawOptimizationScipy``) run over the given bounds, over
+    their negative and positive parts, and once more within +-:data:`REFINE_FRACTION` of each
+    turbine's bound range around each result, keeping per condition the best;
+    ``YawOptimizationGeometric`` (no farm power) runs once.
 
     Args:
         fmodel: FlorisModel, ParFlorisModel or UncertainFlorisModel, with a scalar or a
@@ -123,14 +137,14 @@ def optimize_yaw(
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
     run = functools.partial(_optimize_once, fmodel, progress=progress, chunk_size=chunk_size)
-    # A serial refine refines its own result in all yaws together (BothSignsRefinement); other
-    # optimisers are refined by runs within a window around each result below.
+    # A serial refine searches both signs in its one run (BothSignsRefinement); other
+    # optimisers are run per sign and refined within a window around each result below.
     refines_itself = search == "both_signs" and issubclass(optimizer_class, YawOptimizationSR)
     defaults = inspect.signature(optimizer_class.__init__).parameters
     if refines_itself:
         optimizer_class = _both_signs_class(optimizer_class)
     first = run(optimizer_class, **optimizer_kwargs)
-    if search == "single" or first["farm_power_opt"].isna().any():
+    if search == "single" or refines_itself or first["farm_power_opt"].isna().any():
         return first
 
     shape = (n_findex, n_turbines)
@@ -149,8 +163,6 @@ def optimize_yaw(
     if np.any((lower < 0.0) & (upper > 0.0)):
         for bounds in ((lower, np.minimum(upper, 0.0)), (np.maximum(lower, 0.0), upper)):
             candidates.append(run_within(*bounds))
-    if refines_itself:
-        return _best_of(candidates)
     width = REFINE_FRACTION * (upper - lower)
     refined = []
     for candidate in candidates:
@@ -168,28 +180,39 @@ def _both_signs_class(optimizer_class):
 
 
 class BothSignsRefinement:
-    """Mix-in for FLORIS's serial-refine optimiser (``YawOptimizationSR`` or a subclass): its
-    search, started inside the bounds, then refined in all turbines' yaws together.
+    """Mix-in for FLORIS's serial-refine optimiser (``YawOptimizationSR`` or a subclass): one
+    run over both signs of yaw, started per condition and per turbine from the best steering
+    seed, and refined in all turbines' yaws together (docs/yaw_steering.md#how-both-signs-are-searched).
 
-    The serial refine (Fleming et al. 2022) moves one turbine at a time on grids that end
-    ``(upper - lower) / (Ny_passes[0] - 1) / prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg
-    and [5, 4]); where the best yaws of two turbines are coupled (an upstream turbine's yaw
-    steers the wake the next one steers further) it stops on the ridge between them. After its
-    passes, every condition's best yaws are refined, all conditions in one FLORIS evaluation
-    per step, as the serial refine evaluates its grids:
+    The serial refine (Fleming et al. 2022) moves one turbine at a time, with the others at
+    their best so far, on grids that end ``(upper - lower) / (Ny_passes[0] - 1) /
+    prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg and [5, 4]). Started from zero yaw it
+    misses the optimum where steering pays only when upstream turbines turn together (the
+    neutral day's row at 4 D, 8 m/s: no single turbine's move gains), and it stops on the ridge
+    between coupled yaws. Here, all conditions in one FLORIS evaluation per stage, as the
+    serial refine evaluates its grids (its ``_calc_powers_with_memory``, which skips yaws
+    already evaluated):
 
-    1. sign flips: each turbine's yaw mirrored (clipped to its bounds) one at a time, and all
-       of them together (n_turbines + 1 evaluations);
-    2. per step h of :data:`QUADRATIC_STEPS`, a quadratic model of the farm power fitted to
-       the best yaws, two points along each turbine's yaw and one along each pair (the full
-       gradient and Hessian: 1 + n(n+3)/2 evaluations; the last step keeps the cross terms of
-       the previous Hessian and samples the 2n points only), and its maximum, limited to 4 h
-       in each yaw and to the bounds, at full and half length (2 evaluations).
+    1. steering seeds (:data:`SEED_FRACTIONS` of each sign of each turbine's reach, its
+       largest |bound|): every turbine that wakes another at one common yaw, the others at the
+       start; where a seed beats the start, each of those turbines moved alone by
+       +-:data:`SEED_MOVE_FRACTION` of its reach (2 x 9 + 2 x n_steering evaluations);
+    2. the serial refine's own passes, from that start;
+    3. per step h of :data:`QUADRATIC_STEPS`, a quadratic model of the farm power around the
+       best yaws: in the first, two points along each turbine's yaw and one along each pair of
+       steering turbines one in the other's wake (gradient and Hessian); in the later ones one
+       point along each yaw (the gradient, with the first's Hessian); and the model's maximum,
+       limited to 4 h in each yaw and to the bounds, at full and half length together with
+       each yaw's own move;
+    4. the mirror of the serial refine's result (every sign flipped, clipped to the bounds),
+       refined by the same steps beside it where its power is within :data:`MIRROR_WINDOW` of
+       the best (a veered atmosphere makes the two signs differ by little where steering pays
+       on both).
 
     Every evaluation is kept only where it beats the best so far, so the result is never below
-    the serial refine's. Bounds that exclude zero yaw start the search at the allowed yaw
-    closest to the baseline (FLORIS's own run would return the out-of-bounds baseline when no
-    grid point beats it).
+    the start. Bounds that exclude zero yaw start the search at the allowed yaw closest to the
+    baseline (FLORIS's own run would return the out-of-bounds baseline when no grid point beats
+    it).
     """
 
     def __init__(self, fmodel, *args, **kwargs):
@@ -200,50 +223,73 @@ class BothSignsRefinement:
             self._yaw_angles_opt_subset = start
             self._farm_power_opt_subset = self._calculate_farm_power(start)
 
+    def optimize(self, print_progress=True):
+        self.print_progress = print_progress  # read by _calc_powers_with_memory
+        self._wakes = self._wake_pairs()
+        self._seed_start()
+        return super().optimize(print_progress=print_progress)
+
     def _finalize(self, *args, **kwargs):
         if not args and not kwargs:
-            self._refine_both_signs()
+            self._refine_with_mirror()
         return super()._finalize(*args, **kwargs)
 
-    def _refine_both_signs(self):
+    def _seed_start(self):
+        """Stage 1: the best steering seed of either sign, then single-turbine moves from it."""
         lower, upper = self._minimum_yaw_angle_subset, self._maximum_yaw_angle_subset
-        best = self._yaw_angles_opt_subset
-        n = best.shape[1]
-        flips = np.repeat(best[None], n + 1, axis=0)
-        flips[np.arange(n), :, np.arange(n)] *= -1.0
-        flips[n] *= -1.0
-        self._keep_best(np.clip(flips, lower, upper))
-        wakes = self._wake_pairs()
-        self._keep_best(self._steering_seeds(best, lower, upper, wakes))
-        coupled = wakes | np.swapaxes(wakes, 1, 2) | (
-            np.einsum("fik,fjk->fij", wakes.astype(float), wakes.astype(float)) > 0.0)
+        start = self._yaw_angles_opt_subset.copy()
+        reach = np.maximum(np.abs(lower), np.abs(upper))
+        steering = self._wakes.any(axis=2)[None]
+        common = np.concatenate([SEED_FRACTIONS, -SEED_FRACTIONS])[:, None, None] * reach[None]
+        self._evaluate(np.clip(np.where(steering, common, start[None]), lower, upper)[:, None])
+        won = np.any(self._yaw_angles_opt_subset != start, axis=1)
+        best, n = self._yaw_angles_opt_subset, start.shape[1]
+        moves = np.zeros((2 * n,) + best.shape)
+        step = SEED_MOVE_FRACTION * reach
+        moves[np.arange(n), :, np.arange(n)] = step.T
+        moves[n + np.arange(n), :, np.arange(n)] = -step.T
+        # Only the turbines that steer a wake: the serial refine's own passes find the others.
+        moves *= (won[:, None] & steering[0])[None]
+        self._evaluate(np.clip(best[None] + moves, lower, upper)[:, None])
+
+    def _refine_with_mirror(self):
+        """Stages 3 and 4: the quadratic steps from the best yaws and, beside them in the same
+        evaluations, from their mirror where it is within MIRROR_WINDOW of the best."""
+        lower, upper = self._minimum_yaw_angle_subset, self._maximum_yaw_angle_subset
+        best, power = self._yaw_angles_opt_subset.copy(), self._farm_power_opt_subset.copy()
+        mirror = np.clip(-best, lower, upper)
+        distinct = np.any(np.abs(mirror - best) >= 0.01, axis=1)
+        mirror_power = self._evaluate(mirror[None, None], distinct[None])[0, 0]
+        close = distinct & (mirror_power >= (1.0 - MIRROR_WINDOW) * power)
+        tracks = _Tracks(np.stack([best, mirror]), np.stack([power, mirror_power]),
+                         np.stack([np.ones_like(close), close]), lower, upper)
+        wakes = self._wakes
+        # Cross terms of two steering turbines one of which is in the other's wake (the ridge
+        # the serial refine stops on); a turbine that wakes none moves its own power alone (its
+        # cross terms are small), and the SR's passes and the steps' curvatures place it.
+        steering = wakes.any(axis=2)
+        coupled = (wakes | np.swapaxes(wakes, 1, 2)) & steering[:, :, None] & steering[:, None, :]
+        coupled = np.concatenate([coupled, coupled])
         hessian = None
         for k, step in enumerate(QUADRATIC_STEPS):
-            best, power = self._yaw_angles_opt_subset, self._farm_power_opt_subset
-            pairs = coupled if hessian is None or k < len(QUADRATIC_STEPS) - 1 else None
-            stencil = _QuadraticStencil(best, lower, upper, step, pairs)
-            gradient, hessian = stencil.fit(self._keep_best(stencil.points) - power, hessian)
-            moves = _newton_moves(gradient, hessian, best, lower, upper, 4.0 * step)
-            self._keep_best(np.clip(best + np.concatenate([moves, 0.5 * moves[:1]]),
-                                    lower, upper))
-
-    def _steering_seeds(self, best, lower, upper, wakes):
-        """(K, n_findex, n) yaws where every turbine that wakes another takes one common yaw,
-        K values from lower to upper (the serial refine's first grid, halved in step), the
-        others keeping ``best``: the serial refine moves one turbine at a time, and where
-        steering pays only when two upstream turbines turn together (a row in a neutral day)
-        it stays at zero; the quadratic steps start from the best of these where it beats it."""
-        n_values = 2 * (int(self.Ny_passes[0]) - 1) + 1
-        fractions = np.linspace(0.0, 1.0, n_values)[:, None, None]
-        steering = wakes.any(axis=2)[None]
-        common = lower[None] + fractions * (upper - lower)[None]
-        return np.clip(np.where(steering, common, best[None]), lower, upper)
+            centre, centre_power = tracks.yaws.copy(), tracks.power.copy()
+            # The first step fits the whole model; the later ones its gradient only, one point
+            # per yaw, with the curvatures and cross terms of the first.
+            pairs = coupled if hessian is None else None
+            stencil = _QuadraticStencil(centre, tracks.lower, tracks.upper, step, pairs, hessian)
+            values = tracks.keep_best(stencil.points, self._evaluate)
+            with np.errstate(invalid="ignore"):  # the inactive mirrors' -inf: no move
+                gradient, hessian = stencil.fit(values - centre_power, hessian)
+            moves = _newton_moves(gradient, hessian, centre, tracks.lower, tracks.upper,
+                                  4.0 * step)
+            tracks.keep_best(np.clip(centre + np.concatenate([moves, 0.5 * moves[:1]]),
+                                     tracks.lower, tracks.upper), self._evaluate)
 
     def _wake_pairs(self):
         """(n_findex, n, n): turbine i wakes turbine j, by FLORIS's conservative linear wake cone
-        (half-width D + 0.3 x, ``derive_downstream_turbines``). The quadratic model samples the
-        cross terms of turbine pairs whose yaws act on a common farm power only: one in the
-        other's wake, or both waking a third."""
+        (half-width D + 0.3 x, ``derive_downstream_turbines``). The seeds steer the turbines
+        that wake another; the quadratic model samples the cross terms of pairs of them one of
+        which is in the other's wake."""
         fmodel = self.fmodel_subset
         angle = np.radians(fmodel.core.flow_field.wind_directions - 270.0)[:, None]
         x, y = fmodel.layout_x[None, :], fmodel.layout_y[None, :]
@@ -256,41 +302,78 @@ class BothSignsRefinement:
                                        < diameter[:, :, None] + 0.3 * downstream)
         return wakes
 
-    def _keep_best(self, points):
-        """Evaluate (K, n_findex, n_turbines) yaws in one FLORIS run (FLORIS's own tiling and
-        memory of the serial refine) and keep per condition the best above the best so far."""
-        powers = self._calc_powers_with_memory(points)
-        finite = np.where(np.isfinite(powers), powers, -np.inf)
-        pick = np.argmax(finite, axis=0)
-        conditions = np.arange(points.shape[1])
-        better = finite[pick, conditions] > self._farm_power_opt_subset
-        self._yaw_angles_opt_subset = np.where(better[:, None], points[pick, conditions],
-                                               self._yaw_angles_opt_subset)
-        self._farm_power_opt_subset = np.where(better, finite[pick, conditions],
+    def _evaluate(self, points, active=None):
+        """Farm power of (K, T, n_findex, n_turbines) yaws (T candidate sets per condition) in
+        one FLORIS run, -inf where ``active`` ((T, n_findex) booleans) is False; the best of
+        them above the best so far becomes the best. Inactive points are given the best yaws,
+        which the serial refine's memory does not evaluate again."""
+        k, t, f, n = points.shape
+        best = self._yaw_angles_opt_subset
+        if active is not None:
+            points = np.where(active[None, :, :, None], points, best[None, None])
+        powers = self._calc_powers_with_memory(points.reshape(k * t, f, n)).reshape(k, t, f)
+        powers = np.where(np.isfinite(powers), powers, -np.inf)
+        if active is not None:
+            powers = np.where(active[None], powers, -np.inf)
+        flat = powers.reshape(k * t, f)
+        pick = np.argmax(flat, axis=0)
+        conditions = np.arange(f)
+        better = flat[pick, conditions] > self._farm_power_opt_subset
+        self._yaw_angles_opt_subset = np.where(
+            better[:, None], points.reshape(k * t, f, n)[pick, conditions], best)
+        self._farm_power_opt_subset = np.where(better, flat[pick, conditions],
                                                self._farm_power_opt_subset)
+        return powers
+
+
+class _Tracks:
+    """T candidate yaw sets per condition refined side by side (:meth:`keep_best`), flattened
+    to (T x n_findex) rows for :class:`_QuadraticStencil` and :func:`_newton_moves`."""
+
+    def __init__(self, yaws, power, active, lower, upper):
+        self.t, self.f, n = yaws.shape
+        self.yaws = yaws.reshape(-1, n)
+        self.power = np.where(active, power, -np.inf).reshape(-1)
+        self.active = active
+        self.lower, self.upper = np.tile(lower, (self.t, 1)), np.tile(upper, (self.t, 1))
+
+    def keep_best(self, points, evaluate):
+        """Evaluate (K, T x n_findex, n) yaws; each row keeps its best. Returns (K, T x n_findex)
+        powers (-inf on inactive rows)."""
+        k, _, n = points.shape
+        powers = evaluate(points.reshape(k, self.t, self.f, n), self.active).reshape(k, -1)
+        pick = np.argmax(powers, axis=0)
+        rows = np.arange(powers.shape[1])
+        better = powers[pick, rows] > self.power
+        self.yaws = np.where(better[:, None], points[pick, rows], self.yaws)
+        self.power = np.where(better, powers[pick, rows], self.power)
         return powers
 
 
 class _QuadraticStencil:
     """Yaws around ``centre`` that determine a quadratic model of the farm power by finite
     differences: per turbine two points along its yaw inside its bounds (+-step, or step and
-    2 step away from a bound it is within step of), and per coupled pair (``pairs``, (n_findex,
-    n, n) booleans, or None for none) one point moving both. Turbines whose range is below
-    3e-3 deg stay put. ``points`` is (K, n_findex, n); where a condition has fewer coupled
-    pairs than K the remaining points are the centre (which the serial refine's memory does
-    not evaluate again)."""
+    2 step away from a bound it is within step of), or with ``curvature`` (the (n_findex, n, n)
+    Hessian of a previous model) the first of them only, and per coupled pair (``pairs``,
+    (n_findex, n, n) booleans, or None for none) one point moving both. Turbines whose range is
+    below 3e-3 deg stay put. ``points`` is (K, n_findex, n); where a condition has fewer coupled
+    pairs than K the remaining points are the centre (which the serial refine's memory does not
+    evaluate again)."""
 
-    def __init__(self, centre, lower, upper, step, pairs=None):
+    def __init__(self, centre, lower, upper, step, pairs=None, curvature=None):
         reach = np.minimum(step, (upper - lower) / 3.0)
         self.free = reach >= 1e-3
         reach = np.where(self.free, reach, 1.0)
         self.first = np.where(centre + reach <= upper, reach, -reach)
         back = centre - self.first
         self.second = np.where((back >= lower) & (back <= upper), -self.first, 2.0 * self.first)
+        self.curvature = None if curvature is None else np.einsum("fii->fi", curvature)
         n = centre.shape[1]
-        axes = np.zeros((2, n) + centre.shape)
+        sides = 2 if curvature is None else 1
+        axes = np.zeros((sides, n) + centre.shape)
         axes[0, np.arange(n), :, np.arange(n)] = np.where(self.free, self.first, 0.0).T
-        axes[1, np.arange(n), :, np.arange(n)] = np.where(self.free, self.second, 0.0).T
+        if sides == 2:
+            axes[1, np.arange(n), :, np.arange(n)] = np.where(self.free, self.second, 0.0).T
         if pairs is None:
             self.pairs = (np.zeros(0, int),) * 4
             crossed = np.zeros((0,) + centre.shape)
@@ -302,22 +385,28 @@ class _QuadraticStencil:
             crossed[rank, condition, i] = self.first[condition, i]
             crossed[rank, condition, j] = self.first[condition, j]
             self.pairs = (rank, condition, i, j)
-        self.n = n
-        self.points = np.clip(centre + np.concatenate([axes[0], axes[1], crossed]), lower, upper)
+        self.n, self.sides = n, sides
+        self.points = np.clip(centre + np.concatenate([*axes, crossed]), lower, upper)
 
     def fit(self, gains, hessian=None):
         """(gradient, Hessian) per condition from ``gains`` (K, n_findex): the farm power at
-        ``points`` less that at the centre. The cross terms of pairs not sampled are those of
-        ``hessian`` (or zero). Conditions with a non-finite gain get a zero gradient."""
+        ``points`` less that at the centre. The cross terms of pairs not sampled (and, with one
+        point per yaw, the curvatures) are those of ``hessian`` (or zero). Conditions with a
+        non-finite gain get a zero gradient."""
         n, a, b = self.n, self.first, self.second
-        along_a, along_b = gains[:n].T, gains[n:2 * n].T
-        curvature = 2.0 * (along_a / a - along_b / b) / (a - b)
+        along_a = gains[:n].T
+        if self.sides == 2:
+            along_b = gains[n:2 * n].T
+            curvature = 2.0 * (along_a / a - along_b / b) / (a - b)
+        else:
+            curvature = self.curvature
         gradient = along_a / a - 0.5 * curvature * a
         fitted = (np.zeros((gains.shape[1], n, n)) if hessian is None
                   else hessian * (1.0 - np.eye(n)))
         rank, condition, i, j = self.pairs
-        cross = (gains[2 * n + rank, condition] - along_a[condition, i] - along_a[condition, j]) \
-            / (a[condition, i] * a[condition, j])
+        offset = self.sides * n
+        cross = (gains[offset + rank, condition] - along_a[condition, i]
+                 - along_a[condition, j]) / (a[condition, i] * a[condition, j])
         fitted[condition, i, j] = cross
         fitted[condition, j, i] = cross
         fitted[:, np.arange(n), np.arange(n)] = np.where(self.free, curvature, 0.0)
