@@ -70,9 +70,9 @@ SEED_MOVE_FRACTION = 0.25
 #: is within this fraction of the best (0.2 %).
 MIRROR_WINDOW = 2e-3
 
-#: Finite-difference steps [deg] of the quadratic-model refinement after the serial refine: one
-#: full model (gradient and Hessian) per step, the last one re-using the previous Hessian's
-#: cross terms (docs/yaw_steering.md#how-both-signs-are-searched).
+#: Finite-difference steps [deg] of the quadratic-model refinement after the serial refine: the
+#: first fits the full model (gradient and Hessian), the later ones the gradient only, with the
+#: first's Hessian (docs/yaw_steering.md#how-both-signs-are-searched).
 QUADRATIC_STEPS = (1.0, 0.5)
 
 
