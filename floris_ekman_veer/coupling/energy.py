@@ -407,18 +407,18 @@ def _check_client(fmodel, client) -> None:
 
     from floris_ekman_veer.coupling.distributed import _check_workers, _import_distributed
 
+    if isinstance(fmodel, ParFlorisModel) or not isinstance(fmodel, FlorisModel):
+        raise ValueError(
+            "annual energy: with client= each chunk of conditions runs on a Dask worker as a "
+            f"plain FlorisModel; fmodel must be a FlorisModel, got {type(fmodel).__name__} "
+            "(give its FlorisModel, or drop client= to let the model run its own chunks)"
+        )
     distributed = _import_distributed()
     if not isinstance(client, distributed.Client):
         raise ValueError(
             "annual energy: client must be a dask.distributed.Client (e.g. "
             f"Client(LocalCluster()) or Client('tcp://scheduler:8786')); got "
             f"{type(client).__name__}"
-        )
-    if isinstance(fmodel, ParFlorisModel) or not isinstance(fmodel, FlorisModel):
-        raise ValueError(
-            "annual energy: with client= each chunk of conditions runs on a Dask worker as a "
-            f"plain FlorisModel; fmodel must be a FlorisModel, got {type(fmodel).__name__} "
-            "(give its FlorisModel, or drop client= to let the model run its own chunks)"
         )
     _check_workers(client)
 
