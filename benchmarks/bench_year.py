@@ -161,9 +161,10 @@ def main():
               "peak traced memory [MB] |")
         print("|---|---:|---:|---:|---:|")
         for key in chosen:
-            same = best.get(SAME_MODEL.get(key), np.nan)
-            print(f"| {LINES[key]} | {best[key]:.2f} | {best[key] / reference:.2f} | "
-                  f"{best[key] / same:.2f} | {peaks[key] / 1e6:.0f} |")
+            same = best.get(SAME_MODEL.get(key))
+            same = "-" if same is None else f"{best[key] / same:.2f}"
+            print(f"| {LINES[key]} | {best[key]:.2f} | {best[key] / reference:.2f} | {same} | "
+                  f"{peaks[key] / 1e6:.0f} |")
         if "gch" in best and "plain_gch" in best:
             print(f"annual_energy gch / plain FLORIS GCH: {best['gch'] / best['plain_gch']:.2f}")
     if args.steered:
