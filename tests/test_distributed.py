@@ -189,13 +189,15 @@ SCRIPT = textwrap.dedent(
 
 @pytest.fixture(scope="module")
 def cluster_results(tmp_path_factory):
+    # 325 s measured at a load average of 10-12 on the 2-core machine: the timeout catches a hang,
+    # not a load.
     script = tmp_path_factory.mktemp("dask") / "run_on_cluster.py"
     script.write_text(SCRIPT)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [str(REPOSITORY)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     done = subprocess.run(
         [sys.executable, str(script), str(REPOSITORY / "inputs" / "farm_sbl6.yaml")],
-        capture_output=True, text=True, env=env, timeout=300, cwd=script.parent,
+        capture_output=True, text=True, env=env, timeout=600, cwd=script.parent,
     )
     lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
     assert done.returncode == 0 and lines, done.stderr[-3000:]
