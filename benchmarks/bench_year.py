@@ -1,30 +1,49 @@
 """A year of per-record atmospheres: the study's cost against plain FLORIS runs (issue: year perf).
 
-Hand-run script (not a test), from the repository root:
-``PYTHONPATH=. python benchmarks/bench_year.py [--records 8760] [--side 10] [--repeats 3]``.
+Hand-run script (not a test), from the repository root, e.g.
+``PYTHONPATH=. python benchmarks/bench_year.py --side 3 --records 8760 --repeats 3``,
+``... --lines ekman_veer,gch --records 52560``, or a steered year
+``... --lines none --steered 96 --steered-chunk 24 --dask-workers 2``.
 
-Lines, each timed interleaved with its reference in one process (each repeat runs every line
-once, in turn), best of ``--repeats``; peak memory by tracemalloc
+Lines (``--lines``, comma-separated; default all but the steered run), each timed interleaved
+with the others in one process (each repeat runs every line once, in turn), best of
+``--repeats``; peak memory by tracemalloc (one more call of each line under tracemalloc, untimed,
+as tracing slows the timed ones) and the process's peak resident memory at the end:
 
-(peak memory: one more call of each line under tracemalloc, untimed);
-
-* ``plain gauss``: FLORIS's gauss (no atmosphere, one scalar TI) over the records' conditions,
+* ``plain``: FLORIS's gauss (no atmosphere, one scalar TI) over the records' conditions,
   ``run()`` once, unchunked: the reference of the ratios;
-* ``gauss on the Ekman inflow``: the same model and conditions with a single atmosphere block
-  (the inflow hook's cost, the 3 x 3 line of the inflow issue);
-* ``annual_energy ekman_veer`` and ``annual_energy gch``: ``annual_energy`` of the records,
-  each record with its own atmosphere (``records=``, one class per distinct stability), one
-  vectorised FLORIS model per chunk;
-* with ``--steered``: ``annual_energy(..., YawOptimizationSR)`` of ekman_veer on the records
-  (one run, with its progress bar).
+* ``inflow``: the same gauss model and conditions on the Ekman inflow of a single atmosphere (the
+  inflow hook's cost);
+* ``plain_gch``: FLORIS's GCH (no atmosphere), ``run()`` once: GCH's own cost against gauss;
+* ``gch_one``: that GCH model on the Ekman inflow of a single atmosphere;
+* ``ekman_veer_one``: the ekman_veer model on the records' conditions with a single atmosphere,
+  ``run()`` once;
+* ``ekman_veer`` and ``gch``: ``annual_energy`` of the records, each record with the atmosphere
+  of its stability class (``records=``; ``--classes`` distinct atmospheres, = ``--records`` for
+  one per record as ``fit_site`` gives), one vectorised FLORIS model per chunk of
+  ``--chunk-size`` conditions.
+
+The AEP lines are reported against plain gauss and against the same model on one atmosphere
+(``ekman_veer_one``, ``gch_one``; GCH itself costs more than gauss, so its ratio to gauss mixes the
+two costs).
+
+``--steered N``: ``annual_energy(..., YawOptimizationSR)`` of the first N records (``--steered-
+models``, default ekman_veer), in chunks of ``--steered-chunk`` with its progress bar, run once;
+the time of a year is extrapolated linearly, t(8,760) = t(N) x 8,760 / N (the chunks are
+independent and alike, so the time is proportional to their number; docs/performance.md). With
+``--dask-workers W`` the same study runs again on a ``LocalCluster`` of W single-threaded worker
+processes (``client=``), its numbers are checked bitwise against the serial run, and the
+speed-up serial / cluster is printed (the cluster's start-up not counted).
 
 The records are synthetic: directions uniform, speeds 5-14 m/s at 90 m, the stability of each
 record one of ``--classes`` Obukhov lengths, 100-2000 m (stable nights to near-neutral days).
+State the machine's load (``uptime``) with the numbers.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import tracemalloc
 from pathlib import Path
@@ -80,11 +99,21 @@ def main():
                         help="distinct atmospheres (Obukhov lengths 100-2000 m); = --records "
                              "for one per record, as fit_site gives")
     parser.add_argument("--chunk-size", type=int, default=None)
-    parser.add_argument("--steered", action="store_true")
     parser.add_argument("--memory", action=argparse.BooleanOptionalAction, default=True)
-    parser.add_argument("--lines", default="plain,inflow,ekman_veer,gch")
+    parser.add_argument("--lines", default=",".join(LINES),
+                        help=f"comma-separated, of {list(LINES)} (or none)")
+    parser.add_argument("--steered", type=int, default=0, metavar="N",
+                        help="also run a steered study of the first N records")
+    parser.add_argument("--steered-chunk", type=int, default=24, metavar="K")
+    parser.add_argument("--steered-models", default="ekman_veer")
+    parser.add_argument("--dask-workers", type=int, default=0, metavar="W",
+                        help="run the steered study on a LocalCluster of W processes too")
     args = parser.parse_args()
     floris_ekman_veer.silence_warnings()
+    chosen = [k for k in args.lines.split(",") if k in LINES]
+    unknown = [k for k in args.lines.split(",") if k not in LINES and k != "none"]
+    if unknown:
+        parser.error(f"--lines: unknown {unknown}; choose from {list(LINES)}")
 
     fmodel = farm(args.side)
     series, classes = records(args.records, args.classes)
@@ -93,50 +122,120 @@ def main():
                  for length in np.geomspace(100.0, 2000.0, args.classes)}
     names = np.array(list(stability))[classes]
     directions, speeds, _, _ = series.unpack_for_reinitialize()
-    gauss = builtin_model(fmodel, "gauss")
-    gauss.set(wind_directions=directions, wind_speeds=speeds,
-              turbulence_intensities=np.full(speeds.size, 0.06))
-    plain = gauss.copy()
-    set_atmosphere(plain, None)
+    conditions = dict(wind_directions=directions, wind_speeds=speeds,
+                      turbulence_intensities=np.full(speeds.size, 0.06))
+    # The single atmosphere of the "one atmosphere" lines: the input's own block.
+    models = {}
+    for name in ("gauss", "gch"):
+        on_inflow = builtin_model(fmodel, name)
+        on_inflow.set(**conditions)
+        plain = on_inflow.copy()
+        set_atmosphere(plain, None)
+        models[name] = (plain, on_inflow)
+    own = fmodel.copy()
+    own.set(**conditions)
     options = {} if args.chunk_size is None else {"chunk_size": args.chunk_size}
 
-    lines = {
-        "plain": ("plain FLORIS gauss (reference)", plain.run),
-        "inflow": ("gauss on the Ekman inflow", gauss.run),
-        "ekman_veer": ("annual_energy ekman_veer, per-record atmospheres",
-                       lambda: annual_energy(fmodel, series, stability, records=names,
-                                             models=["ekman_veer"], **options)),
-        "gch": ("annual_energy gch, per-record atmospheres",
-                lambda: annual_energy(fmodel, series, stability, records=names,
-                                      models=["gch"], **options)),
+    def study(model):
+        return lambda: annual_energy(fmodel, series, stability, records=names, models=[model],
+                                     progress=False, **options)
+
+    run = {
+        "plain": models["gauss"][0].run, "inflow": models["gauss"][1].run,
+        "plain_gch": models["gch"][0].run, "gch_one": models["gch"][1].run,
+        "ekman_veer_one": own.run, "ekman_veer": study("ekman_veer"), "gch": study("gch"),
     }
-    chosen = [k for k in args.lines.split(",") if k in lines]
     print(f"{args.records} records ({args.classes} atmospheres), {args.side} x {args.side} farm, "
-          f"best of {args.repeats}, interleaved")
+          f"best of {args.repeats}, interleaved; load {os.getloadavg()[0]:.1f} (1 min)",
+          flush=True)
     best = {k: np.inf for k in chosen}
-    for repeat in range(args.repeats):
+    for repeat in range(args.repeats if chosen else 0):
         for key in chosen:
-            elapsed = timed(lines[key][1])
+            elapsed = timed(run[key])
             best[key] = min(best[key], elapsed)
             print(f"  repeat {repeat}: {key} {elapsed:.2f} s", flush=True)
-    best = {k: (t, peak_memory(lines[k][1]) if args.memory else np.nan) for k, t in best.items()}
-    reference = best["plain"][0] if "plain" in best else np.nan
-    print(f"| line | time [s] | / plain gauss | peak memory [MB] |")
-    print("|---|---:|---:|---:|")
-    for key in chosen:
-        elapsed, peak = best[key]
-        print(f"| {lines[key][0]} | {elapsed:.2f} | {elapsed / reference:.2f} | "
-              f"{peak / 1e6:.0f} |")
+    peaks = {k: peak_memory(run[k]) if args.memory else np.nan for k in chosen}
+    if chosen:
+        reference = best.get("plain", np.nan)
+        print("| line | time [s] | / plain gauss | / same model, one atmosphere | "
+              "peak traced memory [MB] |")
+        print("|---|---:|---:|---:|---:|")
+        for key in chosen:
+            same = best.get(SAME_MODEL.get(key))
+            same = "-" if same is None else f"{best[key] / same:.2f}"
+            print(f"| {LINES[key]} | {best[key]:.2f} | {best[key] / reference:.2f} | {same} | "
+                  f"{peaks[key] / 1e6:.0f} |")
+        if "gch" in best and "plain_gch" in best:
+            print(f"annual_energy gch / plain FLORIS GCH: {best['gch'] / best['plain_gch']:.2f}")
     if args.steered:
-        from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+        steered(fmodel, series, stability, names, args)
+    print(f"process peak resident memory: {peak_resident() / 1e6:.0f} MB; load "
+          f"{os.getloadavg()[0]:.1f} (1 min)")
 
+
+#: The benchmark's lines (``--lines``) and their labels.
+LINES = {
+    "plain": "plain FLORIS gauss (reference)",
+    "inflow": "gauss on the Ekman inflow, one atmosphere",
+    "plain_gch": "plain FLORIS GCH",
+    "gch_one": "GCH on the Ekman inflow, one atmosphere",
+    "ekman_veer_one": "ekman_veer, one atmosphere",
+    "ekman_veer": "annual_energy ekman_veer, per-record atmospheres",
+    "gch": "annual_energy gch, per-record atmospheres",
+}
+#: Each AEP line's reference of the same model on one atmosphere.
+SAME_MODEL = {"ekman_veer": "ekman_veer_one", "gch": "gch_one", "inflow": "plain",
+              "gch_one": "plain_gch"}
+
+
+def peak_resident() -> float:
+    """The process's peak resident set size [bytes] (Linux reports kB, macOS bytes)."""
+    import resource
+    import sys
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return float(peak if sys.platform == "darwin" else peak * 1024)
+
+
+def steered(fmodel, series, stability, names, args) -> None:
+    """The steered study of the first ``--steered`` records, serial and (``--dask-workers``) on
+    a LocalCluster; times, the extrapolation to 8,760 records and the bitwise check."""
+    from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+    n = min(args.steered, len(names))
+    subset = TimeSeries(series.wind_directions[:n], series.wind_speeds[:n],
+                        turbulence_intensities=0.06)
+    kwargs = dict(records=names[:n], models=args.steered_models.split(","), progress=True,
+                  chunk_size=args.steered_chunk)
+    start = time.perf_counter()
+    serial = annual_energy(fmodel, subset, stability, YawOptimizationSR, **kwargs)
+    elapsed = time.perf_counter() - start
+    year = serial.table[serial.table.stability == "all"]
+    print(f"steered ({YawOptimizationSR.__name__}, {args.steered_models}, {n} records, chunks of "
+          f"{args.steered_chunk}): {elapsed:.1f} s = {elapsed / n:.2f} s per record; a year of "
+          f"8,760 records: {elapsed / n * 8760 / 60:.1f} min (t x 8,760 / {n}); gain "
+          f"{', '.join(f'{g:+.2f} %' for g in year.gain_percent)}; load "
+          f"{os.getloadavg()[0]:.1f} (1 min)", flush=True)
+    if not args.dask_workers:
+        return
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=args.dask_workers, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
+        # A first small study registers the package on the workers (not counted).
+        annual_energy(fmodel, TimeSeries(subset.wind_directions[:1], subset.wind_speeds[:1],
+                                         turbulence_intensities=0.06), stability,
+                      records=names[:1], models=["ekman_veer"], progress=False, client=client)
         start = time.perf_counter()
-        result = annual_energy(fmodel, series, stability, YawOptimizationSR, records=names,
-                               models=["ekman_veer"], progress=True, **options)
-        elapsed = time.perf_counter() - start
-        year = result.table[result.table.stability == "all"].iloc[0]
-        print(f"steered year (YawOptimizationSR, ekman_veer): {elapsed:.1f} s, gain "
-              f"{year.gain_percent:+.2f} %")
+        on_cluster = annual_energy(fmodel, subset, stability, YawOptimizationSR, client=client,
+                                   **kwargs)
+        on_time = time.perf_counter() - start
+    same = all(
+        np.array_equal(serial.conditions[m][c].to_numpy(), on_cluster.conditions[m][c].to_numpy())
+        for m in serial.conditions for c in ("farm_power_baseline", "farm_power_steered"))
+    print(f"on a LocalCluster of {args.dask_workers} processes: {on_time:.1f} s, speed-up "
+          f"{elapsed / on_time:.2f} x; bitwise the serial numbers: {same}; load "
+          f"{os.getloadavg()[0]:.1f} (1 min)")
 
 
 if __name__ == "__main__":

@@ -155,15 +155,25 @@ def choice_field(default: str, options):
 # boolean is refused there too, where numpy would silently read "10" as 10.0 and True as 1.0.
 
 
+def _plain_numbers(values) -> bool:
+    """True when every item of ``values`` is a Python int or float or a numpy integer or
+    floating scalar (never a bool): the common case of a long flat list (a year of per-record
+    values), decided by the few distinct types instead of item by item. False means "not
+    decided here" (the item-by-item check follows)."""
+    return all(t is float or t is int or issubclass(t, (np.floating, np.integer))
+               for t in set(map(type, values)))
+
+
 def _is_real(value) -> bool:
     """True for a real number, or a (nested) sequence or numeric array of real numbers; False
     for strings, booleans, None and anything else numpy would silently coerce to float."""
     if isinstance(value, np.ndarray):
         if value.dtype.kind in "iuf":
             return True
-        return value.dtype.kind == "O" and all(_is_real(v) for v in value.ravel())
+        return value.dtype.kind == "O" and (_plain_numbers(value.ravel())
+                                            or all(_is_real(v) for v in value.ravel()))
     if isinstance(value, (list, tuple)):
-        return all(_is_real(v) for v in value)
+        return _plain_numbers(value) or all(_is_real(v) for v in value)
     if hasattr(value, "__array__") and not isinstance(value, (str, bytes, np.generic)):
         # pandas Series and Index, xarray, and other array-likes: judged by their values
         return _is_real(np.asarray(value))

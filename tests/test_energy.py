@@ -277,3 +277,77 @@ def test_gch_comparison_is_the_yaw_studys(row, atmospheres):
                                   np.sum(model.get_turbine_powers(), axis=1))
     np.testing.assert_array_equal(result.inflow["gch", "night"]["turbulence_intensities"],
                                   model.core.flow_field.turbulence_intensities)
+
+
+def _year_of_records(row, n=7, seed=5):
+    """``n`` records, each with its own atmosphere (stability from neutral to SBL-6)."""
+    rng = np.random.default_rng(seed)
+    series = TimeSeries(rng.uniform(262.0, 278.0, n), rng.uniform(6.0, 13.0, n),
+                        turbulence_intensities=0.06)
+    atmosphere = atmosphere_of(row.core).sliced(slice(None))
+    atmosphere["stability_parameter"] = rng.uniform(0.0, 148.49, n).tolist()
+    return series, atmosphere, [f"record {k}" for k in range(n)]
+
+
+def test_per_record_results_do_not_depend_on_the_chunking(row):
+    """A record's numbers are its own: chunks of 1, 3 and all records give them bitwise."""
+    series, atmosphere, labels = _year_of_records(row)
+    results = [energy.record_energy(row, series, atmosphere, labels, models=["ekman_veer", "gch"],
+                                    chunk_size=size) for size in (1, 3, 7)]
+    first = results[0]
+    assert len(first.conditions["ekman_veer"]) == 7
+    for other in results[1:]:
+        for model in ("ekman_veer", "gch"):
+            np.testing.assert_array_equal(other.conditions[model]["farm_power_baseline"],
+                                          first.conditions[model]["farm_power_baseline"])
+            for key in first.inflow:
+                np.testing.assert_array_equal(other.inflow[key]["turbulence_intensities"],
+                                              first.inflow[key]["turbulence_intensities"])
+        np.testing.assert_array_equal(other.table["aep_baseline_gwh"],
+                                      first.table["aep_baseline_gwh"])
+    # The per-record atmospheres matter: a record run alone in its own model gives its power.
+    alone = row.copy()
+    set_atmosphere(alone, {k: v if np.ndim(v) == 0 else v[4:5] for k, v in atmosphere.items()},
+                   wind_directions=series.wind_directions[4:5],
+                   wind_speeds=series.wind_speeds[4:5],
+                   turbulence_intensities=first.inflow["ekman_veer", "record 4"][
+                       "turbulence_intensities"])
+    alone.run()
+    assert first.conditions["ekman_veer"]["farm_power_baseline"].iloc[4] == np.sum(
+        alone.get_turbine_powers())
+
+
+def test_the_comparison_solves_each_chunks_abl_once(row, monkeypatch):
+    """The GCH comparison's I_u(z_h) and the inflow hook share one ABL solve per chunk."""
+    from floris_ekman_veer.coupling import inflow
+
+    series, atmosphere, labels = _year_of_records(row, n=6, seed=9)
+    solved = []
+    original = inflow._solve_moving
+
+    def counting(spec, wind_speeds, *args):
+        solved.append(np.asarray(wind_speeds).size)
+        return original(spec, wind_speeds, *args)
+
+    monkeypatch.setattr(inflow, "_solve_moving", counting)
+    inflow._SOLVE_CACHE.clear()
+    energy.record_energy(row, series, atmosphere, labels, models=["gch"], chunk_size=2)
+    # Three chunks of two records: three solves of two conditions (the template's own
+    # conditions are solved once more, when the GCH copy of the model is built).
+    assert [size for size in solved if size == 2] == [2, 2, 2]
+
+
+def test_client_must_be_a_dask_client(row, atmospheres, no_work):
+    pytest.importorskip("distributed")
+    series, atmosphere, labels = _year_of_records(row, n=2)
+    with pytest.raises(ValueError, match=r"client must be a dask.distributed.Client.*got str"):
+        energy.record_energy(row, series, atmosphere, labels, client="tcp://127.0.0.1:8786")
+    with pytest.raises(ValueError, match=r"client must be a dask.distributed.Client.*got int"):
+        annual_energy(row, ROSE, {"night": {"frequency": 1.0, "atmosphere":
+                                            atmospheres["night"]}}, client=8786)
+    # A ParFlorisModel already runs its own chunks in parallel: not both at once.
+    from floris_ekman_veer import ParFlorisModel
+
+    par = ParFlorisModel(row, interface=None)
+    with pytest.raises(ValueError, match=r"fmodel must be a FlorisModel, got ParFlorisModel"):
+        energy.record_energy(par, series, atmosphere, labels, client=object())

@@ -45,6 +45,13 @@ PYTHON = {
     "G boolean": (lambda: build(geostrophic_wind=True), r"^geostrophic_wind must be a real number.*got True \(bool\)"),
     "G list with a string": (lambda: build(geostrophic_wind=[8.0, "9"]), r"^geostrophic_wind must be a real number"),
     "G boolean array": (lambda: build(geostrophic_wind=np.array([True, False])), r"^geostrophic_wind must be a real number"),
+    # a year of per-record values (checked by the items' types at once, not item by item):
+    # one boolean, string or None at the end is still found
+    "long list ending in a boolean": (lambda: build(cooling_rate=[-0.5] * 8760 + [True]), r"^cooling_rate must be a real number.*got \[-0.5, "),
+    "long list with a numpy boolean": (lambda: build(cooling_rate=[-0.5] * 8760 + [np.True_]), r"^cooling_rate must be a real number"),
+    "long list ending in a string": (lambda: build(cooling_rate=[-0.5] * 8760 + ["-1"]), r"^cooling_rate must be a real number"),
+    "long object array with None": (lambda: build(cooling_rate=np.array([-0.5] * 8760 + [None], dtype=object)), r"^cooling_rate must be a real number"),
+    "long list of rows with a boolean": (lambda: build(cooling_rate=[[-0.5]] * 8760 + [[True]]), r"^cooling_rate must be a real number"),
     "z0 string": (lambda: build(roughness_length="0.1"), r"^roughness_length must be a real number.*got '0.1'"),
     "latitude boolean": (lambda: build(latitude=True), r"^latitude must be a real number.*got True"),
     "constant string": (lambda: build(von_karman="0.4"), r"^von_karman must be a real number"),
@@ -129,3 +136,13 @@ def test_floris_reference_wind_failure_names_the_condition():
     with pytest.raises(ValueError, match=r"no ABL has a wind speed of 3 m/s at 90 m at condition 1 .*"
                                          r"the slowest wind these inputs support at 90 m is"):
         floris(atmosphere, wind_speeds=(12.0, 3.0, 14.0), wind_directions=(270.0,) * 3)
+
+
+def test_long_lists_of_numbers_are_read_as_given():
+    """Plain numbers of any numeric type in a long list are accepted (and read exactly)."""
+    from floris_ekman_veer._validation import real_array
+
+    values = [-0.5] * 8759 + [np.float32(-0.25), np.int64(-1), -2]
+    array = real_array("cooling_rate", values)
+    np.testing.assert_array_equal(array, np.array(values, dtype=float))
+    assert real_array("z", np.array(values, dtype=object)).dtype == float

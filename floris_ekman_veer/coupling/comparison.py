@@ -77,7 +77,9 @@ def builtin_inflow_settings(
 
     Args:
         atmosphere: EkmanABL inputs without the wind speed (the ``ekman_veer.atmosphere`` block;
-            values may be per-condition lists).
+            values may be per-condition lists), or its validated ``AtmosphereSpec`` (as
+            ``inflow.atmosphere_of`` gives it: then the solve is the one the model's inflow hook
+            makes, shared through the solve cache).
         wind_speeds: FLORIS's wind speeds [m/s] at ``reference_height``, one per condition.
         reference_height: FLORIS's ``reference_wind_height`` [m].
         hub_height: Hub height z_h [m] of the turbine the values are for.
@@ -89,7 +91,9 @@ def builtin_inflow_settings(
         ``wind_shear`` (rotor-equivalent power-law exponent).
     """
     wind_speeds = np.atleast_1d(np.asarray(wind_speeds, dtype=float))
-    abl = solve(AtmosphereSpec.from_mapping(atmosphere), wind_speeds, reference_height)
+    spec = (atmosphere if isinstance(atmosphere, AtmosphereSpec)
+            else AtmosphereSpec.from_mapping(atmosphere))
+    abl = solve(spec, wind_speeds, reference_height)
     radius = 0.5 * rotor_diameter
     if hub_height - radius <= np.max(abl.roughness_length):
         raise ValueError(f"the rotor bottom z_h - R = {hub_height - radius} m must be above "

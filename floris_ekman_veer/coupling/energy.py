@@ -54,7 +54,13 @@ from floris_ekman_veer.coupling.comparison import (
     builtin_model,
     comparison_set_kwargs,
 )
-from floris_ekman_veer.coupling.inflow import AtmosphereSpec, set_atmosphere
+from floris_ekman_veer.coupling.inflow import (
+    ATMOSPHERE_KEY,
+    PARAMETER_BLOCK,
+    AtmosphereSpec,
+    set_atmosphere,
+)
+from floris_ekman_veer.coupling.input_checks import zero_power_speed
 from floris_ekman_veer.coupling.names import VELOCITY_MODEL_NAME as MODEL_NAME
 from floris_ekman_veer.coupling.optimization import check_optimizer_options, optimize_yaw
 
@@ -248,6 +254,7 @@ def annual_energy(
     turbulence_intensities: str = "atmosphere",
     progress: bool | None = None,
     chunk_size: int = DEFAULT_CHUNK_SIZE,
+    client=None,
     **optimizer_kwargs,
 ) -> AnnualEnergy:
     """AEP per stability class and model, baseline and with optimised yaw (module docstring).
@@ -266,11 +273,16 @@ def annual_energy(
         progress: tqdm bar over the study's conditions (None: with an optimiser).
         chunk_size: Conditions per FLORIS model (bounds the memory; results do not depend on
             it).
+        client: A ``dask.distributed.Client``: the chunks run on its workers, each a
+            self-contained task (the chunk's FLORIS model, its run and its yaw optimisation),
+            gathered in order, so the numbers are bitwise those of the serial study
+            (docs/coupling.md#annual-energy); needs the extra ``dask`` and ``fmodel`` a plain
+            FlorisModel.
         **optimizer_kwargs: Options of ``optimizer_class`` (checked before any run).
     """
     classes = stability_classes(stability, wind_data, records)
     study = _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
-                         chunk_size, optimizer_kwargs)
+                         chunk_size, optimizer_kwargs, client)
     groups = {}
     for k, c in enumerate(classes):
         # Classes giving the same EkmanABL inputs run together, one atmosphere per condition.
@@ -296,7 +308,8 @@ def annual_energy(
 def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Sequence[str],
                   optimizer_class=None, *, models: Sequence[str] = (MODEL_NAME, "gch"),
                   turbulence_intensities: str = "atmosphere", progress: bool | None = None,
-                  chunk_size: int = DEFAULT_CHUNK_SIZE, **optimizer_kwargs) -> AnnualEnergy:
+                  chunk_size: int = DEFAULT_CHUNK_SIZE, client=None,
+                  **optimizer_kwargs) -> AnnualEnergy:
     """:func:`annual_energy` of a ``TimeSeries`` whose records each have their own atmosphere
     (``atmosphere``: the block with one value per record, as ``SiteAtmosphere.atmosphere``).
 
@@ -305,7 +318,7 @@ def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Seque
     classes and records, without a class mapping per record.
     """
     study = _check_study(fmodel, series, optimizer_class, models, turbulence_intensities,
-                         chunk_size, optimizer_kwargs)
+                         chunk_size, optimizer_kwargs, client)
     wind_frequencies = np.asarray(series.unpack_freq(), dtype=float).reshape(-1)
     n = wind_frequencies.size
     spec = AtmosphereSpec.from_mapping(atmosphere)
@@ -351,7 +364,7 @@ class _Conditions:
 
 
 def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
-                 chunk_size, optimizer_kwargs) -> dict:
+                 chunk_size, optimizer_kwargs, client=None) -> dict:
     """Check a study's options before any FLORIS run; the wind data's arrays and models."""
     models = list(models)
     allowed = [MODEL_NAME, *BUILTIN_WAKES]
@@ -379,8 +392,35 @@ def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensit
     elif optimizer_kwargs:
         raise ValueError(f"annual energy: optimiser options {sorted(optimizer_kwargs)} given "
                          "without an optimizer_class")
+    if client is not None:
+        _check_client(fmodel, client)
     return dict(models=models, directions=directions, speeds=speeds, wind_ti=wind_ti,
-                turbulence_intensities=turbulence_intensities, chunk_size=int(chunk_size))
+                turbulence_intensities=turbulence_intensities, chunk_size=int(chunk_size),
+                client=client)
+
+
+def _check_client(fmodel, client) -> None:
+    """Refuse, before any run, a ``client`` that is not a ``dask.distributed.Client`` or a
+    model the workers cannot rebuild as it is; register the package on every worker."""
+    from floris import FlorisModel
+    from floris.par_floris_model import ParFlorisModel
+
+    from floris_ekman_veer.coupling.distributed import _check_workers, _import_distributed
+
+    if isinstance(fmodel, ParFlorisModel) or not isinstance(fmodel, FlorisModel):
+        raise ValueError(
+            "annual energy: with client= each chunk of conditions runs on a Dask worker as a "
+            f"plain FlorisModel; fmodel must be a FlorisModel, got {type(fmodel).__name__} "
+            "(give its FlorisModel, or drop client= to let the model run its own chunks)"
+        )
+    distributed = _import_distributed()
+    if not isinstance(client, distributed.Client):
+        raise ValueError(
+            "annual energy: client must be a dask.distributed.Client (e.g. "
+            f"Client(LocalCluster()) or Client('tcp://scheduler:8786')); got "
+            f"{type(client).__name__}"
+        )
+    _check_workers(client)
 
 
 def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_class, study,
@@ -398,8 +438,17 @@ def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_clas
         for model in study["models"]:
             bar.set_postfix_str(model)
             template = fmodel.copy() if model == MODEL_NAME else builtin_model(fmodel, model)
-            parts = [_run_conditions(template, model, c, study, optimizer_class,
-                                     optimizer_kwargs, bar) for c in conditions]
+            chunks = [_chunk_of(c, rows, study, optimizer_kwargs) for c in conditions
+                      for rows in _chunk_rows(c.wind_index.size, study["chunk_size"])]
+            if study["client"] is None:
+                parts = []
+                for chunk in chunks:
+                    parts.append(_run_chunk(template, model, chunk, study["turbulence_intensities"],
+                                            optimizer_class))
+                    bar.update(chunk.speeds.size)
+            else:
+                parts = _run_on_cluster(study["client"], template, model, chunks,
+                                        study["turbulence_intensities"], optimizer_class, bar)
             per_model[model] = {k: np.concatenate([p[k] for p in parts]) if k != "optima"
                                 else pd.concat([p[k] for p in parts], ignore_index=True)
                                 for k in parts[0] if parts[0][k] is not None}
@@ -451,33 +500,105 @@ def _aep(freq, farm_power) -> float:
     return float(np.nansum(np.multiply(freq, farm_power)) * HOURS_PER_YEAR) / 1e9
 
 
-def _run_conditions(template, model, conditions, study, optimizer_class, optimizer_kwargs, bar):
-    """Farm powers (baseline and steered), optima and inflow of ``conditions``, chunk by chunk."""
-    out = {k: [] for k in ("baseline", "steered", "optima", "turbulence_intensities",
-                           "wind_veer", "wind_shear")}
-    n = conditions.wind_index.size
-    for rows in np.array_split(np.arange(n), max(1, -(-n // study["chunk_size"]))):
-        if not rows.size:
-            continue
-        case = _chunk_model(template, model, conditions, rows, study)
-        flow_field = case.core.flow_field
-        out["turbulence_intensities"].append(flow_field.turbulence_intensities.copy())
-        out["wind_veer"].append(np.full(rows.size, float(flow_field.wind_veer)))
-        out["wind_shear"].append(np.full(rows.size, float(flow_field.wind_shear)))
+def _chunk_rows(n: int, chunk_size: int) -> list:
+    """Contiguous chunks of at most ``chunk_size`` of ``n`` conditions (np.array_split, as
+    FLORIS's ParFlorisModel cuts its conditions)."""
+    return [rows for rows in np.array_split(np.arange(n), max(1, -(-n // chunk_size)))
+            if rows.size]
+
+
+@attrs.frozen(eq=False)
+class _Chunk:
+    """One chunk of a study, self-contained (a Dask task carries it): its conditions, their
+    atmosphere (a plain block: scalars, or one value per condition) and the optimiser's options
+    cut to them."""
+
+    atmosphere: dict
+    directions: np.ndarray
+    speeds: np.ndarray
+    wind_ti: np.ndarray
+    optimizer_kwargs: dict
+
+
+def _chunk_of(conditions, rows, study, optimizer_kwargs) -> _Chunk:
+    index = conditions.wind_index[rows]
+    return _Chunk(conditions.atmosphere_of(rows), study["directions"][index],
+                  study["speeds"][index], study["wind_ti"][index],
+                  _rows_of(optimizer_kwargs, index))
+
+
+def _run_chunk(template, model, chunk, ti_source, optimizer_class) -> dict:
+    """Farm powers (baseline and steered), optima and inflow of one chunk, on ``template`` set
+    to the chunk's conditions (one model build)."""
+    case = _chunk_model(template, model, chunk, ti_source)
+    flow_field = case.core.flow_field
+    n = chunk.speeds.size
+    out = {"turbulence_intensities": flow_field.turbulence_intensities.copy(),
+           "wind_veer": np.full(n, float(flow_field.wind_veer)),
+           "wind_shear": np.full(n, float(flow_field.wind_shear)),
+           "steered": None, "optima": None}
+    case.run()
+    out["baseline"] = np.sum(case.get_turbine_powers(), axis=1)
+    if optimizer_class is not None:
+        df_opt = optimize_yaw(case, optimizer_class, progress=False, **chunk.optimizer_kwargs)
+        case.set(yaw_angles=np.vstack(df_opt["yaw_angles_opt"]))
         case.run()
-        out["baseline"].append(np.sum(case.get_turbine_powers(), axis=1))
-        if optimizer_class is not None:
-            df_opt = optimize_yaw(case, optimizer_class, progress=False, **_rows_of(
-                optimizer_kwargs, conditions.wind_index[rows]))
-            case.set(yaw_angles=np.vstack(df_opt["yaw_angles_opt"]))
-            case.run()
-            out["steered"].append(np.sum(case.get_turbine_powers(), axis=1))
-            out["optima"].append(df_opt)
-            # FLORIS's set() keeps non-zero yaw angles: the next chunk's baseline is unyawed.
-            case.reset_operation()
-        bar.update(rows.size)
-    return {k: (pd.concat(v, ignore_index=True) if k == "optima" else np.concatenate(v))
-            if v else None for k, v in out.items()}
+        out["steered"] = np.sum(case.get_turbine_powers(), axis=1)
+        out["optima"] = df_opt
+        # FLORIS's set() keeps non-zero yaw angles: the next chunk's baseline is unyawed.
+        case.reset_operation()
+    return out
+
+
+def _run_on_cluster(client, template, model, chunks, ti_source, optimizer_class, bar) -> list:
+    """:func:`_run_chunk` of every chunk as a task on the Dask cluster of ``client``; the results
+    in the chunks' order, the workers' warnings reported here once (floris_ekman_veer.warnings)."""
+    from distributed import as_completed
+
+    import floris_ekman_veer.warnings as package_warnings
+
+    config = template.core.as_dict()
+    # The workers set every chunk's conditions and atmosphere: the template's own (possibly a
+    # year of per-record lists) need not travel.
+    config["flow_field"].update(wind_directions=[], wind_speeds=[], turbulence_intensities=[])
+    block = config["wake"]["wake_velocity_parameters"].get(PARAMETER_BLOCK)
+    if block is not None:
+        block.pop(ATMOSPHERE_KEY, None)
+    [config] = client.scatter([config], broadcast=True)
+    futures = client.map(_remote_chunk, chunks, config=config, model=model, ti_source=ti_source,
+                         optimizer_class=optimizer_class,
+                         setting=package_warnings.warnings_setting(), pure=False)
+    sizes = {future.key: chunk.speeds.size for future, chunk in zip(futures, chunks)}
+    package_warnings.discard_from_workers()
+    for future in as_completed(futures):
+        bar.update(sizes[future.key])
+    results = client.gather(futures)
+    package_warnings.report_from_workers(sum(sizes.values()))
+    return [part for part, _ in results]
+
+
+def _remote_chunk(chunk, config, model, ti_source, optimizer_class, setting):
+    """A chunk on a Dask worker: the template rebuilt there with the chunk's conditions (a plain
+    FlorisModel), then :func:`_run_chunk` as in the serial study; the package's warnings travel
+    back with the result."""
+    import copy
+
+    from floris import FlorisModel
+
+    import floris_ekman_veer.warnings as package_warnings
+    from floris_ekman_veer.coupling.parallel import prepare_worker
+
+    prepare_worker()
+    package_warnings.apply_setting(setting)
+    config = copy.deepcopy(config)
+    config["flow_field"].update(wind_directions=chunk.directions.tolist(),
+                                wind_speeds=chunk.speeds.tolist(),
+                                turbulence_intensities=chunk.wind_ti.tolist())
+    parameters = config["wake"]["wake_velocity_parameters"]
+    parameters.setdefault(PARAMETER_BLOCK, {})[ATMOSPHERE_KEY] = dict(chunk.atmosphere)
+    with package_warnings.collecting() as records:
+        part = _run_chunk(FlorisModel(config), model, chunk, ti_source, optimizer_class)
+    return part, package_warnings.WorkerRecords(records) if records else None
 
 
 def _rows_of(optimizer_kwargs, index):
@@ -490,23 +611,24 @@ def _rows_of(optimizer_kwargs, index):
             for name, value in optimizer_kwargs.items()}
 
 
-def _chunk_model(template, model: str, conditions, rows, study):
-    """``template`` set to the conditions ``rows`` of ``conditions``, each with its atmosphere,
-    and the inflow scalars of the comparison (:func:`comparison_set_kwargs`): one model build."""
-    index = conditions.wind_index[rows]
-    atmosphere = conditions.atmosphere_of(rows)
-    speeds = study["speeds"][index]
-    kwargs = dict(wind_directions=study["directions"][index], wind_speeds=speeds,
-                  turbulence_intensities=study["wind_ti"][index])
-    if study["turbulence_intensities"] == "atmosphere" or model != MODEL_NAME:
+def _chunk_model(template, model: str, chunk: _Chunk, ti_source: str):
+    """``template`` set to the chunk's conditions, each with its atmosphere, and the inflow
+    scalars of the comparison (:func:`comparison_set_kwargs`): one model build and one ABL solve
+    (the comparison solves the ABL as the model's inflow hook does, so the build finds it in the
+    solve cache)."""
+    kwargs = dict(wind_directions=chunk.directions, wind_speeds=chunk.speeds,
+                  turbulence_intensities=chunk.wind_ti)
+    if ti_source == "atmosphere" or model != MODEL_NAME:
         farm = template.core.farm
+        spec = attrs.evolve(AtmosphereSpec.from_mapping(chunk.atmosphere),
+                            rest_below=zero_power_speed(farm.turbine_definitions))
         fair = comparison_set_kwargs(
-            atmosphere, speeds, template.core.flow_field.reference_wind_height,
+            spec, chunk.speeds, template.core.flow_field.reference_wind_height,
             float(farm.hub_heights.reshape(-1, farm.n_turbines)[0, 0]),
             float(farm.rotor_diameters.reshape(-1, farm.n_turbines)[0, 0]))
-        if study["turbulence_intensities"] == "atmosphere":
+        if ti_source == "atmosphere":
             kwargs["turbulence_intensities"] = fair["turbulence_intensities"]
         if model != MODEL_NAME:  # only FLORIS's built-ins read wind_veer
             kwargs["wind_veer"] = fair["wind_veer"]
-    set_atmosphere(template, atmosphere, **kwargs)
+    set_atmosphere(template, chunk.atmosphere, **kwargs)
     return template

@@ -152,7 +152,9 @@ class SiteAtmosphere:
 
     def annual_energy(self, fmodel, optimizer_class=None, **options):
         """:func:`~floris_ekman_veer.annual_energy` of ``fmodel`` for these records, each record
-        with its fitted atmosphere (``options``: annual_energy's and the optimiser's).
+        with its fitted atmosphere (``options``: annual_energy's and the optimiser's;
+        ``client=`` a ``dask.distributed.Client`` runs the chunks on its cluster, bitwise the
+        serial numbers, docs/coupling.md#annual-energy).
 
         The classes are those of :meth:`stability`; the records run as chunks of one vectorised
         FLORIS model each, with the per-record atmosphere block (as :meth:`apply`), never a
