@@ -740,9 +740,12 @@ class EkmanABL:
         # z = h gives eta = 1 exactly: sqrt(1 - eta) would turn round-off into ~1e-8 of U.
         eta = np.minimum(z / self.boundary_layer_height, 1.0)
         g, dg = stress_shape(eta, h_hat, self.c_g, self.stress_decay)
-        stress = (1.0 - eta) ** 1.5
+        # 1 - eta and its root once (U and V both take them: the same numbers, fewer passes).
+        depth = 1.0 - eta
+        stress = depth**1.5
+        depth_root = np.sqrt(depth)
         u_g = self.geostrophic_components[0]
-        ekman_u = -dg * stress + 1.5 * g / h_hat * np.sqrt(1.0 - eta) + u_g / u_star
+        ekman_u = -dg * stress + 1.5 * g / h_hat * depth_root + u_g / u_star
         surface_u = (
             np.log(xi / xi0) / self.von_karman
             + stability_term(self.stability_parameter, xi, xi0, self.von_karman,
@@ -755,7 +758,7 @@ class EkmanABL:
         real = one_minus_g2 > 0
         root = np.sqrt(np.where(real, one_minus_g2, 1.0))
         # kappa V_g/u* = -B = -3 kappa/(2 h_hat): writing V_g through B makes V(0) = 0 exact.
-        veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * np.sqrt(1.0 - eta) - 1.0)
+        veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * depth_root - 1.0)
         v = self._hemisphere * u_star * np.where(real, veer_terms, -1.5 / h_hat)
         return u * scale, v * scale
 
@@ -767,15 +770,22 @@ class EkmanABL:
         u, v = self._velocity(self._direction_heights(z, name))
         return np.rad2deg(np.arctan2(v, u))
 
-    def hub_aligned_velocity(self, z, reference_height):
+    def hub_frame(self, reference_height):
+        """(cos a, sin a) of the wind's angle a at ``reference_height`` (> 0) in the
+        surface-stress frame: the rotation of :meth:`hub_aligned_velocity`, to compute once for
+        many evaluations at the same reference height."""
+        u_ref, v_ref = self._velocity(self._direction_heights(reference_height, "reference_height"))
+        speed = np.hypot(u_ref, v_ref)
+        return u_ref / speed, v_ref / speed
+
+    def hub_aligned_velocity(self, z, reference_height, frame=None):
         """(U, V)(z) rotated so that V(reference_height) = 0 and U(reference_height) > 0.
 
         This is the frame of the wake model (docs/conventions.md#hub-aligned-frame): x along the
-        wind at hub height. Heights z >= 0; reference_height > 0.
+        wind at hub height. Heights z >= 0; reference_height > 0. ``frame``: the rotation
+        :meth:`hub_frame` gives for ``reference_height`` (then not computed again).
         """
-        u_ref, v_ref = self._velocity(self._direction_heights(reference_height, "reference_height"))
-        speed = np.hypot(u_ref, v_ref)
-        cos_a, sin_a = u_ref / speed, v_ref / speed
+        cos_a, sin_a = self.hub_frame(reference_height) if frame is None else frame
         u, v = self.velocity(z)
         return u * cos_a + v * sin_a, v * cos_a - u * sin_a
 

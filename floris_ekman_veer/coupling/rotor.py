@@ -257,7 +257,39 @@ def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
     segment sum per condition, not a matrix product, so that a condition's numbers do not
     depend on how many others share its batch (BLAS blocks a product by its size)."""
     row, weight, start = cells.row_cells
-    return np.add.reduceat(values[..., row] * weight, start, axis=-1)
+    weighted = np.take(values, row, axis=-1)
+    weighted *= weight
+    return np.add.reduceat(weighted, start, axis=-1)
+
+
+#: Conditions per piece of :func:`_cell_means_by_rows`: the piece's gathered rows (a few hundred
+#: (cell, row) pairs each) stay in cache.
+_CELL_PIECE = 128
+
+
+def _cell_means_by_rows(u, index, moment: float, cells: RotorCells) -> np.ndarray:
+    """:func:`cell_mean`'s <U^m>_k^(1/m), (n_findex, n^2), from U held by height: ``u``
+    (heights, n_findex), ``index`` (rows,) the height of each sub-point row.
+
+    The same numbers as :func:`cell_mean` of the rows (n_findex, rows): the same powers,
+    products and quotients elementwise, and each cell's segment of (cell, row) pairs summed by
+    numpy's ``add.reduceat``, whose pairwise sum runs along the segment whatever axis holds it.
+    Done a piece of conditions at a time, so that the cubes and the gathered rows stay in cache.
+    """
+    row, weight, start = cells.row_cells
+    rows_of_pairs = index[row]
+    weight = weight[:, None]
+    n_findex = u.shape[1]
+    sums = np.empty((start.size, n_findex))
+    for c in range(0, n_findex, _CELL_PIECE):
+        values = u[:, c:c + _CELL_PIECE]
+        if moment != 1.0:
+            values = values**3
+        weighted = np.take(values, rows_of_pairs, axis=0)
+        weighted *= weight
+        sums[:, c:c + _CELL_PIECE] = np.add.reduceat(weighted, start, axis=0)
+    mean = sums.T / cells.area
+    return mean if moment == 1.0 else np.cbrt(mean)
 
 
 def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.ndarray:
@@ -495,10 +527,10 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
     """u_initial of a FLORIS turbine grid: U_k = <U^m>_k^(1/m) over each rotor cell (m of
     :func:`sorted_moments`).
 
-    ``profile(z)`` returns the inflow U (one output) at heights ``z`` (1, 1, 1, heights).
-    Returns (n_findex, n_turbines, n, n). The cells are averaged once per distinct (hub height,
-    radius, m) of the farm and gathered to the turbines, so the work and memory do not grow
-    with the number of turbines.
+    ``profile(heights)`` returns the inflow U at 1-D ``heights`` for every condition,
+    (heights, n_findex) (or (heights, 1): the same for all). Returns (n_findex, n_turbines,
+    n, n). The cells are averaged once per distinct (hub height, radius, m) of the farm and
+    gathered to the turbines, so the work and memory do not grow with the number of turbines.
     """
     cells = rotor_cells(grid.grid_resolution, AMBIENT_ROWS, AMBIENT_NODES)
     order = grid.sorted_indices[:, :, 0, 0]
@@ -511,8 +543,11 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
                                return_inverse=True)
     heights = kinds[:, :1] + kinds[:, 1:2] * cells.row_z  # (kinds, rows)
     distinct, inverse = np.unique(heights, return_inverse=True)
+    inverse = inverse.reshape(heights.shape)
     n_findex = order.shape[0]
-    u = np.broadcast_to(profile(distinct.reshape(1, 1, 1, -1)), (n_findex, 1, 1, distinct.size))
-    u_rows = u.reshape(n_findex, -1)[:, inverse.reshape(heights.shape)]  # (n_findex, kinds, rows)
-    means = cell_mean(u_rows, kinds[:, 2], cells)  # (n_findex, kinds, n, n)
-    return means[np.arange(n_findex)[:, None], kind_of.ravel()[order]]
+    u = np.broadcast_to(profile(distinct), (distinct.size, n_findex))
+    means = np.empty((n_findex, len(kinds), cells.n**2))
+    for k, moment in enumerate(kinds[:, 2]):
+        means[:, k] = _cell_means_by_rows(u, inverse[k], moment, cells)
+    means = means.reshape(n_findex, len(kinds), cells.n, cells.n)
+    return np.take_along_axis(means, kind_of.ravel()[order][:, :, None, None], axis=1)
