@@ -645,6 +645,9 @@ def _with_core_atmosphere(method):
             stack.enter_context(package_warnings.run_scope(self.flow_field.wind_speeds,
                                                            self.flow_field.reference_wind_height))
             rest = stack.enter_context(_at_rest(self, atmosphere))
+            if method.__name__ != "steady_state_atmospheric_condition":
+                # (run() initialises the domain first: said there, once)
+                warn_shallow(self, atmosphere)
             for make in CORE_CONTEXTS:
                 stack.enter_context(make(self))
             result = method(self, *args, **kwargs)
@@ -720,25 +723,54 @@ def _validating_post_init(method):
     return wrapper
 
 
-def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
-    """At build: the shallow-boundary-layer check (coupling/shallow.py), hubs in the roughness
-    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
-    from floris_ekman_veer.coupling import shallow
-
-    flow_field = core.flow_field
-    height = flow_field.reference_wind_height
+def _reference_height(core: Core) -> float | None:
+    """The Core's reference wind height, FLORIS's "use the hub height" sentinel (-1, which
+    FlorisModel replaces without a rebuild) read as the hub height; None where FLORIS refuses
+    the sentinel (several hub heights)."""
+    height = core.flow_field.reference_wind_height
     if abs(height + 1.0) < 1e-6:
-        # FLORIS's "use the hub height" sentinel, which FlorisModel replaces without a rebuild.
         hubs = np.unique(core.farm.hub_heights)
         if hubs.size != 1:
-            return  # FLORIS refuses it
+            return None
         height = float(hubs[0])
-    abl = solve(spec, flow_field.wind_speeds, height)
+    return height
+
+
+def _check_shallow(core: Core, abl, height: float, stage: str) -> None:
+    from floris_ekman_veer.coupling import shallow
+
     shallow.check_rotor_inside(
         core.wake.wake_velocity_parameters.get(PARAMETER_BLOCK),
         np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1)),
-        flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+        core.flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+        stage=stage,
     )
+
+
+def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
+    """Count a Core's conditions whose boundary layer is shallower than a rotor top in one
+    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` (coupling/shallow.py), at
+    the user's run: every Core solve, the ParFlorisModel parent before its workers (sent with
+    the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
+    Core's atmosphere, if known (else read)."""
+    spec = atmosphere_of(core) if spec is None else spec
+    if spec is None or not core.flow_field.n_findex:
+        return
+    height = _reference_height(core)
+    if height is not None:
+        _check_shallow(core, solve(spec, core.flow_field.wind_speeds, height), height, "run")
+
+
+def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
+    """At build: the shallow-boundary-layer policy ``raise`` (coupling/shallow.py; ``warn``
+    counts them at the first run instead, :func:`warn_shallow`), hubs in the roughness
+    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
+    flow_field = core.flow_field
+    height = _reference_height(core)
+    if height is None:
+        return  # FLORIS refuses it
+    abl = solve(spec, flow_field.wind_speeds, height)
+    _check_shallow(core, abl, height, "build")
     sublayer = np.max(np.where(abl.at_rest, 0.0, np.reshape(abl.roughness_sublayer_height, -1)))
     low = np.flatnonzero(np.asarray(core.farm.hub_heights, dtype=float) < sublayer)
     if low.size:
