@@ -731,9 +731,13 @@ class EkmanABL:
     def _velocity(self, z):
         u_star, h_hat = self.friction_velocity, self.h_hat
         z_s = self.roughness_sublayer_height
-        sublayer = z < z_s
-        scale = np.where(sublayer, z / z_s, 1.0)
-        z = np.where(sublayer, z_s, z)
+        # Heights all above every condition's sublayer (rotor heights): scale 1, nothing to
+        # replace (u * 1.0 is u exactly), without the full-size mask and quotient.
+        scale = None
+        if not np.min(z, initial=np.inf) >= np.max(z_s):
+            sublayer = z < z_s
+            scale = np.where(sublayer, z / z_s, 1.0)
+            z = np.where(sublayer, z_s, z)
         xi = z * self._f / u_star
         xi0 = self.roughness_length * self._f / u_star
         # z/h; the profile formulas live on [0, h]. Taken as z/h (not xi/h_hat) so that
@@ -760,7 +764,7 @@ class EkmanABL:
         # kappa V_g/u* = -B = -3 kappa/(2 h_hat): writing V_g through B makes V(0) = 0 exact.
         veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * depth_root - 1.0)
         v = self._hemisphere * u_star * np.where(real, veer_terms, -1.5 / h_hat)
-        return u * scale, v * scale
+        return (u, v) if scale is None else (u * scale, v * scale)
 
     def wind_angle(self, z):
         """Mathematical flow angle atan2(V, U) [deg] in the surface-stress frame (z > 0)."""
