@@ -749,21 +749,29 @@ class EkmanABL:
         stress = depth**1.5
         depth_root = np.sqrt(depth)
         u_g = self.geostrophic_components[0]
-        ekman_u = -dg * stress + 1.5 * g / h_hat * depth_root + u_g / u_star
-        surface_u = (
-            np.log(xi / xi0) / self.von_karman
-            + stability_term(self.stability_parameter, xi, xi0, self.von_karman,
-                             self.businger_dyer_gamma)
-            + 0.3 * self.zilitinkevich_number * (xi - xi0)
-        )
-        u = np.where(eta <= self.matching_fraction, surface_u, ekman_u) * u_star
+        # The sums below are accumulated in place, term by term in the order written
+        # (-dg stress + 1.5 g / h_hat sqrt(1 - eta) + U_g/u*): the same roundings, fewer arrays.
+        ekman_u = -dg * stress
+        ekman_u += 1.5 * g / h_hat * depth_root
+        ekman_u += u_g / u_star
+        surface_u = np.log(xi / xi0)
+        surface_u /= self.von_karman
+        surface_u += stability_term(self.stability_parameter, xi, xi0, self.von_karman,
+                                    self.businger_dyer_gamma)
+        surface_u += 0.3 * self.zilitinkevich_number * (xi - xi0)
+        u = np.where(eta <= self.matching_fraction, surface_u, ekman_u)
+        u *= u_star
 
         one_minus_g2 = 1.0 - g**2
         real = one_minus_g2 > 0
-        root = np.sqrt(np.where(real, one_minus_g2, 1.0))
+        # (g < 1 everywhere but within 0.3 % of h below the top: no masking needed there)
+        everywhere = bool(np.all(real))
+        root = np.sqrt(one_minus_g2 if everywhere else np.where(real, one_minus_g2, 1.0))
         # kappa V_g/u* = -B = -3 kappa/(2 h_hat): writing V_g through B makes V(0) = 0 exact.
-        veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * depth_root - 1.0)
-        v = self._hemisphere * u_star * np.where(real, veer_terms, -1.5 / h_hat)
+        veer_terms = g * dg / root * stress
+        veer_terms += 1.5 / h_hat * (root * depth_root - 1.0)
+        v = self._hemisphere * u_star * (veer_terms if everywhere
+                                         else np.where(real, veer_terms, -1.5 / h_hat))
         return (u, v) if scale is None else (u * scale, v * scale)
 
     def wind_angle(self, z):
