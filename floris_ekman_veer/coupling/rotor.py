@@ -262,18 +262,19 @@ def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
     return np.add.reduceat(weighted, start, axis=-1)
 
 
-#: Conditions per piece of :func:`_cell_means_by_rows`: the piece's gathered rows (a few hundred
-#: (cell, row) pairs each) stay in cache.
+#: Conditions per piece of :func:`cell_mean`: the piece's gathered rows (a few hundred (cell,
+#: row) pairs each) stay in cache.
 _CELL_PIECE = 128
 
 
-def _cell_means_by_rows(u, index, moment: float, cells: RotorCells) -> np.ndarray:
-    """:func:`cell_mean`'s <U^m>_k^(1/m), (n_findex, n^2), from U held by height: ``u``
-    (heights, n_findex), ``index`` (rows,) the height of each sub-point row.
+def cell_mean(u, index, moment: float, cells: RotorCells) -> np.ndarray:
+    """<U^m>_k^(1/m) of each cell, (n_findex, n^2) in FLORIS's point order, from U held by
+    height (U depends on height only): ``u`` (heights, n_findex), ``index`` (rows,) the height
+    of each sub-point row, ``moment`` m (1 or 3).
 
-    The same numbers as :func:`cell_mean` of the rows (n_findex, rows): the same powers,
-    products and quotients elementwise, and each cell's segment of (cell, row) pairs summed by
-    numpy's ``add.reduceat``, whose pairwise sum runs along the segment whatever axis holds it.
+    Each cell's sum over its (cell, row) pairs is numpy's ``add.reduceat`` segment, as in
+    :func:`row_cell_sums` of the rows (n_findex, rows): its pairwise sum runs along the segment
+    whatever axis holds it, so the numbers are those of :func:`row_cell_sums` bit for bit.
     Done a piece of conditions at a time, so that the cubes and the gathered rows stay in cache.
     """
     row, weight, start = cells.row_cells
@@ -290,19 +291,6 @@ def _cell_means_by_rows(u, index, moment: float, cells: RotorCells) -> np.ndarra
         sums[:, c:c + _CELL_PIECE] = np.add.reduceat(weighted, start, axis=0)
     mean = sums.T / cells.area
     return mean if moment == 1.0 else np.cbrt(mean)
-
-
-def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.ndarray:
-    """<U^m>_k^(1/m) of each cell from U at the sub-point rows (U depends on height only).
-
-    ``u_rows``: (..., rows); ``moment`` m (1 or 3) broadcasting against ``u_rows[..., 0]``.
-    Returns (..., n, n) in FLORIS's point order.
-    """
-    moment = np.asarray(moment)[..., None]
-    powers = np.where(moment == 1.0, u_rows, u_rows**3)
-    mean = row_cell_sums(powers, cells) / cells.area
-    mean = np.where(moment == 1.0, mean, np.cbrt(mean))
-    return mean.reshape(*u_rows.shape[:-1], cells.n, cells.n)
 
 
 def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
@@ -548,6 +536,6 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
     u = np.broadcast_to(profile(distinct), (distinct.size, n_findex))
     means = np.empty((n_findex, len(kinds), cells.n**2))
     for k, moment in enumerate(kinds[:, 2]):
-        means[:, k] = _cell_means_by_rows(u, inverse[k], moment, cells)
+        means[:, k] = cell_mean(u, inverse[k], moment, cells)
     means = means.reshape(n_findex, len(kinds), cells.n, cells.n)
     return np.take_along_axis(means, kind_of.ravel()[order][:, :, None, None], axis=1)
