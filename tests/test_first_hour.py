@@ -129,23 +129,56 @@ def test_every_warning_class_is_importable_from_the_package():
 
 
 def test_shallow_warning_at_the_users_line_once_per_study_with_a_summary():
+    """Building and set() say nothing; the first run counts the model's shallow conditions at
+    the user's line, in its own numbers (the optimiser's tiled copies add nothing); later runs
+    of the same conditions say nothing new."""
     from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
     with caught() as records:
-        fmodel = FlorisModel(FARM)  # BUILD-LINE
-        fmodel.set(wind_directions=[270.0] * 5, wind_speeds=[6.0, 7.0, 8.0, 9.0, 11.0],  # SET-LINE
+        fmodel = FlorisModel(FARM)
+        fmodel.set(wind_directions=[270.0] * 5, wind_speeds=[6.0, 7.0, 8.0, 9.0, 11.0],
                    turbulence_intensities=[0.06] * 5)
-        YawOptimizationSR(fmodel, minimum_yaw_angle=-10.0, maximum_yaw_angle=10.0,
+        assert not of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
+        YawOptimizationSR(fmodel, minimum_yaw_angle=-10.0, maximum_yaw_angle=10.0,  # OPT-LINE
                           Ny_passes=[3, 2]).optimize(print_progress=False)
         fmodel.set(wind_speeds=[9.0, 8.0, 7.0, 6.0, 11.0])  # same conditions: nothing new
+        fmodel.run()
     shallow_records = of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
     assert [(r.filename, r.lineno) for r in shallow_records] == [
-        (__file__, line_of("# BUILD" "-LINE")), (__file__, line_of("# SET" "-LINE"))]
-    # the build's 9 m/s first, then the set's new speeds, summarised with the 9 m/s
+        (__file__, line_of("# OPT" "-LINE"))]
     assert str(shallow_records[0].message).startswith(
-        "1 of 1 conditions (wind speeds 9 m/s at 90 m; h = 125.4 m)")
-    assert str(shallow_records[1].message).startswith(
         "4 of 5 conditions (wind speeds 6, 7, 8 and 9 m/s at 90 m; h = 90.11 to 125.4 m)")
+
+
+def test_every_shipped_input_builds_without_a_warning():
+    """No shipped input warns before the user's own set() or run() (farm_sbl6's placeholder
+    9 m/s condition has a boundary layer shallower than the rotor top: counted at its run)."""
+    names = sorted(p.stem for p in (REPO / "inputs").glob("*.yaml"))
+    assert "farm_sbl6" in names
+    for name in names:
+        with caught() as records:
+            fmodel = FlorisModel(floris_ekman_veer.example_input(name))
+        assert not of(records, floris_ekman_veer.FlorisEkmanVeerWarning), name
+    with caught() as records:
+        fmodel = FlorisModel(FARM)
+        fmodel.run()  # RUN-SBL6
+    (record,) = of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
+    assert (record.filename, record.lineno) == (__file__, line_of("# RUN" "-SBL6"))
+    assert str(record.message).startswith("1 of 1 conditions (wind speeds 9 m/s at 90 m")
+
+
+def test_optimize_yaw_counts_the_shallow_conditions_once_at_its_start():
+    from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+
+    fmodel = FlorisModel(FARM)
+    fmodel.set(wind_directions=[270.0, 280.0, 270.0], wind_speeds=[8.0, 9.0, 12.0],
+               turbulence_intensities=[0.06] * 3)
+    with caught() as records:
+        floris_ekman_veer.optimize_yaw(fmodel, YawOptimizationSR, minimum_yaw_angle=-10.0,  # YAW
+                                       maximum_yaw_angle=10.0, Ny_passes=[3, 2], progress=False)
+    (record,) = of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
+    assert (record.filename, record.lineno) == (__file__, line_of("# YAW"))
+    assert str(record.message).startswith("2 of 3 conditions (wind speeds 8 and 9 m/s at 90 m")
 
 
 def test_thrust_limit_warning_once_per_run_naming_the_speeds():
@@ -211,6 +244,12 @@ def test_parallel_chunks_do_not_repeat_the_shallow_warning():
     fmodel.set(wind_speeds=[8.0, 9.0, 11.0, 12.0], wind_directions=[270.0] * 4,
                turbulence_intensities=[0.06] * 4)
     par = ParFlorisModel(fmodel, interface="multiprocessing", max_workers=2)
+    with caught() as records:
+        par.run()  # PAR-RUN
+    # the parent counts all its conditions once, at the user's line
+    (record,) = of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
+    assert (record.filename, record.lineno) == (__file__, line_of("# PAR" "-RUN"))
+    assert str(record.message).startswith("2 of 4 conditions (wind speeds 8 and 9 m/s at 90 m")
     chunks = par._preprocessing()
     assert len(chunks) == 2
     for fmodel_dict, _ in chunks:

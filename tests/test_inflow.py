@@ -570,8 +570,10 @@ def test_velocity_deficit_profiles_use_the_inflow():
 
 def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
     """The rotor cells' rows of heights for many conditions are evaluated a few heights at a time
-    (inflow._PROFILE_PIECE): elementwise in height, the pieces give the same bits, stable and
-    convective alike, below the ground included."""
+    with the conditions innermost (inflow.ambient_rows, inflow._PROFILE_PIECE): elementwise in
+    height and condition, the pieces give the same bits as one evaluation, stable and
+    convective alike, below the ground included; ambient_velocity gives them in FLORIS's
+    layout."""
     from floris_ekman_veer import EkmanABL
     from floris_ekman_veer.coupling import inflow
 
@@ -580,9 +582,30 @@ def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
     for stability in ({"obukhov_length": 100.0}, {"obukhov_length": -50.0}):
         abl = EkmanABL.from_reference_wind(speeds, 90.0, latitude=52.0, roughness_length=0.1,
                                            **stability)
-        pieces = inflow._ambient_velocity(abl, z, 90.0)
         assert speeds.size * z.size > 2 * inflow._PROFILE_PIECE  # evaluated in pieces
+        rows = inflow.ambient_rows(abl, z.reshape(-1), 90.0)
+        pieces = inflow.ambient_velocity(abl, z, 90.0)
         whole = abl.hub_aligned_velocity(np.maximum(z, 0.0), 90.0)
-        for piece, one, name in zip(pieces, whole, "UV"):
+        for row, piece, one, name in zip(rows, pieces, whole, "UV"):
+            assert row.shape == (z.size, speeds.size) and piece.shape == one.shape
+            np.testing.assert_array_equal(row.T, piece.reshape(speeds.size, -1), err_msg=name)
             np.testing.assert_array_equal(piece[..., 1:], one[..., 1:], err_msg=name)
             assert np.all(piece[..., 0] == 0.0)  # below the ground
+
+
+def test_profile_pieces_of_one_height_for_more_conditions_than_a_piece(monkeypatch):
+    """More conditions than a piece holds (n_findex > 2 _PROFILE_PIECE: 131,072 hourly records
+    with the shipped piece) go one height per piece, the same bits; the pieces once split
+    themselves again without end (RecursionError)."""
+    from floris_ekman_veer import EkmanABL
+    from floris_ekman_veer.coupling import inflow
+
+    monkeypatch.setattr(inflow, "_PROFILE_PIECE", 8)
+    speeds = np.random.default_rng(1).uniform(3.0, 20.0, 40).reshape(-1, 1, 1, 1)
+    z = np.linspace(20.0, 160.0, 5).reshape(1, 1, 1, -1)
+    abl = EkmanABL.from_reference_wind(speeds, 90.0, latitude=52.0, roughness_length=0.1,
+                                       obukhov_length=200.0)
+    assert speeds.size > 2 * inflow._PROFILE_PIECE
+    for piece, one in zip(inflow.ambient_velocity(abl, z, 90.0),
+                          abl.hub_aligned_velocity(z, 90.0)):
+        np.testing.assert_array_equal(piece, one)

@@ -189,3 +189,21 @@ def test_cubature_grid_warns_naming_the_turbine_grid():
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         fmodel.run()
+
+
+def test_cell_mean_by_height_is_row_cell_sums_bit_for_bit():
+    """The inflow's cell means, summed with the conditions innermost and a piece of conditions
+    at a time, are the per-condition segment sums of row_cell_sums exactly, for m = 3 and 1,
+    with rows gathered from distinct heights."""
+    from floris_ekman_veer.coupling import rotor
+
+    cells = rotor.rotor_cells(3, rotor.AMBIENT_ROWS, rotor.AMBIENT_NODES)
+    rng = np.random.default_rng(5)
+    heights_u = rng.uniform(4.0, 12.0, (cells.rows + 7, 3 * rotor._CELL_PIECE + 5))
+    index = rng.permutation(cells.rows + 7)[:cells.rows]
+    u_rows = heights_u[index].T  # (n_findex, rows)
+    for moment in (3.0, 1.0):
+        powers = u_rows**3 if moment == 3.0 else u_rows
+        mean = rotor.row_cell_sums(powers, cells) / cells.area
+        expected = np.cbrt(mean) if moment == 3.0 else mean
+        np.testing.assert_array_equal(rotor.cell_mean(heights_u, index, moment, cells), expected)

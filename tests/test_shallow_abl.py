@@ -2,7 +2,7 @@
 
 Every physically valid condition runs: the variance law is continued above h to its zero at
 h exp(B1/A1), so the wake expansion falls continuously to its floor; the conditions are counted
-in a ShallowBoundaryLayerWarning when the model is built, or refused with
+in a ShallowBoundaryLayerWarning at the model's run, or refused when it is built with
 ``wake_velocity_parameters.ekman_veer.shallow_boundary_layer: raise``.
 """
 
@@ -46,11 +46,10 @@ def boundary_layer_height(speed, config):
 def test_wind_rose_3_to_25_ms_runs_with_finite_powers_and_counts_shallow_conditions():
     config = farm_config()
     speeds, directions = np.arange(3.0, 26.0), np.arange(0.0, 360.0, 5.0)
-    with pytest.warns(ShallowBoundaryLayerWarning) as caught:
-        fmodel = FlorisModel(config)  # 9 m/s: h = 125 m, below the rotor top
-        fmodel.set(wind_data=WindRose(wind_directions=directions, wind_speeds=speeds,
-                                      ti_table=0.06))
-    with warnings.catch_warnings():
+    fmodel = FlorisModel(config)  # 9 m/s: h = 125 m, below the rotor top (said at a run)
+    fmodel.set(wind_data=WindRose(wind_directions=directions, wind_speeds=speeds,
+                                  ti_table=0.06))
+    with pytest.warns(ShallowBoundaryLayerWarning) as caught, warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # heavy loading below 4 m/s (README)
         fmodel.run()
     powers = fmodel.get_turbine_powers()
@@ -139,7 +138,7 @@ def test_farm_power_is_continuous_where_h_crosses_the_rotor(height):
         fmodel = FlorisModel(config)
         fmodel.set(wind_speeds=speeds, wind_directions=[270.0] * 2,
                    turbulence_intensities=[0.06] * 2)
-    fmodel.run()
+        fmodel.run()
     powers = fmodel.get_turbine_powers()
     assert np.all(np.isfinite(powers))
     # wake losses (downstream / front) change by far less than a k_w step of 1e-4 would give

@@ -731,33 +731,48 @@ class EkmanABL:
     def _velocity(self, z):
         u_star, h_hat = self.friction_velocity, self.h_hat
         z_s = self.roughness_sublayer_height
-        sublayer = z < z_s
-        scale = np.where(sublayer, z / z_s, 1.0)
-        z = np.where(sublayer, z_s, z)
+        # Heights all above every condition's sublayer (rotor heights): scale 1, nothing to
+        # replace (u * 1.0 is u exactly), without the full-size mask and quotient.
+        scale = None
+        if not np.min(z, initial=np.inf) >= np.max(z_s):
+            sublayer = z < z_s
+            scale = np.where(sublayer, z / z_s, 1.0)
+            z = np.where(sublayer, z_s, z)
         xi = z * self._f / u_star
         xi0 = self.roughness_length * self._f / u_star
         # z/h; the profile formulas live on [0, h]. Taken as z/h (not xi/h_hat) so that
         # z = h gives eta = 1 exactly: sqrt(1 - eta) would turn round-off into ~1e-8 of U.
         eta = np.minimum(z / self.boundary_layer_height, 1.0)
         g, dg = stress_shape(eta, h_hat, self.c_g, self.stress_decay)
-        stress = (1.0 - eta) ** 1.5
+        # 1 - eta and its root once (U and V both take them: the same numbers, fewer passes).
+        depth = 1.0 - eta
+        stress = depth**1.5
+        depth_root = np.sqrt(depth)
         u_g = self.geostrophic_components[0]
-        ekman_u = -dg * stress + 1.5 * g / h_hat * np.sqrt(1.0 - eta) + u_g / u_star
-        surface_u = (
-            np.log(xi / xi0) / self.von_karman
-            + stability_term(self.stability_parameter, xi, xi0, self.von_karman,
-                             self.businger_dyer_gamma)
-            + 0.3 * self.zilitinkevich_number * (xi - xi0)
-        )
-        u = np.where(eta <= self.matching_fraction, surface_u, ekman_u) * u_star
+        # The sums below are accumulated in place, term by term in the order written
+        # (-dg stress + 1.5 g / h_hat sqrt(1 - eta) + U_g/u*): the same roundings, fewer arrays.
+        ekman_u = -dg * stress
+        ekman_u += 1.5 * g / h_hat * depth_root
+        ekman_u += u_g / u_star
+        surface_u = np.log(xi / xi0)
+        surface_u /= self.von_karman
+        surface_u += stability_term(self.stability_parameter, xi, xi0, self.von_karman,
+                                    self.businger_dyer_gamma)
+        surface_u += 0.3 * self.zilitinkevich_number * (xi - xi0)
+        u = np.where(eta <= self.matching_fraction, surface_u, ekman_u)
+        u *= u_star
 
         one_minus_g2 = 1.0 - g**2
         real = one_minus_g2 > 0
-        root = np.sqrt(np.where(real, one_minus_g2, 1.0))
+        # (g < 1 everywhere but within 0.3 % of h below the top: no masking needed there)
+        everywhere = bool(np.all(real))
+        root = np.sqrt(one_minus_g2 if everywhere else np.where(real, one_minus_g2, 1.0))
         # kappa V_g/u* = -B = -3 kappa/(2 h_hat): writing V_g through B makes V(0) = 0 exact.
-        veer_terms = g * dg / root * stress + 1.5 / h_hat * (root * np.sqrt(1.0 - eta) - 1.0)
-        v = self._hemisphere * u_star * np.where(real, veer_terms, -1.5 / h_hat)
-        return u * scale, v * scale
+        veer_terms = g * dg / root * stress
+        veer_terms += 1.5 / h_hat * (root * depth_root - 1.0)
+        v = self._hemisphere * u_star * (veer_terms if everywhere
+                                         else np.where(real, veer_terms, -1.5 / h_hat))
+        return (u, v) if scale is None else (u * scale, v * scale)
 
     def wind_angle(self, z):
         """Mathematical flow angle atan2(V, U) [deg] in the surface-stress frame (z > 0)."""
@@ -767,15 +782,22 @@ class EkmanABL:
         u, v = self._velocity(self._direction_heights(z, name))
         return np.rad2deg(np.arctan2(v, u))
 
-    def hub_aligned_velocity(self, z, reference_height):
+    def hub_frame(self, reference_height):
+        """(cos a, sin a) of the wind's angle a at ``reference_height`` (> 0) in the
+        surface-stress frame: the rotation of :meth:`hub_aligned_velocity`, to compute once for
+        many evaluations at the same reference height."""
+        u_ref, v_ref = self._velocity(self._direction_heights(reference_height, "reference_height"))
+        speed = np.hypot(u_ref, v_ref)
+        return u_ref / speed, v_ref / speed
+
+    def hub_aligned_velocity(self, z, reference_height, frame=None):
         """(U, V)(z) rotated so that V(reference_height) = 0 and U(reference_height) > 0.
 
         This is the frame of the wake model (docs/conventions.md#hub-aligned-frame): x along the
-        wind at hub height. Heights z >= 0; reference_height > 0.
+        wind at hub height. Heights z >= 0; reference_height > 0. ``frame``: the rotation
+        :meth:`hub_frame` gives for ``reference_height`` (then not computed again).
         """
-        u_ref, v_ref = self._velocity(self._direction_heights(reference_height, "reference_height"))
-        speed = np.hypot(u_ref, v_ref)
-        cos_a, sin_a = u_ref / speed, v_ref / speed
+        cos_a, sin_a = self.hub_frame(reference_height) if frame is None else frame
         u, v = self.velocity(z)
         return u * cos_a + v * sin_a, v * cos_a - u * sin_a
 

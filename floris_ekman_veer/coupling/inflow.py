@@ -416,11 +416,29 @@ def _distinct_heights(z: np.ndarray):
 
 
 #: The last few (ABL, heights, reference height) -> (U, V) of :func:`ambient_velocity` on small
-#: height sets: a solve's rotor cells are evaluated for the inflow (coupling/rotor.py) and again
-#: for the crossflow (coupling/yawed_rotor.py) at the same heights.
+#: height sets, and of :func:`ambient_rows`: a solve's rotor cells are evaluated for the inflow
+#: (coupling/rotor.py) and again for the crossflow (coupling/yawed_rotor.py) at the same heights.
 _AMBIENT_CACHE: OrderedDict = OrderedDict()
 _AMBIENT_CACHE_SIZE = 2
 _AMBIENT_CACHED_HEIGHTS = 4096
+_ROWS_CACHE: OrderedDict = OrderedDict()
+
+
+def _cached(cache: OrderedDict, key, abl, compute):
+    """``compute()`` (a pair of arrays, made read-only) under ``key`` for ``abl``, or the pair
+    kept from the last call with the same key and the same ABL instance."""
+    with _SOLVE_LOCK:
+        entry = cache.get(key)
+    if entry is not None and entry[0]() is abl:
+        return entry[1], entry[2]
+    U, V = compute()
+    U.flags.writeable = False
+    V.flags.writeable = False
+    with _SOLVE_LOCK:
+        cache[key] = (weakref.ref(abl), U, V)
+        while len(cache) > _AMBIENT_CACHE_SIZE:
+            cache.popitem(last=False)
+    return U, V
 
 
 def ambient_velocity(abl, z, reference_height: float):
@@ -429,23 +447,18 @@ def ambient_velocity(abl, z, reference_height: float):
     docs/atmosphere.md#roughness-sublayer, so U > 0 for every z > 0), and 0 below the ground
     (z < 0, where FLORIS's power law has no value either). Results for at most
     ``_AMBIENT_CACHED_HEIGHTS`` heights are kept for the next call with the same ABL and heights
-    (read-only arrays)."""
+    (read-only arrays). A row of heights ``(1, 1, 1, heights)`` for many conditions is
+    evaluated by :func:`ambient_rows` (the same numbers)."""
     z = np.asarray(z, dtype=float)
+    n_findex = _row_conditions(abl, z)
+    if n_findex:
+        return tuple(np.ascontiguousarray(values.T).reshape(n_findex, 1, 1, -1)
+                     for values in ambient_rows(abl, z.reshape(-1), reference_height))
     if z.size > _AMBIENT_CACHED_HEIGHTS:
         return _ambient_velocity(abl, z, reference_height)
     key = (id(abl), z.shape, z.tobytes(), float(reference_height))
-    with _SOLVE_LOCK:
-        entry = _AMBIENT_CACHE.get(key)
-    if entry is not None and entry[0]() is abl:
-        return entry[1], entry[2]
-    U, V = _ambient_velocity(abl, z, reference_height)
-    U.flags.writeable = False
-    V.flags.writeable = False
-    with _SOLVE_LOCK:
-        _AMBIENT_CACHE[key] = (weakref.ref(abl), U, V)
-        while len(_AMBIENT_CACHE) > _AMBIENT_CACHE_SIZE:
-            _AMBIENT_CACHE.popitem(last=False)
-    return U, V
+    return _cached(_AMBIENT_CACHE, key, abl,
+                   lambda: _ambient_velocity(abl, z, reference_height))
 
 
 #: Elements of the profile's work arrays per piece: a row of heights for many conditions (the
@@ -454,16 +467,49 @@ def ambient_velocity(abl, z, reference_height: float):
 _PROFILE_PIECE = 1 << 16
 
 
-def _ambient_velocity(abl, z, reference_height: float):
+def _row_conditions(abl, z: np.ndarray) -> int:
+    """n_findex if ``z`` is a row of heights (1, 1, 1, heights) that :func:`ambient_rows`
+    evaluates for an ABL of n_findex conditions (attributes (n_findex, 1, 1, 1)) in pieces,
+    else 0."""
+    shape = np.shape(abl.friction_velocity)
+    if len(shape) != 4 or shape[1:] != (1, 1, 1) or z.ndim != 4 or z.shape[:3] != (1, 1, 1):
+        return 0
+    return shape[0] if shape[0] * z.shape[3] > 2 * _PROFILE_PIECE else 0
+
+
+def ambient_rows(abl, heights, reference_height: float):
+    """:func:`ambient_velocity` at 1-D ``heights`` for every condition of an ABL with
+    attributes (n_findex, 1, 1, 1): (U, V), each (heights, n_findex), read-only, kept for the
+    next call with the same ABL and heights.
+
+    The profile is elementwise in height and condition, so any grouping gives the same bits:
+    it is evaluated ``_PROFILE_PIECE // n_findex`` heights at a time (at least one), with the
+    conditions innermost (numpy's loops then run along the conditions, not along a few heights,
+    and the temporaries stay in cache), the rotation to the hub frame computed once.
+    """
+    heights = np.asarray(heights, dtype=float).reshape(-1)
+    key = (id(abl), heights.tobytes(), float(reference_height))
+    return _cached(_ROWS_CACHE, key, abl, lambda: _rows_velocity(abl, heights, reference_height))
+
+
+def _rows_velocity(abl, heights: np.ndarray, reference_height: float):
     n_findex = int(np.size(abl.friction_velocity))
-    if z.ndim == 4 and z.shape[:3] == (1, 1, 1) and n_findex * z.shape[3] > 2 * _PROFILE_PIECE:
-        # Elementwise in height: the pieces give the same numbers as one evaluation.
-        width = max(1, _PROFILE_PIECE // n_findex)
-        pieces = [_ambient_velocity(abl, z[..., k:k + width], reference_height)
-                  for k in range(0, z.shape[3], width)]
-        return tuple(np.concatenate(parts, axis=-1) for parts in zip(*pieces))
+    frame = abl.hub_frame(reference_height)
+    U, V = np.empty((heights.size, n_findex)), np.empty((heights.size, n_findex))
+    width = max(1, _PROFILE_PIECE // n_findex)
+    for k in range(0, heights.size, width):
+        # (heights, 1, 1, 1, 1) against the ABL's (n_findex, 1, 1, 1): (heights, n_findex, ...)
+        u, v = _ambient_velocity(abl, heights[k:k + width].reshape(-1, 1, 1, 1, 1),
+                                 reference_height, frame)
+        U[k:k + width], V[k:k + width] = u.reshape(-1, n_findex), v.reshape(-1, n_findex)
+    return U, V
+
+
+def _ambient_velocity(abl, z, reference_height: float, frame=None):
     above = z >= 0.0
-    U, V = abl.hub_aligned_velocity(np.where(above, z, 0.0), reference_height)
+    if np.all(above):
+        return abl.hub_aligned_velocity(z, reference_height, frame)
+    U, V = abl.hub_aligned_velocity(np.where(above, z, 0.0), reference_height, frame)
     return np.where(above, U, 0.0), np.where(above, V, 0.0)
 
 
@@ -555,7 +601,7 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
         # Each rotor point carries the cubic mean of U over its rotor cell (coupling/rotor.py).
         # (U alone: the gradient's two extra profile evaluations would be discarded.)
         U = turbine_grid_inflow(
-            lambda z: ambient_velocity(abl, z, self.reference_wind_height)[0], grid
+            lambda heights: ambient_rows(abl, heights, self.reference_wind_height)[0], grid
         )
     shape = self.u_initial_sorted.shape
     if np.any(abl.at_rest):
@@ -599,6 +645,9 @@ def _with_core_atmosphere(method):
             stack.enter_context(package_warnings.run_scope(self.flow_field.wind_speeds,
                                                            self.flow_field.reference_wind_height))
             rest = stack.enter_context(_at_rest(self, atmosphere))
+            if method.__name__ != "steady_state_atmospheric_condition":
+                # (run() initialises the domain first: said there, once)
+                warn_shallow(self, atmosphere)
             for make in CORE_CONTEXTS:
                 stack.enter_context(make(self))
             result = method(self, *args, **kwargs)
@@ -674,25 +723,54 @@ def _validating_post_init(method):
     return wrapper
 
 
-def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
-    """At build: the shallow-boundary-layer check (coupling/shallow.py), hubs in the roughness
-    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
-    from floris_ekman_veer.coupling import shallow
-
-    flow_field = core.flow_field
-    height = flow_field.reference_wind_height
+def _reference_height(core: Core) -> float | None:
+    """The Core's reference wind height, FLORIS's "use the hub height" sentinel (-1, which
+    FlorisModel replaces without a rebuild) read as the hub height; None where FLORIS refuses
+    the sentinel (several hub heights)."""
+    height = core.flow_field.reference_wind_height
     if abs(height + 1.0) < 1e-6:
-        # FLORIS's "use the hub height" sentinel, which FlorisModel replaces without a rebuild.
         hubs = np.unique(core.farm.hub_heights)
         if hubs.size != 1:
-            return  # FLORIS refuses it
+            return None
         height = float(hubs[0])
-    abl = solve(spec, flow_field.wind_speeds, height)
+    return height
+
+
+def _check_shallow(core: Core, abl, height: float, stage: str) -> None:
+    from floris_ekman_veer.coupling import shallow
+
     shallow.check_rotor_inside(
         core.wake.wake_velocity_parameters.get(PARAMETER_BLOCK),
         np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1)),
-        flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+        core.flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+        stage=stage,
     )
+
+
+def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
+    """Count a Core's conditions whose boundary layer is shallower than a rotor top in one
+    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` (coupling/shallow.py), at
+    the user's run: every Core solve, the ParFlorisModel parent before its workers (sent with
+    the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
+    Core's atmosphere, if known (else read)."""
+    spec = atmosphere_of(core) if spec is None else spec
+    if spec is None or not core.flow_field.n_findex:
+        return
+    height = _reference_height(core)
+    if height is not None:
+        _check_shallow(core, solve(spec, core.flow_field.wind_speeds, height), height, "run")
+
+
+def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
+    """At build: the shallow-boundary-layer policy ``raise`` (coupling/shallow.py; ``warn``
+    counts them at the first run instead, :func:`warn_shallow`), hubs in the roughness
+    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
+    flow_field = core.flow_field
+    height = _reference_height(core)
+    if height is None:
+        return  # FLORIS refuses it
+    abl = solve(spec, flow_field.wind_speeds, height)
+    _check_shallow(core, abl, height, "build")
     sublayer = np.max(np.where(abl.at_rest, 0.0, np.reshape(abl.roughness_sublayer_height, -1)))
     low = np.flatnonzero(np.asarray(core.farm.hub_heights, dtype=float) < sublayer)
     if low.size:

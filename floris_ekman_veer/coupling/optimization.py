@@ -26,7 +26,7 @@ import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere
+from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
 from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
 
 #: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
@@ -136,6 +136,9 @@ def optimize_yaw(
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
+    # Its shallow conditions counted once here, at the user's call (the re-built models' runs
+    # below are silenced: they would repeat the count in ever different numbers).
+    warn_shallow(fmodel.core)
     run = functools.partial(_optimize_once, fmodel, progress=progress, chunk_size=chunk_size)
     # A serial refine searches both signs in its one run (BothSignsRefinement); other
     # optimisers are run per sign and refined within a window around each result below.
@@ -491,8 +494,8 @@ def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer
     frames = []
     with tqdm(total=n_findex, desc=f"{optimizer_class.__name__}", unit="condition",
               disable=not progress) as bar, warnings.catch_warnings():
-        # fmodel's own build counted its shallow conditions; the optimiser's many re-builds
-        # (tiled, masked condition sets) would repeat that count in ever different numbers.
+        # optimize_yaw counted fmodel's shallow conditions at its start; the optimiser's many
+        # re-builds (tiled, masked condition sets) would repeat that count in other numbers.
         warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
         for atmosphere, index in runs:
             subset = (row_following_subset(fmodel, index) if atmosphere is ROWS
@@ -767,6 +770,9 @@ def _dispatching_optimize(original):
 
     @functools.wraps(original)
     def wrapper(self, *args, **kwargs):
+        # The model's shallow conditions counted once, in its own numbers: the optimiser's
+        # tiled copies then report nothing new.
+        warn_shallow(self.fmodel.core)
         spec = atmosphere_of(self.fmodel.core)
         if (spec is None or spec.n_conditions is None
                 or "_atmosphere_rows" in self.fmodel.__dict__):  # a row_following_subset

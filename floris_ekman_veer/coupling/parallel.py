@@ -30,6 +30,7 @@ from floris_ekman_veer.coupling.inflow import (
     _patch,
     atmosphere_of,
     install_inflow_hook,
+    warn_shallow,
 )
 
 
@@ -76,7 +77,8 @@ def _splitting_preprocessing(method):
             start = share.stop
             block = fmodel_dict["wake"]["wake_velocity_parameters"].get(PARAMETER_BLOCK)
             if spec is not None and block.get(shallow.POLICY_KEY, "warn") == "warn":
-                # This model's own build has reported its shallow conditions: not again per chunk.
+                # The parent counts its shallow conditions once, at the user's run
+                # (_reporting_parent): not again per chunk.
                 block[shallow.POLICY_KEY] = "ignore"
             if per_condition:
                 flow_field = fmodel_dict["flow_field"]
@@ -109,9 +111,12 @@ def _recording_worker(function):
 
 
 def _reporting_parent(method):
-    """ParFlorisModel.run / _sample_value_at_points: report what the workers recorded."""
+    """ParFlorisModel.run / _sample_value_at_points: count the shallow conditions of all the
+    parent's conditions once (its workers are sent the policy ``ignore``), and report what the
+    workers recorded."""
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
+        warn_shallow(self.core)
         package_warnings.discard_from_workers()
         result = method(self, *args, **kwargs)
         package_warnings.report_from_workers(self.core.flow_field.n_findex)

@@ -257,20 +257,40 @@ def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
     segment sum per condition, not a matrix product, so that a condition's numbers do not
     depend on how many others share its batch (BLAS blocks a product by its size)."""
     row, weight, start = cells.row_cells
-    return np.add.reduceat(values[..., row] * weight, start, axis=-1)
+    weighted = np.take(values, row, axis=-1)
+    weighted *= weight
+    return np.add.reduceat(weighted, start, axis=-1)
 
 
-def cell_mean(u_rows: np.ndarray, moment: np.ndarray, cells: RotorCells) -> np.ndarray:
-    """<U^m>_k^(1/m) of each cell from U at the sub-point rows (U depends on height only).
+#: Conditions per piece of :func:`cell_mean`: the piece's gathered rows (a few hundred (cell,
+#: row) pairs each) stay in cache.
+_CELL_PIECE = 128
 
-    ``u_rows``: (..., rows); ``moment`` m (1 or 3) broadcasting against ``u_rows[..., 0]``.
-    Returns (..., n, n) in FLORIS's point order.
+
+def cell_mean(u, index, moment: float, cells: RotorCells) -> np.ndarray:
+    """<U^m>_k^(1/m) of each cell, (n_findex, n^2) in FLORIS's point order, from U held by
+    height (U depends on height only): ``u`` (heights, n_findex), ``index`` (rows,) the height
+    of each sub-point row, ``moment`` m (1 or 3).
+
+    Each cell's sum over its (cell, row) pairs is numpy's ``add.reduceat`` segment, as in
+    :func:`row_cell_sums` of the rows (n_findex, rows): its pairwise sum runs along the segment
+    whatever axis holds it, so the numbers are those of :func:`row_cell_sums` bit for bit.
+    Done a piece of conditions at a time, so that the cubes and the gathered rows stay in cache.
     """
-    moment = np.asarray(moment)[..., None]
-    powers = np.where(moment == 1.0, u_rows, u_rows**3)
-    mean = row_cell_sums(powers, cells) / cells.area
-    mean = np.where(moment == 1.0, mean, np.cbrt(mean))
-    return mean.reshape(*u_rows.shape[:-1], cells.n, cells.n)
+    row, weight, start = cells.row_cells
+    rows_of_pairs = index[row]
+    weight = weight[:, None]
+    n_findex = u.shape[1]
+    sums = np.empty((start.size, n_findex))
+    for c in range(0, n_findex, _CELL_PIECE):
+        values = u[:, c:c + _CELL_PIECE]
+        if moment != 1.0:
+            values = values**3
+        weighted = np.take(values, rows_of_pairs, axis=0)
+        weighted *= weight
+        sums[:, c:c + _CELL_PIECE] = np.add.reduceat(weighted, start, axis=0)
+    mean = sums.T / cells.area
+    return mean if moment == 1.0 else np.cbrt(mean)
 
 
 def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
@@ -495,10 +515,10 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
     """u_initial of a FLORIS turbine grid: U_k = <U^m>_k^(1/m) over each rotor cell (m of
     :func:`sorted_moments`).
 
-    ``profile(z)`` returns the inflow U (one output) at heights ``z`` (1, 1, 1, heights).
-    Returns (n_findex, n_turbines, n, n). The cells are averaged once per distinct (hub height,
-    radius, m) of the farm and gathered to the turbines, so the work and memory do not grow
-    with the number of turbines.
+    ``profile(heights)`` returns the inflow U at 1-D ``heights`` for every condition,
+    (heights, n_findex) (or (heights, 1): the same for all). Returns (n_findex, n_turbines,
+    n, n). The cells are averaged once per distinct (hub height, radius, m) of the farm and
+    gathered to the turbines, so the work and memory do not grow with the number of turbines.
     """
     cells = rotor_cells(grid.grid_resolution, AMBIENT_ROWS, AMBIENT_NODES)
     order = grid.sorted_indices[:, :, 0, 0]
@@ -511,8 +531,11 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
                                return_inverse=True)
     heights = kinds[:, :1] + kinds[:, 1:2] * cells.row_z  # (kinds, rows)
     distinct, inverse = np.unique(heights, return_inverse=True)
+    inverse = inverse.reshape(heights.shape)
     n_findex = order.shape[0]
-    u = np.broadcast_to(profile(distinct.reshape(1, 1, 1, -1)), (n_findex, 1, 1, distinct.size))
-    u_rows = u.reshape(n_findex, -1)[:, inverse.reshape(heights.shape)]  # (n_findex, kinds, rows)
-    means = cell_mean(u_rows, kinds[:, 2], cells)  # (n_findex, kinds, n, n)
-    return means[np.arange(n_findex)[:, None], kind_of.ravel()[order]]
+    u = np.broadcast_to(profile(distinct), (distinct.size, n_findex))
+    means = np.empty((n_findex, len(kinds), cells.n**2))
+    for k, moment in enumerate(kinds[:, 2]):
+        means[:, k] = cell_mean(u, inverse[k], moment, cells)
+    means = means.reshape(n_findex, len(kinds), cells.n, cells.n)
+    return np.take_along_axis(means, kind_of.ravel()[order][:, :, None, None], axis=1)

@@ -4,8 +4,9 @@ Weak winds under strong stable stratification give boundary layers tens of metre
 3 m/s: h = 47 m under a 90 m hub). The model runs there (docs/atmosphere.md#shallow-boundary-layer):
 the inflow above h is the geostrophic wind and the turbulence of the variance law is continued
 above h to its zero at h exp(B1/A1), so the ``ekman_veer`` wake expansion falls continuously to
-its floor. Those conditions lie outside what the paper validated, so when a model is built
-(its conditions known) they are counted in a :class:`ShallowBoundaryLayerWarning`, or, with::
+its floor. Those conditions lie outside what the paper validated, so at the user's run they are
+counted in a :class:`ShallowBoundaryLayerWarning` (once: building a model, a shipped input
+included, says nothing), or, when the model is built (its conditions known), with::
 
     wake:
       wake_velocity_parameters:
@@ -14,7 +15,8 @@ its floor. Those conditions lie outside what the paper validated, so when a mode
 
 refused with a ValueError naming each such condition's index, wind speed, h and hub height
 (``ignore``: counted silently; the package sends its ParFlorisModel and Dask workers their share
-of conditions with ``ignore``, because the model they came from has said it already). A condition
+of conditions with ``ignore``, because the parent counts all its conditions once, and
+``optimize_yaw`` counts them once at its start, not in each of its re-built models). A condition
 is affected when any rotor's top (hub height + D/2) is above h.
 """
 
@@ -34,6 +36,9 @@ POLICY_PATH = f"wake.wake_velocity_parameters.ekman_veer.{POLICY_KEY}"
 
 _SHOWN = 5  # conditions listed in a message
 
+#: When :func:`check_rotor_inside` is called: a model's build (refuses only) or a run (warns).
+STAGES = ("build", "run")
+
 
 def policy(block: Mapping | None) -> str:
     """The validated policy of an ``ekman_veer`` parameter block ("warn" by default)."""
@@ -45,14 +50,20 @@ def policy(block: Mapping | None) -> str:
 
 def check_rotor_inside(
     block: Mapping | None, boundary_layer_height, wind_speeds, reference_height: float,
-    hub_heights, rotor_diameters,
+    hub_heights, rotor_diameters, *, stage: str,
 ) -> np.ndarray:
     """Warn about (policy "warn") or refuse (policy "raise") conditions with a rotor top above h.
 
     ``boundary_layer_height`` and ``wind_speeds`` per condition; ``hub_heights`` and
-    ``rotor_diameters`` per turbine. Returns the boolean mask of affected conditions.
+    ``rotor_diameters`` per turbine. ``stage``: "build" (a model's build: refuses, never warns,
+    so that building an input says nothing before the user's run) or "run" (warns). Returns the
+    boolean mask of affected conditions.
     """
     mode = policy(block)
+    if stage not in STAGES:
+        raise ValueError(f"check_rotor_inside: stage must be one of {list(STAGES)}; got {stage!r}")
+    if stage == "build" and mode == "warn":
+        mode = "ignore"
     h = np.asarray(boundary_layer_height, dtype=float).reshape(-1)
     speeds = np.broadcast_to(np.asarray(wind_speeds, dtype=float).reshape(-1), h.shape)
     hubs = np.asarray(hub_heights, dtype=float).reshape(-1)
