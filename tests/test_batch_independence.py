@@ -6,8 +6,8 @@ The cells' sums used to follow the batch: the rows a wake reaches were grouped b
 into chunks over all conditions together, and each chunk's rows added into the cells in turn;
 a condition alone (one group) summed its rows in another order than inside a batch (6 of 40
 conditions differed in the last bits, <= 1.3e-15 relative). Now each row's stretches are summed
-per row and added into the cells in row order (coupling/models.py), and the inflow's cell means
-are segment sums, not a BLAS matrix product (coupling/rotor.py).
+per row and added into the cells in row order (plugin/models.py), and the inflow's cell means
+are segment sums, not a BLAS matrix product (plugin/rotor.py).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from floris import FlorisModel
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
-from floris_ekman_veer.coupling import models
+from floris_ekman_veer.plugin import models
 
 FARM = Path(__file__).resolve().parents[1] / "inputs" / "farm_sbl6.yaml"
 

@@ -73,9 +73,9 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
 def test_the_graph_is_read():
     edges = internal_edges()
     # Known edges, so that an empty graph (a broken parser) cannot pass the cycle test.
-    assert "floris_ekman_veer.coupling.inflow" in edges["floris_ekman_veer.coupling.parallel"]
-    assert "floris_ekman_veer.coupling.turbine" in edges["floris_ekman_veer.coupling.registry"]
-    assert "floris_ekman_veer.coupling.registry" in edges[PACKAGE]
+    assert "floris_ekman_veer.plugin.inflow" in edges["floris_ekman_veer.plugin.parallel"]
+    assert "floris_ekman_veer.plugin.turbine" in edges["floris_ekman_veer.registry"]
+    assert "floris_ekman_veer.registry" in edges[PACKAGE]
 
 
 def test_find_cycle_detects_a_cycle():

@@ -1,4 +1,4 @@
-"""The Ekman inflow hook (floris_ekman_veer.coupling.inflow, .parallel)."""
+"""The Ekman inflow hook (floris_ekman_veer.plugin.inflow, .parallel)."""
 
 import copy
 import multiprocessing
@@ -14,7 +14,8 @@ from floris.core.wake_velocity.none import NoneVelocityDeficit
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling import inflow, parallel, registry
+from floris_ekman_veer.plugin import inflow, parallel
+from floris_ekman_veer import registry
 
 from conftest import EXAMPLE_WAKES, STABLE_ATMOSPHERE, make_config
 
@@ -573,7 +574,7 @@ def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
     (inflow._PROFILE_PIECE): elementwise in height, the pieces give the same bits, stable and
     convective alike, below the ground included."""
     from floris_ekman_veer import EkmanABL
-    from floris_ekman_veer.coupling import inflow
+    from floris_ekman_veer.plugin import inflow
 
     speeds = np.random.default_rng(0).uniform(3.0, 20.0, 3000).reshape(-1, 1, 1, 1)
     z = np.concatenate([[-1.0, 0.0, 0.01], np.linspace(1.0, 400.0, 253)]).reshape(1, 1, 1, -1)

@@ -45,7 +45,7 @@ import numpy as np
 
 #: The moment m of the rotor average that each turbine's power and thrust take: FLORIS's power
 #: curves take the cubic mean (m = 3) of the turbine grid; the actuator disk takes the plain
-#: mean of u (m = 1, Eq. Ud, coupling/turbine.py). The cells then carry <U^m>_k^(1/m) and
+#: mean of u (m = 1, Eq. Ud, plugin/turbine.py). The cells then carry <U^m>_k^(1/m) and
 #: deficits that remove the wake's exact share of <u^m> (docs/coupling.md#rotor-average).
 PLAIN_MEAN_OPERATION_MODELS = frozenset({"actuator-disk"})
 

@@ -57,14 +57,14 @@ from floris_ekman_veer.atmosphere.turbulence import (
     streamwise_turbulence_intensity,
     wake_expansion_rate,
 )
-from floris_ekman_veer.coupling.inflow import ambient_velocity, solved_atmosphere
-from floris_ekman_veer.coupling.shallow import POLICIES as SHALLOW_POLICIES
-from floris_ekman_veer.coupling.names import (
+from floris_ekman_veer.plugin.inflow import ambient_velocity, solved_atmosphere
+from floris_ekman_veer.plugin.shallow import POLICIES as SHALLOW_POLICIES
+from floris_ekman_veer.plugin.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
 )
-from floris_ekman_veer.coupling.rotor import (
+from floris_ekman_veer.plugin.rotor import (
     WAKE_MODELS,
     WAKE_OVERLAP_VELOCITY,
     RotorCells,
@@ -184,7 +184,7 @@ class Ambient:
     turbine_y: np.ndarray
     turbine_hub_heights: np.ndarray  # (n_turbines,)
     floris_turbulence: np.ndarray  # FLORIS's ambient turbulence intensity, (n_findex, 1, 1, 1)
-    rotor: RotorAmbient | None = None  # turbine grids: the rotor cells (coupling/rotor.py)
+    rotor: RotorAmbient | None = None  # turbine grids: the rotor cells (plugin/rotor.py)
     #: Cubature grids: points per rotor side N (FLORIS's quadrature of point values), else None.
     cubature_points: int | None = None
     warned: set = field(factory=set)  # resolution warnings already given in this solve
@@ -262,7 +262,7 @@ def is_rotor_grid(grid: Grid) -> bool:
 
 @define(frozen=True)
 class RotorAmbient:
-    """The rotor cells of a turbine grid (coupling/rotor.py) and the ambient at their rows.
+    """The rotor cells of a turbine grid (plugin/rotor.py) and the ambient at their rows.
 
     Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
     radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
@@ -320,7 +320,7 @@ class _EkmanWakeModel(BaseModel):
     """Parameters shared by the velocity models that draw on the Ekman atmosphere."""
 
     #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
-    #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.coupling.inflow.
+    #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.plugin.inflow.
     atmosphere: dict | None = field(default=None)
     A1: float = number_field(TOWNSEND_PERRY_A1, *_POSITIVE)
     B1: float = number_field(TOWNSEND_PERRY_B1, *_NON_NEGATIVE)
@@ -333,7 +333,7 @@ class _EkmanWakeModel(BaseModel):
     wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
-    #: or "raise"; read by the inflow hook when the model is built (coupling/shallow.py).
+    #: or "raise"; read by the inflow hook when the model is built (plugin/shallow.py).
     shallow_boundary_layer: str = choice_field("warn", SHALLOW_POLICIES)
 
     #: Where the block sits in a FLORIS input (error messages name it).
@@ -346,7 +346,7 @@ class _EkmanWakeModel(BaseModel):
 
         ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
         waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
-        coupling/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
+        plugin/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
         ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
         so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
@@ -373,7 +373,7 @@ class _EkmanWakeModel(BaseModel):
         ambient = Ambient.of(grid, flow_field)
         wakes = None
         if ambient.rotor is not None:
-            # A fresh superposition per solve (coupling/rotor.py); FLORIS's wake models only if
+            # A fresh superposition per solve (plugin/rotor.py); FLORIS's wake models only if
             # they are the ones calling this model.
             wake_models = WAKE_MODELS.get()
             if wake_models is not None and wake_models.velocity_model is not self:
@@ -461,7 +461,7 @@ class _EkmanWakeModel(BaseModel):
         self, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
         turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
     ):
-        """d_k of every rotor cell of the grid after turbine i's wake (coupling/rotor.py).
+        """d_k of every rotor cell of the grid after turbine i's wake (plugin/rotor.py).
 
         Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
         (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
@@ -710,7 +710,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     deflection field (this package's ``ekman_veer`` deflection: yaw + veer, varying with z).
 
     Parameters (``wake_velocity_parameters.ekman_veer``):
-        atmosphere: the Ekman atmosphere (see floris_ekman_veer.coupling.inflow).
+        atmosphere: the Ekman atmosphere (see floris_ekman_veer.plugin.inflow).
         curl: polar-angle dependent (curled) width; False keeps the initial ellipse xi_hat = 1.
         polar_angle_centre: "wake_centre" (paper: theta about the full yaw + veer centre) or
             "yaw_centre" (the authors' published code: theta about the yaw-only centre while the
@@ -798,7 +798,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
                                 local_v, ambient.abl.friction_velocity)
         # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
         # heights, downstream of turbine i only (upstream there is no wake: 0), and at the rows
-        # of the rotor cells (coupling/rotor.py) only for the rotors the velocity model
+        # of the rotor cells (plugin/rotor.py) only for the rotors the velocity model
         # integrates (RotorDeflection.rows_at).
         rotor = ambient.rotor
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
