@@ -83,6 +83,7 @@ from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
 GLAUERT_THRUST_COEFFICIENT = 0.96
 
+
 # --------------------------------------------------------------------------------- shared pieces
 def _from_input_block(cls, data):
     """FLORIS's ``from_dict`` for a model block, refusing a non-mapping block (e.g. ``"on"``,
