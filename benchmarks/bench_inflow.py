@@ -12,7 +12,8 @@ import time
 import numpy as np
 from floris import FlorisModel
 
-from floris_ekman_veer.coupling import comparison, inflow
+from floris_ekman_veer.studies import comparison
+from floris_ekman_veer.plugin import inflow
 
 N_CONDITIONS, N_TURBINES, REPEATS = 1000, 100, 5
 ATMOSPHERE = {

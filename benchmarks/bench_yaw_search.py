@@ -30,7 +30,7 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))

@@ -53,8 +53,8 @@ from floris import FlorisModel, TimeSeries
 
 import floris_ekman_veer
 from floris_ekman_veer import annual_energy
-from floris_ekman_veer.coupling.comparison import builtin_model
-from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.studies.comparison import builtin_model
+from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 
 INPUT = Path(__file__).resolve().parents[1] / "inputs" / "farm_night.yaml"
 N_CLASSES = 6

@@ -10,7 +10,7 @@ farm input's with mu = 0) and SBL-6 (the farm input's, mu = 148.49). Variants:
     ambient           k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper;
     local_turbulence  alpha' times FLORIS's turbulence intensity at each turbine (ambient plus
                       crespo_hernandez wake-added) in the same smooth maximum; FLORIS's ambient
-                      TI set to the ABL's I_u(z_h) (coupling/comparison.py), so that the two
+                      TI set to the ABL's I_u(z_h) (studies/comparison.py), so that the two
                       variants differ only by the wake-added turbulence;
     gauss             FLORIS's gauss velocity and deflection on the same inflow and TI, for
                       reference (FLORIS's wake expansion grows with the local TI).
@@ -40,8 +40,8 @@ except ImportError:
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.studies.comparison import builtin_inflow_settings  # noqa: E402
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 SIDE, SPACING = 10, 7 * 126.0

@@ -26,7 +26,7 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 #: The site of the shipped inputs and the paper's cases.

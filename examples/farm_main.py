@@ -16,7 +16,7 @@ Every model gets the atmosphere's I_u(z_h) as turbulence intensity (the ekman_ve
 their wake expansion k_w from the ABL itself, plus FLORIS's wake-added turbulence: the input's
 wake_expansion: local_turbulence; gauss reads the TI). ``--gauss-wind-veer`` also
 gives gauss the rotor-layer veer as FLORIS's ``wind_veer`` (as
-``floris_ekman_veer.coupling.comparison.builtin_inflow_settings`` suggests). It is off by default:
+``floris_ekman_veer.studies.comparison.builtin_inflow_settings`` suggests). It is off by default:
 FLORIS's gauss narrows its initial width by cos(wind_veer) and tilts its ellipse, and with this
 night's ~40 degrees and I_u ~ 0.02 its deficit saturates (u = 0 on part of the waked rotor at
 9 m/s, 81 kW instead of 401 kW for the turbine 7 D behind). It prints the ABL of each
@@ -53,10 +53,10 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
-from floris_ekman_veer.coupling.comparison import builtin_inflow_settings  # noqa: E402
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
-from floris_ekman_veer.coupling.inflow import ambient_velocity  # noqa: E402
-from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
+from floris_ekman_veer.studies.comparison import builtin_inflow_settings  # noqa: E402
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.plugin.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.studies.validity import validity_report, validity_summary  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 

@@ -2,8 +2,8 @@
 
     python examples/validate.py [--output DIR] [--gallery DIR]
 
-Runs every case of ``floris_ekman_veer.validation`` (six single wakes and Horns Rev 1, data
-shipped in floris_ekman_veer/validation/data/, DTU PyWake's validation data, MIT licence) with the
+Runs every case of ``floris_ekman_veer.studies.validation`` (six single wakes and Horns Rev 1, data
+shipped in floris_ekman_veer/studies/validation/data/, DTU PyWake's validation data, MIT licence) with the
 paper's M-1, M-2, M-3 and FLORIS's gauss, GCH, cc, TurbOPark-Gauss and empirical Gauss on the same
 Ekman inflow, for two atmospheres per case: the paper's pure ABL with the site's roughness
 ("site") and the neutral ABL whose I_u(z_h) is the measured turbulence intensity ("matched",
@@ -35,14 +35,14 @@ from tqdm import tqdm  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_cases import arguments, report  # noqa: E402
 
-from floris_ekman_veer.validation.atmospheres import (  # noqa: E402
+from floris_ekman_veer.studies.validation.atmospheres import (  # noqa: E402
     ATMOSPHERES,
     atmosphere,
     hub_turbulence,
     wake_scales,
 )
-from floris_ekman_veer.validation.cases import HORNS_REV, SINGLE_WAKE_CASES  # noqa: E402
-from floris_ekman_veer.validation.metrics import (  # noqa: E402
+from floris_ekman_veer.studies.validation.cases import HORNS_REV, SINGLE_WAKE_CASES  # noqa: E402
+from floris_ekman_veer.studies.validation.metrics import (  # noqa: E402
     arc_errors,
     efficiency_errors,
     markdown,
@@ -50,7 +50,7 @@ from floris_ekman_veer.validation.metrics import (  # noqa: E402
     reference_arc_errors,
     row_errors,
 )
-from floris_ekman_veer.validation.models import (  # noqa: E402
+from floris_ekman_veer.studies.validation.models import (  # noqa: E402
     SINGLE_WAKE_MODELS,
     WAKE_MODELS,
     arc_directions,

@@ -50,14 +50,14 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import annual_energy, optimize_yaw  # noqa: E402
-from floris_ekman_veer.coupling.comparison import (  # noqa: E402
+from floris_ekman_veer.studies.comparison import (  # noqa: E402
     builtin_model,
     comparison_set_kwargs,
     fair_builtin_set_kwargs,
 )
-from floris_ekman_veer.coupling.inflow import set_atmosphere  # noqa: E402
-from floris_ekman_veer.coupling.validity import validity_report, validity_summary  # noqa: E402
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.plugin.inflow import set_atmosphere  # noqa: E402
+from floris_ekman_veer.studies.validity import validity_report, validity_summary  # noqa: E402
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 
 DAY_INPUT = REPOSITORY / "inputs" / "farm_day.yaml"
 NIGHT_INPUT = REPOSITORY / "inputs" / "farm_night.yaml"

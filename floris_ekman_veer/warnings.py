@@ -16,7 +16,7 @@ top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and e
 * said by the process the user runs: in ParFlorisModel's worker processes (multiprocessing,
   concurrent, Dask) the warnings are recorded and travel back with each chunk's result, and the
   parent reports them as a serial run would (one thrust-limit summary counting all the run's
-  conditions; nothing the parent already said), at the user's line (coupling/parallel.py).
+  conditions; nothing the parent already said), at the user's line (plugin/parallel.py).
 
 Silencing, for this process and every worker process or Dask worker it starts or sends models
 to::
@@ -28,7 +28,7 @@ to::
 or, before Python starts, ``FLORIS_EKMAN_VEER_WARNINGS=ignore`` (or a comma-separated list of
 class names) in the environment. The setting lives in that environment variable, which process
 pools inherit; it travels with every model the package sends to a ParFlorisModel worker
-(coupling/parallel.py) and is set on the Dask workers at each run (coupling/distributed.py). ``silence_warnings(None)`` restores the
+(plugin/parallel.py) and is set on the Dask workers at each run (studies/distributed.py). ``silence_warnings(None)`` restores the
 default. Python's own
 warning filters work as usual in the process where they are set.
 """

@@ -8,7 +8,7 @@ import pytest
 from floris import FlorisModel
 from hypothesis import HealthCheck, Phase, settings
 
-from floris_ekman_veer.coupling import inflow
+from floris_ekman_veer.plugin import inflow
 
 # Hypothesis profiles, selected by the environment variable HYPOTHESIS_PROFILE (README, "Set up"):
 # "ci" (default): few examples, derandomised (reproducible CI), no example database; "long": the
@@ -98,7 +98,7 @@ def assert_as_plain_floris(outputs):
     installed and with all of them removed (plain FLORIS); the hooks are installed again."""
     import numpy as np
 
-    from floris_ekman_veer.coupling import registry
+    from floris_ekman_veer import registry
 
     hooked = outputs()
     inflow.uninstall_inflow_hook()

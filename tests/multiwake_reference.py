@@ -1,5 +1,5 @@
 """A converged reference of turbine powers where several wakes overlap, independent of the
-rotor cells that ship (coupling/rotor.py); used by tests/test_multiwake.py and
+rotor cells that ship (plugin/rotor.py); used by tests/test_multiwake.py and
 benchmarks/bench_rotor_average.py (docs/coupling.md#rotor-average).
 
 FLORIS's own sequential solver runs on a fine grid of point values in the slot of its
@@ -27,7 +27,7 @@ from floris.core import TurbineCubatureGrid
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 TURBINE_LIBRARY = Path(floris.__file__).parent / "turbine_library"

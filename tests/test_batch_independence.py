@@ -6,8 +6,8 @@ The cells' sums used to follow the batch: the rows a wake reaches were grouped b
 into chunks over all conditions together, and each chunk's rows added into the cells in turn;
 a condition alone (one group) summed its rows in another order than inside a batch (6 of 40
 conditions differed in the last bits, <= 1.3e-15 relative). Now each row's stretches are summed
-per row and added into the cells in row order (coupling/models.py), and the inflow's cell means
-are segment sums, not a BLAS matrix product (coupling/rotor.py).
+per row and added into the cells in row order (plugin/rotor.py), and the inflow's cell means
+are segment sums, not a BLAS matrix product (plugin/rotor.py).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from floris import FlorisModel
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
-from floris_ekman_veer.coupling import models
+from floris_ekman_veer.plugin import rotor
 
 FARM = Path(__file__).resolve().parents[1] / "inputs" / "farm_sbl6.yaml"
 
@@ -52,8 +52,8 @@ def test_condition_alone_equals_it_in_a_batch(velocity_model, monkeypatch):
         alone = powers(fmodel, speeds[i:i + 1], directions[i:i + 1], yaw[i:i + 1])
         np.testing.assert_array_equal(alone[0], batch[i], err_msg=f"condition {i}")
     # Smaller chunks of rows (what a bigger batch gets): the same bits.
-    monkeypatch.setattr(models, "ROW_CHUNK", 97)
+    monkeypatch.setattr(rotor, "ROW_CHUNK", 97)
     np.testing.assert_array_equal(powers(fmodel, speeds, directions, yaw), batch)
-    monkeypatch.setattr(models, "PAIR_CHUNK", 5)
+    monkeypatch.setattr(rotor, "PAIR_CHUNK", 5)
     np.testing.assert_array_equal(powers(fmodel, speeds[::-1], directions[::-1], yaw[::-1]),
                                   batch[::-1])

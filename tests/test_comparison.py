@@ -1,11 +1,12 @@
-"""Fair-comparison helpers and the native heterogeneous-inflow exporter (coupling/comparison.py)."""
+"""Fair-comparison helpers and the native heterogeneous-inflow exporter (studies/comparison.py)."""
 
 import numpy as np
 import pytest
 from floris import FlorisModel, UncertainFlorisModel
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling import comparison, inflow
+from floris_ekman_veer.studies import comparison
+from floris_ekman_veer.plugin import inflow
 
 from conftest import STABLE_ATMOSPHERE, make_config
 

@@ -20,7 +20,7 @@ import pytest
 pytest.importorskip("distributed")
 
 from floris_ekman_veer import ParFlorisModel  # noqa: E402
-from floris_ekman_veer.coupling import distributed as cluster_module  # noqa: E402
+from floris_ekman_veer.studies import distributed as cluster_module  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parents[1]
 
@@ -40,7 +40,7 @@ SCRIPT = textwrap.dedent(
         from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
         from floris_ekman_veer import ParFlorisModel, annual_energy
-        from floris_ekman_veer.coupling import inflow
+        from floris_ekman_veer.plugin import inflow
 
         farm = sys.argv[1]
         wind_speeds = np.array([7.0, 8.0, 9.0, 10.0, 11.0, 12.0, 9.0])
@@ -142,7 +142,7 @@ SCRIPT = textwrap.dedent(
             out["records_steered"] = bool(np.all(powers[0][:, 1] >= powers[0][:, 0]))
             # annual_energy(client=): whole chunks (model, run, yaw optimisation) as Dask tasks,
             # each record with its own atmosphere; gathered in order, bitwise the serial study.
-            from floris_ekman_veer.coupling.energy import record_energy
+            from floris_ekman_veer.studies.energy import record_energy
 
             client_started = time.perf_counter()
             series = TimeSeries(np.array([266.0, 274.0, 95.0]), np.array([8.0, 10.0, 9.0]),

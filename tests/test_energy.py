@@ -1,4 +1,4 @@
-"""Annual energy per stability class (floris_ekman_veer.coupling.energy)."""
+"""Annual energy per stability class (floris_ekman_veer.studies.energy)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import pytest
 from floris import FlorisModel, TimeSeries, WindRose
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-from floris_ekman_veer.coupling import energy
-from floris_ekman_veer.coupling.comparison import builtin_inflow_settings, builtin_model
-from floris_ekman_veer.coupling.energy import annual_energy
-from floris_ekman_veer.coupling.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.studies import energy
+from floris_ekman_veer.studies.comparison import builtin_inflow_settings, builtin_model
+from floris_ekman_veer.studies.energy import annual_energy
+from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 
 FARM = Path(__file__).resolve().parents[1] / "inputs" / "farm_sbl6.yaml"
 YAW = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
@@ -196,7 +196,7 @@ def _per_class_reference(row, atmospheres, series, records, model):
     """The per-class path (one FLORIS model per class, before the vectorised study): each
     class's conditions with its scalar atmosphere, I_u(z_h) per condition and the comparison's
     wind_veer for the built-ins; AEP by FLORIS's get_farm_AEP."""
-    from floris_ekman_veer.coupling.comparison import comparison_set_kwargs
+    from floris_ekman_veer.studies.comparison import comparison_set_kwargs
 
     directions, speeds, ti, _ = series.unpack_for_reinitialize()
     freq = series.unpack_freq()
@@ -319,7 +319,7 @@ def test_per_record_results_do_not_depend_on_the_chunking(row):
 
 def test_the_comparison_solves_each_chunks_abl_once(row, monkeypatch):
     """The GCH comparison's I_u(z_h) and the inflow hook share one ABL solve per chunk."""
-    from floris_ekman_veer.coupling import inflow
+    from floris_ekman_veer.plugin import inflow
 
     series, atmosphere, labels = _year_of_records(row, n=6, seed=9)
     solved = []

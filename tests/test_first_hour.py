@@ -22,7 +22,7 @@ from floris.utilities import load_yaml
 import floris_ekman_veer
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.coupling import shallow
+from floris_ekman_veer.plugin import shallow
 from tests.conftest import STABLE_ATMOSPHERE
 
 REPO = Path(__file__).resolve().parents[1]
@@ -207,7 +207,7 @@ def restore_setting():
 
 
 def test_silence_warnings_here_and_in_the_workers_it_sends_models_to(restore_setting):
-    from floris_ekman_veer.coupling.parallel import WorkerDict
+    from floris_ekman_veer.plugin.parallel import WorkerDict
 
     floris_ekman_veer.silence_warnings()
     with caught() as records:

@@ -1,5 +1,5 @@
-"""The first hour of a site engineer (coupling/input_checks.py, coupling/registry.py,
-coupling/tables.py; docs/user_guide.md#floris-inputs-the-atmosphere-replaces): FLORIS inputs
+"""The first hour of a site engineer (plugin/input_checks.py, registry.py,
+studies/tables.py; docs/user_guide.md#floris-inputs-the-atmosphere-replaces): FLORIS inputs
 the atmosphere replaces say so once, a model-name typo names the registered models and the
 closest one, a result table prints whole, and the README's quick start is inside the validated
 envelope without a warning."""
@@ -17,8 +17,8 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import ModelSettingsWarning
-from floris_ekman_veer.coupling.energy import COLUMNS, AnnualEnergy
-from floris_ekman_veer.coupling.registry import UnknownModelError
+from floris_ekman_veer.studies.energy import COLUMNS, AnnualEnergy
+from floris_ekman_veer.registry import UnknownModelError
 
 REPO = Path(__file__).resolve().parents[1]
 ATMOSPHERE = {"latitude": 52.0, "roughness_length": 0.1, "cooling_rate": -0.25}

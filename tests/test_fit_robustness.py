@@ -1,5 +1,5 @@
 """Records that a real site logs never sink a fit, and every refusal names its input
-(atmosphere/fit.py and coupling/site.py; docs/measurements.md#a-year-of-records): a light-wind
+(atmosphere/fit.py and studies/site.py; docs/measurements.md#a-year-of-records): a light-wind
 record among others, a state next to the ABL top's kinks, repeated time stamps, bad options,
 directions in radians, vectorised simple inputs."""
 
@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from floris_ekman_veer import EkmanABL, fit_site
-from floris_ekman_veer.coupling.site import atmosphere_from_shear_and_veer
+from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
 
 SITE = dict(latitude=52.0, roughness_length=0.05)
 Z = np.arange(30.0, 151.0, 20.0)

@@ -1,4 +1,4 @@
-"""The Ekman inflow hook (floris_ekman_veer.coupling.inflow, .parallel)."""
+"""The Ekman inflow hook (floris_ekman_veer.plugin.inflow, .parallel)."""
 
 import copy
 import multiprocessing
@@ -14,7 +14,8 @@ from floris.core.wake_velocity.none import NoneVelocityDeficit
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling import inflow, parallel, registry
+from floris_ekman_veer.plugin import inflow, parallel
+from floris_ekman_veer import registry
 
 from conftest import EXAMPLE_WAKES, STABLE_ATMOSPHERE, make_config
 
@@ -575,7 +576,7 @@ def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
     convective alike, below the ground included; ambient_velocity gives them in FLORIS's
     layout."""
     from floris_ekman_veer import EkmanABL
-    from floris_ekman_veer.coupling import inflow
+    from floris_ekman_veer.plugin import inflow
 
     speeds = np.random.default_rng(0).uniform(3.0, 20.0, 3000).reshape(-1, 1, 1, 1)
     z = np.concatenate([[-1.0, 0.0, 0.01], np.linspace(1.0, 400.0, 253)]).reshape(1, 1, 1, -1)
@@ -598,7 +599,7 @@ def test_profile_pieces_of_one_height_for_more_conditions_than_a_piece(monkeypat
     with the shipped piece) go one height per piece, the same bits; the pieces once split
     themselves again without end (RecursionError)."""
     from floris_ekman_veer import EkmanABL
-    from floris_ekman_veer.coupling import inflow
+    from floris_ekman_veer.plugin import inflow
 
     monkeypatch.setattr(inflow, "_PROFILE_PIECE", 8)
     speeds = np.random.default_rng(1).uniform(3.0, 20.0, 40).reshape(-1, 1, 1, 1)

@@ -1,4 +1,4 @@
-"""FLORIS integration of the ekman_veer wake models (coupling/models.py), in FLORIS's regression style.
+"""FLORIS integration of the ekman_veer wake models (plugin/models.py), in FLORIS's regression style.
 
 Everything here goes through FLORIS itself (FlorisModel built from the package's YAML inputs, its
 turbine, cubature, planar and points grids, its solvers), and checks the result against the
@@ -34,8 +34,8 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling.inflow import ambient_velocity
-from floris_ekman_veer.coupling.models import (
+from floris_ekman_veer.plugin.inflow import ambient_velocity
+from floris_ekman_veer.plugin.models import (
     EkmanVeerVelocityDeficit,
     EkmanVeerVelocityDeflection,
     Gaussian2014VelocityDeficit,
@@ -224,7 +224,7 @@ def test_switching_model_names_keeps_the_ekman_inflow():
     _, gauss = run("gauss", "gauss")
     np.testing.assert_array_equal(gauss[:3], m1[:3])  # x = 0: unwaked, same inflow
     # To the rotor cells' cut-off: sub-point rows where a wake stays below 1e-5 U_h are not
-    # integrated, and the two models bound their wakes differently (coupling/models.py).
+    # integrated, and the two models bound their wakes differently (plugin/models.py).
     np.testing.assert_allclose(m3, m1, rtol=1e-6)
     assert np.max(np.abs(gauss[3:] - m1[3:])) > 0.05
 
@@ -964,7 +964,7 @@ def test_yaw_of_90_degrees_or_more_is_refused(yaw):
 
 
 @pytest.mark.filterwarnings("ignore:.*max_thrust_coefficient:RuntimeWarning")  # C_T(3 m/s)
-@pytest.mark.filterwarnings("ignore::floris_ekman_veer.coupling.shallow.ShallowBoundaryLayerWarning")
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.plugin.shallow.ShallowBoundaryLayerWarning")
 def test_hub_above_the_boundary_layer_takes_the_floor_expansion():
     """SBL-6 stability at 3 m/s: h = 47 m, below the 90 m hub and below h exp(B1/A1) = 76 m:
     no ambient turbulence at the hub, k_w is the floor (docs/atmosphere.md#shallow-boundary-layer)."""

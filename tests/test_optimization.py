@@ -18,8 +18,9 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.coupling import inflow, registry
-from floris_ekman_veer.coupling.optimization import atmosphere_groups
+from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer import registry
+from floris_ekman_veer.studies.optimization import atmosphere_groups
 
 from conftest import STABLE_ATMOSPHERE, assert_as_plain_floris, make_config
 

@@ -31,9 +31,13 @@ from floris import FlorisModel
 fmodel = FlorisModel(f.example_input("sbl6"))  # with its !include turbines/...
 fmodel.run()
 assert (fmodel.get_turbine_powers() > 0).all()
-from floris_ekman_veer.validation.cases import DATA, HORNS_REV  # the validation data ship
+from floris_ekman_veer.studies.validation.cases import DATA, HORNS_REV  # the validation data ship
 assert "site-packages" in str(DATA) and (DATA / "PyWake-LICENSE.txt").is_file(), DATA
 assert HORNS_REV.layout[0].size == 80 and len(list(DATA.glob("*.dat"))) == 52
+import floris_ekman_veer.plugin.inflow, floris_ekman_veer.studies.energy  # every layer ships
+import floris_ekman_veer.coupling.inflow as old_inflow  # the old path ships as an alias too
+import floris_ekman_veer.validation.cases as old_cases  # old path
+assert old_inflow is floris_ekman_veer.plugin.inflow and old_cases.DATA == DATA
 """
 
 

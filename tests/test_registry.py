@@ -1,4 +1,4 @@
-"""Registration of the package's models in FLORIS's tables (coupling/registry.py)."""
+"""Registration of the package's models in FLORIS's tables (registry.py)."""
 
 from __future__ import annotations
 
@@ -11,13 +11,14 @@ from floris.core.wake import MODEL_MAP
 from floris.utilities import load_yaml
 
 import floris_ekman_veer
-from floris_ekman_veer.coupling import inflow, registry
-from floris_ekman_veer.coupling.models import (
+from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer import registry
+from floris_ekman_veer.plugin.models import (
     EkmanVeerVelocityDeficit,
     EkmanVeerVelocityDeflection,
     Gaussian2014VelocityDeficit,
 )
-from floris_ekman_veer.coupling.turbine import ActuatorDiskTurbine
+from floris_ekman_veer.plugin.turbine import ActuatorDiskTurbine
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 

@@ -1,4 +1,4 @@
-"""Calm conditions in validity_report have no boundary layer (coupling/validity.py), and a bad
+"""Calm conditions in validity_report have no boundary layer (studies/validity.py), and a bad
 warnings setting is refused when the package is imported (floris_ekman_veer/warnings.py,
 docs/user_guide.md#warnings)."""
 
@@ -36,7 +36,7 @@ def test_calm_rows_are_at_rest_with_no_boundary_layer():
     assert list(both["inside_envelope"]) == [False, False, True]
     assert list(both["wind_speed"]) == [0.0, 0.001, 10.0]
     assert not alone["at_rest"].any()
-    from floris_ekman_veer.coupling.validity import validity_summary
+    from floris_ekman_veer.studies.validity import validity_summary
 
     line = validity_summary(both)
     assert "1 of 3 conditions inside" in line and "2 at rest" in line and "OUTSIDE" not in line

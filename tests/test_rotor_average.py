@@ -1,4 +1,4 @@
-"""The rotor average (coupling/rotor.py, docs/coupling.md#rotor-average).
+"""The rotor average (plugin/rotor.py, docs/coupling.md#rotor-average).
 
 1. The cells: equal areas 1/n^2 partitioning the disk, each holding its FLORIS point.
 2. Convergence: for single wakes (the paper's disk in CNBL, SBL-4, SBL-6 and the NREL 5 MW
@@ -24,7 +24,7 @@ from floris import FlorisModel
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
-from floris_ekman_veer.coupling.rotor import grid_offsets, rotor_cells
+from floris_ekman_veer.plugin.rotor import grid_offsets, rotor_cells
 from floris_ekman_veer.wake.deficit import normalised_deficit
 from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
 
@@ -195,7 +195,7 @@ def test_cell_mean_by_height_is_row_cell_sums_bit_for_bit():
     """The inflow's cell means, summed with the conditions innermost and a piece of conditions
     at a time, are the per-condition segment sums of row_cell_sums exactly, for m = 3 and 1,
     with rows gathered from distinct heights."""
-    from floris_ekman_veer.coupling import rotor
+    from floris_ekman_veer.plugin import rotor
 
     cells = rotor.rotor_cells(3, rotor.AMBIENT_ROWS, rotor.AMBIENT_NODES)
     rng = np.random.default_rng(5)

@@ -12,7 +12,7 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL, fit_site, optimize_yaw
-from floris_ekman_veer.coupling.inflow import solved_atmosphere
+from floris_ekman_veer.plugin.inflow import solved_atmosphere
 from tests.conftest import make_config
 
 REPO = Path(__file__).resolve().parents[1]
@@ -90,7 +90,7 @@ def test_annual_energy_and_optimize_yaw_run_per_record():
               turbulence_intensities=site.turbulence_intensities[1:2])
     classes, record_classes = site.stability()
     assert record_classes == list(records["time"]) and len(classes) == 3
-    from floris_ekman_veer.coupling.inflow import set_atmosphere
+    from floris_ekman_veer.plugin.inflow import set_atmosphere
     set_atmosphere(alone, classes[record_classes[1]]["atmosphere"],
                    wind_directions=site.wind_directions[1:2], wind_speeds=site.wind_speeds[1:2],
                    turbulence_intensities=site.turbulence_intensities[1:2])
@@ -166,7 +166,7 @@ def test_shipped_synthetic_mast_is_labelled_and_fitted():
 def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
     """One of rotor veer and shear with the hub speed determines u* and L: the veer is met
     exactly and the shear follows (docs/measurements.md#simpler-site-inputs)."""
-    from floris_ekman_veer.coupling.site import atmosphere_from_shear_and_veer
+    from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
 
     bottom, top = 27.0, 153.0
     for veer in (2.0, 10.0, 20.0):

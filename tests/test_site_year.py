@@ -14,7 +14,7 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import fit_site
-from floris_ekman_veer.coupling.site import EXCLUSION_KINDS
+from floris_ekman_veer.studies.site import EXCLUSION_KINDS
 from tests.data.generate_mast_year import HEIGHTS, main as generate
 
 YEAR = Path(__file__).resolve().parent / "data" / "mast_year.csv.gz"
@@ -108,7 +108,7 @@ def test_the_fitted_year_runs_as_one_floris_model(site):
     power = fmodel.get_farm_power()
     assert power.shape == (len(site.labels),) and np.all(np.isfinite(power))
     # The atmosphere FLORIS solves per record is the fitted one.
-    abl = floris_ekman_veer.coupling.inflow.solved_atmosphere(fmodel.core.flow_field)
+    abl = floris_ekman_veer.plugin.inflow.solved_atmosphere(fmodel.core.flow_field)
     np.testing.assert_allclose(np.ravel(abl.geostrophic_wind),
                                site.profile_fit.geostrophic_wind, rtol=1e-3)
 

@@ -1,4 +1,4 @@
-"""Tests of the actuator-disk operation model (floris_ekman_veer.coupling.turbine).
+"""Tests of the actuator-disk operation model (floris_ekman_veer.plugin.turbine).
 
 Hand numbers: the paper's LES disk, C_T' = 1.33, D = z_h = 100 m, rho = 1.225 kg/m^3.
 """
@@ -16,8 +16,8 @@ from floris.utilities import load_yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from floris_ekman_veer.coupling import registry
-from floris_ekman_veer.coupling import turbine as adt
+from floris_ekman_veer import registry
+from floris_ekman_veer.plugin import turbine as adt
 
 REPO = Path(__file__).resolve().parents[1]
 TURBINE_YAML = REPO / "inputs" / "turbines" / "actuator_disk_les.yaml"

@@ -1,4 +1,4 @@
-"""Validation against measured wakes and farms (floris_ekman_veer.validation, examples/validate.py).
+"""Validation against measured wakes and farms (floris_ekman_veer.studies.validation, examples/validate.py).
 
 The shipped reference data load as published; the TI-matched atmosphere gives the measured
 turbulence; the FLORIS models built per case see one inflow; the direction average through
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from floris_ekman_veer.validation import atmospheres, cases, metrics, models
+from floris_ekman_veer.studies.validation import atmospheres, cases, metrics, models
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
 import validate  # noqa: E402

@@ -1,5 +1,5 @@
 """floris_ekman_veer.validity_report: each condition against the paper's validated envelope
-(wake-validated stability, h / rotor top, friction Rossby number; coupling/validity.py,
+(wake-validated stability, h / rotor top, friction Rossby number; studies/validity.py,
 docs/yaw_steering.md#the-validated-envelope)."""
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
-from floris_ekman_veer.coupling.validity import (
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.studies.validity import (
     MIN_H_OVER_ROTOR_TOP,
     MU_ENVELOPE,
     ROSSBY_RANGE,

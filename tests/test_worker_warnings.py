@@ -1,6 +1,6 @@
 """The package's warnings from ParFlorisModel workers reach the user as a serial run's do: once,
 at the user's line, with the counts of the whole run (floris_ekman_veer/warnings.py,
-coupling/parallel.py). Before, each worker printed its own, located at the pool's frame and
+plugin/parallel.py). Before, each worker printed its own, located at the pool's frame and
 counting its share of the conditions."""
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """optimize_yaw finds the optimum over both signs of yaw, whatever the bounds
-(coupling/optimization.py, docs/yaw_steering.md#finding-the-optimum).
+(studies/optimization.py, docs/yaw_steering.md#finding-the-optimum).
 
 The reference is a brute-force search on a 1-degree grid, built here: every pair of yaw angles of
 the two front turbines of a 3-turbine row, and for each pair the best yaw of the last turbine
@@ -26,9 +26,9 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.coupling.inflow import set_atmosphere
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
-from floris_ekman_veer.coupling.yawed_rotor import veer_aware
+from floris_ekman_veer.plugin.inflow import set_atmosphere
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.yawed_rotor import veer_aware
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 DIAMETER = 126.0

@@ -1,5 +1,5 @@
-"""The veer-aware yawed rotor (coupling/yawed_rotor.py, coupling/crossflow.py, the actuator disk
-in coupling/turbine.py; docs/yaw_steering.md).
+"""The veer-aware yawed rotor (plugin/yawed_rotor.py, plugin/crossflow.py, the actuator disk
+in plugin/turbine.py; docs/yaw_steering.md).
 
 References built here, independent of the rotor cells: the disk integral of u_n = U cos b +
 V sin b over a polar Gauss-Legendre quadrature (200 radii x 400 angles) of the ambient profile.
@@ -18,11 +18,11 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.coupling import inflow
-from floris_ekman_veer.coupling import turbine as adt
-from floris_ekman_veer.coupling.crossflow import CROSSFLOW, MOMENTS
-from floris_ekman_veer.coupling.inflow import set_atmosphere
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin import turbine as adt
+from floris_ekman_veer.plugin.crossflow import CROSSFLOW, MOMENTS
+from floris_ekman_veer.plugin.inflow import set_atmosphere
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 from conftest import assert_as_plain_floris
 
@@ -376,7 +376,7 @@ def test_cubature_crossflow_grows_with_the_points():
     680 MB per condition)."""
     import tracemalloc
 
-    from floris_ekman_veer.coupling.yawed_rotor import _cells_crossflow
+    from floris_ekman_veer.plugin.yawed_rotor import _cells_crossflow
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)

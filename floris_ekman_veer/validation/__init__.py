@@ -1,7 +1,12 @@
-"""Validation against measured wakes and farms (docs/validation.md#measured-wakes-and-farms).
+"""Old import path: ``floris_ekman_veer.validation`` and its modules (0.1.0) are aliases of
+``floris_ekman_veer.studies.validation`` (docs/architecture.md#old-import-paths). New code imports
+the new path."""
 
-A study on top of FLORIS and the package's coupling: ``cases`` reads the shipped reference data
-(Horns Rev 1 and six single wakes: measured, LES, RANS), ``atmospheres`` turns a case into the
-atmosphere every model runs on, ``models`` builds and runs the FLORIS models, ``metrics`` the
-error tables. ``examples/validate.py`` writes the tables and figures.
-"""
+from floris_ekman_veer._old_paths import keep_old_paths
+
+keep_old_paths(__name__, {
+    "cases": "floris_ekman_veer.studies.validation.cases",
+    "atmospheres": "floris_ekman_veer.studies.validation.atmospheres",
+    "models": "floris_ekman_veer.studies.validation.models",
+    "metrics": "floris_ekman_veer.studies.validation.metrics",
+})

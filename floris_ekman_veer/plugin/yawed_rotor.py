@@ -2,7 +2,7 @@
 
 Across a veered rotor the wind direction changes with height, so the velocity normal to a
 rotor yawed by beta is, per rotor cell, u_n = U cos beta + V sin beta (hub-aligned wake frame,
-:mod:`floris_ekman_veer.coupling.crossflow`, docs/yaw_steering.md). FLORIS's cosine-loss model
+:mod:`floris_ekman_veer.plugin.crossflow`, docs/yaw_steering.md). FLORIS's cosine-loss model
 takes U alone, so its yawed power is symmetric in beta; with veer the two signs differ (an NREL
 5 MW at 8 m/s in the SBL-4 atmosphere: 1179 kW at +20 deg, 1288 kW at -20 deg).
 
@@ -19,11 +19,11 @@ rotor-normal force is C_T(U) <u_n^2> over the disk, so FLORIS's ct_i = C_T cos b
 <u_n^2> / <(U cos beta)^2>, with C_T read from the power curve's table at FLORIS's rotor-average
 speed as FLORIS does; the axial induction FLORIS derives from ct_i follows.
 
-The actuator disk (``actuator-disk``, :mod:`floris_ekman_veer.coupling.turbine`) takes the disk
+The actuator disk (``actuator-disk``, :mod:`floris_ekman_veer.plugin.turbine`) takes the disk
 mean <u_n> = <U> cos beta + <V> sin beta where it took <U> cos beta.
 
 Where V comes from: the ambient V(z) of the atmosphere, averaged over each rotor cell of FLORIS's
-turbine grid (the cells of :mod:`floris_ekman_veer.coupling.rotor`), or at the points of a
+turbine grid (the cells of :mod:`floris_ekman_veer.plugin.rotor`), or at the points of a
 cubature grid. The wakes of FLORIS's and this package's models are streamwise deficits, so a
 waked cell has u_n = (U - Delta u) cos beta + V sin beta. Heterogeneous speed multipliers scale U,
 not V. FLORIS allows one definition per ``turbine_type`` name, so the V cells are per type.
@@ -42,8 +42,8 @@ from floris.core.rotor_velocity import average_velocity
 from floris.core.turbine.operation_models import CosineLossTurbine
 from floris.floris_model import FlorisModel
 
-from floris_ekman_veer.coupling import inflow
-from floris_ekman_veer.coupling.crossflow import (
+from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin.crossflow import (
     CROSSFLOW,
     ambient_crossflow,
     cell_moments,
@@ -52,7 +52,7 @@ from floris_ekman_veer.coupling.crossflow import (
     normal_squares,
     veer_ratio,
 )
-from floris_ekman_veer.coupling.rotor import (
+from floris_ekman_veer.plugin.rotor import (
     AMBIENT_NODES,
     AMBIENT_ROWS,
     rotor_cells,
@@ -156,7 +156,7 @@ def bounded_thrust(veer_aware, cosine_law, yaw_angles):
 
 
 def crossflow_lookup(core):
-    """The look-up of :data:`~floris_ekman_veer.coupling.crossflow.CROSSFLOW` for a Core, or
+    """The look-up of :data:`~floris_ekman_veer.plugin.crossflow.CROSSFLOW` for a Core, or
     None without an atmosphere. V cells are computed once per (rotor, shape).
 
     A table is known by identity: the Core's farm's tables, and those of every farm initialised
@@ -202,7 +202,7 @@ def crossflow_lookup(core):
 
 def _cells_crossflow(abl, reference_height, hub, diameter, turbine, shape, grid):
     """The ambient moments (crossflow.MOMENTS) per rotor cell, (n_findex, 1, *cells) each:
-    over the cells of coupling/rotor.py for an n x n turbine grid, at the points of a cubature
+    over the cells of plugin/rotor.py for an n x n turbine grid, at the points of a cubature
     grid; None for any other shape."""
     n_findex = shape[0]
     if isinstance(grid, TurbineCubatureGrid) and tuple(shape[2:]) == grid.z_sorted.shape[2:]:

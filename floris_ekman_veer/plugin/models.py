@@ -32,14 +32,12 @@ Conventions (docs/conventions.md, docs/coupling.md), each pinned by tests:
 from __future__ import annotations
 
 import warnings
-import weakref
 from typing import Any
 
 import numpy as np
 import attrs
 from attrs import define, field
-from floris.core import BaseModel, FlowField, Grid, TurbineCubatureGrid, TurbineGrid
-from floris.utilities import rotate_coordinates_rel_west
+from floris.core import BaseModel, FlowField, Grid
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import (
@@ -57,26 +55,20 @@ from floris_ekman_veer.atmosphere.turbulence import (
     streamwise_turbulence_intensity,
     wake_expansion_rate,
 )
-from floris_ekman_veer.coupling.inflow import ambient_velocity, solved_atmosphere
-from floris_ekman_veer.coupling.shallow import POLICIES as SHALLOW_POLICIES
-from floris_ekman_veer.coupling.names import (
+from floris_ekman_veer.plugin.ambient import Ambient
+from floris_ekman_veer.plugin.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
 )
-from floris_ekman_veer.coupling.rotor import (
+from floris_ekman_veer.plugin.rotor import (
+    ROTOR_PLANE_MARGIN,
     WAKE_MODELS,
-    WAKE_OVERLAP_VELOCITY,
-    RotorCells,
     RotorWakes,
-    rotor_cells,
-    rotor_geometry,
-    row_interpolation,
-    ROWS_PER_POINT,
-    rows_profile,
-    sorted_moments,
-    sub_quadrature,
+    TurbineWake,
+    rotor_cell_deficit,
 )
+from floris_ekman_veer.plugin.shallow import POLICIES as SHALLOW_POLICIES
 from floris_ekman_veer.wake.deficit import (
     CURL_ALPHA,
     WIDTH_FACTOR,
@@ -90,30 +82,6 @@ from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
 GLAUERT_THRUST_COEFFICIENT = 0.96
-
-#: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
-#: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
-#: rotor points can lie a round-off (~1e-13 m) downstream of x_i, where the wake is already 2a
-#: deep: without the margin a turbine sits in its own wake (tests/test_models.py). FLORIS's gauss
-#: model uses the same 0.1 m.
-ROTOR_PLANE_MARGIN = 0.1
-
-#: A sub-point row of a rotor is integrated in a wake where the deficit, with the widest width
-#: the wake can have, exceeds this fraction of U_h somewhere on the row; elsewhere the wake is 0
-#: (a power change of at most 3e-5 of a turbine that sees no other wake, far less where wakes
-#: combine).
-NEGLIGIBLE_DEFICIT = 1e-5
-
-#: Rotors whose wake centre is evaluated at their sub-point rows at once.
-PAIR_CHUNK = 1024
-
-#: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
-#: about 0.3 MB each.
-ROW_CHUNK = 4096
-
-#: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
-#: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
-MIN_BAND_PER_ROW = 0.4
 
 
 # --------------------------------------------------------------------------------- shared pieces
@@ -156,171 +124,12 @@ def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
     return np.where(heavy, limit, ct)
 
 
-#: The latest Ambient, keyed by the identities of its grid, flow field and inflow array.
-_AMBIENTS: dict = {}
-
-
-@define(frozen=True)
-class Ambient:
-    """The ambient atmosphere of one FLORIS grid, evaluated once per model preparation.
-
-    Holds the ABL, the ambient (U, V) at the grid in FLORIS's frame (aligned with the wind at the
-    reference height; 0 below the roughness length), and the hub-height speed and direction at
-    each distinct hub height of the farm, so that no wake evaluates the profile again.
-
-    FLORIS's deflection call carries no hub height (docs/coupling.md#call-signatures). Every grid holds the farm's
-    ``turbine_coordinates`` (x, y, hub height) and rotates points about the centre of the farm's
-    bounding box, as done here, so the turbine whose wake is computed is the one at (x_i, y_i).
-    """
-
-    abl: Any
-    u: np.ndarray
-    v: np.ndarray
-    hub_heights: np.ndarray  # distinct hub heights of the farm, sorted
-    hub_speed: np.ndarray  # (n_findex, n_hub_heights)
-    hub_cos: np.ndarray  # direction of the hub-height wind in FLORIS's frame
-    hub_sin: np.ndarray
-    turbine_x: np.ndarray  # rotated turbine positions, (n_findex, n_turbines)
-    turbine_y: np.ndarray
-    turbine_hub_heights: np.ndarray  # (n_turbines,)
-    floris_turbulence: np.ndarray  # FLORIS's ambient turbulence intensity, (n_findex, 1, 1, 1)
-    rotor: RotorAmbient | None = None  # turbine grids: the rotor cells (coupling/rotor.py)
-    #: Cubature grids: points per rotor side N (FLORIS's quadrature of point values), else None.
-    cubature_points: int | None = None
-    warned: set = field(factory=set)  # resolution warnings already given in this solve
-
-    @classmethod
-    def of(cls, grid: Grid, flow_field: FlowField) -> Ambient:
-        """The ambient of ``grid`` for ``flow_field``'s current inflow, shared by the velocity
-        and deflection models of one solve (built once per flow-field initialisation)."""
-        key = (id(grid), id(flow_field), id(flow_field.u_initial_sorted))
-        cached = _AMBIENTS.get(key)
-        if cached is not None and cached[0]() is grid and cached[1]() is flow_field:
-            return cached[2]
-        ambient = cls._build(grid, flow_field)
-        _AMBIENTS.clear()  # one solve at a time: keep only the latest
-        _AMBIENTS[key] = (weakref.ref(grid), weakref.ref(flow_field), ambient)
-        return ambient
-
-    @classmethod
-    def _build(cls, grid: Grid, flow_field: FlowField) -> Ambient:
-        abl = solved_atmosphere(flow_field)
-        reference_height = flow_field.reference_wind_height
-        coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
-        hub_heights = np.unique(coordinates[:, 2])
-        u_hub, v_hub = abl.hub_aligned_velocity(hub_heights.reshape(1, 1, 1, -1), reference_height)
-        speed = np.hypot(u_hub, v_hub)
-        x, y, _, _, _ = rotate_coordinates_rel_west(flow_field.wind_directions, coordinates)
-        n_findex = len(flow_field.wind_directions)
-        shape = (n_findex, hub_heights.size)
-        rotor = RotorAmbient.of(grid, abl, reference_height) if is_rotor_grid(grid) else None
-        if rotor is None:
-            u, v = ambient_velocity(abl, grid.z_sorted, reference_height)
-        else:
-            # The cell path needs the ambient at the sub-point rows only; the deflection model's
-            # point values (for models that read them) need it at the grid's heights, which on a
-            # turbine grid are those of the rotor's point rows.
-            u, v = ambient_velocity(abl, grid.z_sorted[:, :, :1, :], reference_height)
-        return cls(
-            abl, u, v, hub_heights,
-            *(np.broadcast_to(a, (n_findex, 1, 1, hub_heights.size)).reshape(shape)
-              for a in (speed, u_hub / speed, v_hub / speed)),
-            x, y, coordinates[:, 2],
-            np.asarray(flow_field.turbulence_intensities, dtype=float).reshape(-1, 1, 1, 1),
-            rotor, grid.grid_resolution if isinstance(grid, TurbineCubatureGrid) else None,
-        )
-
-    def hub_height_at(self, x_i, y_i):
-        """Hub height of the turbine at (x_i, y_i) (shapes (n_findex, 1, 1, 1))."""
-        distance = (self.turbine_x - x_i[:, 0, 0]) ** 2 + (self.turbine_y - y_i[:, 0, 0]) ** 2
-        return self.turbine_hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
-
-    def hub_frame(self, hub_height):
-        """U_h and the direction (cos, sin) of the wind at ``hub_height`` in FLORIS's frame
-        (shapes (n_findex, 1, 1, 1))."""
-        if np.any(hub_height <= self.abl.roughness_length):
-            raise ValueError("hub_height must be above the atmosphere's roughness_length")
-        rows = np.arange(hub_height.shape[0])
-        column = np.searchsorted(self.hub_heights, hub_height[:, 0, 0, 0])
-        pick = lambda table: table[rows, column][:, None, None, None]  # noqa: E731
-        return pick(self.hub_speed), pick(self.hub_cos), pick(self.hub_sin)
-
-    def at_hub(self, hub_height):
-        """U_h and the ambient (U, V) at the grid in the frame where V(hub_height) = 0
-        (docs/conventions.md#hub-aligned-frame): FLORIS's frame rotated by the hub-height direction."""
-        hub_speed, cos_a, sin_a = self.hub_frame(hub_height)
-        u = self.u * cos_a + self.v * sin_a
-        v = self.v * cos_a - self.u * sin_a
-        return hub_speed, u, v
-
-
-def is_rotor_grid(grid: Grid) -> bool:
-    """FLORIS's turbine grid (n x n points per rotor, equal-weight cubic mean): the grid on which
-    the models return rotor-cell averages (docs/coupling.md#rotor-average)."""
-    return isinstance(grid, TurbineGrid)
-
-
-@define(frozen=True)
-class RotorAmbient:
-    """The rotor cells of a turbine grid (coupling/rotor.py) and the ambient at their rows.
-
-    Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
-    radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
-    (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
-    FLORIS's inflow component, V the lateral one).
-    """
-
-    cells: RotorCells
-    moment: np.ndarray  # (n_findex, n_turbines): 3 (cubic mean) or 1 (plain mean), rotor.py
-    x: np.ndarray
-    y: np.ndarray
-    z: np.ndarray
-    radius: np.ndarray
-    kind: np.ndarray
-    kind_heights: np.ndarray
-    kind_u: np.ndarray
-    kind_v: np.ndarray
-    warned: set = field(factory=set)
-
-    @classmethod
-    def of(cls, grid: Grid, abl, reference_height) -> RotorAmbient:
-        cells = rotor_cells(grid.grid_resolution, *sub_quadrature(
-            grid.grid_resolution, float(np.max(grid.turbine_diameters))))
-        x, y, z, radius, _ = rotor_geometry(grid)
-        kind, heights, u, v = rows_profile(
-            lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
-        )
-        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v)
-
-    def rows(self, f, j):
-        """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""
-        kind = self.kind[f, j]
-        return self.kind_heights[kind], self.kind_u[f, kind], self.kind_v[f, kind]
-
-
-@define(frozen=True)
-class _TurbineWake:
-    """Turbine i's quantities at the grid, shared by the velocity models (radians, metres)."""
-
-    dx: np.ndarray
-    dy: np.ndarray
-    dz: np.ndarray
-    yaw: np.ndarray
-    ct: np.ndarray
-    radius: np.ndarray
-    hub_speed: np.ndarray
-    k_w: np.ndarray
-    local_u: np.ndarray
-    local_v: np.ndarray
-    friction_velocity: np.ndarray
-
-
 @define
 class _EkmanWakeModel(BaseModel):
     """Parameters shared by the velocity models that draw on the Ekman atmosphere."""
 
     #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
-    #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.coupling.inflow.
+    #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.plugin.inflow.
     atmosphere: dict | None = field(default=None)
     A1: float = number_field(TOWNSEND_PERRY_A1, *_POSITIVE)
     B1: float = number_field(TOWNSEND_PERRY_B1, *_NON_NEGATIVE)
@@ -333,7 +142,7 @@ class _EkmanWakeModel(BaseModel):
     wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
-    #: or "raise"; read by the inflow hook when the model is built (coupling/shallow.py).
+    #: or "raise"; read by the inflow hook when the model is built (plugin/shallow.py).
     shallow_boundary_layer: str = choice_field("warn", SHALLOW_POLICIES)
 
     #: Where the block sits in a FLORIS input (error messages name it).
@@ -346,7 +155,7 @@ class _EkmanWakeModel(BaseModel):
 
         ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
         waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
-        coupling/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
+        plugin/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
         ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
         so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
@@ -373,7 +182,7 @@ class _EkmanWakeModel(BaseModel):
         ambient = Ambient.of(grid, flow_field)
         wakes = None
         if ambient.rotor is not None:
-            # A fresh superposition per solve (coupling/rotor.py); FLORIS's wake models only if
+            # A fresh superposition per solve (plugin/rotor.py); FLORIS's wake models only if
             # they are the ones calling this model.
             wake_models = WAKE_MODELS.get()
             if wake_models is not None and wake_models.velocity_model is not self:
@@ -418,13 +227,14 @@ class _EkmanWakeModel(BaseModel):
         yaw = np.deg2rad(yaw_angle_i)
         ct = self.wake_thrust_coefficient(ct_i, yaw)
         if ambient.rotor is not None:
-            return self._rotor_cell_deficit(
-                x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, 0.5 * rotor_diameter_i,
-                turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
+            return rotor_cell_deficit(
+                self, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct,
+                0.5 * rotor_diameter_i, turbulence_intensity_i, axial_induction_i, u_initial,
+                ambient, wakes,
             )
         hub_speed, local_u, local_v = ambient.at_hub(hub_height_i)
         dx = x - x_i
-        wake = _TurbineWake(
+        wake = TurbineWake(
             dx=np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0),  # dx = 0 means "no wake"
             dy=y - y_i - deflection_field_i,
             dz=z - hub_height_i,
@@ -457,179 +267,7 @@ class _EkmanWakeModel(BaseModel):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
-    def _rotor_cell_deficit(
-        self, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
-        turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
-    ):
-        """d_k of every rotor cell of the grid after turbine i's wake (coupling/rotor.py).
-
-        Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
-        (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
-        width) are integrated; the wake is 0 elsewhere. The wake is superposed on the others at
-        the sub-points (``wakes``, :class:`RotorWakes`) and each reached cell returns the
-        increment FLORIS's combination turns into the combined cell deficit; the rest 0.
-        """
-        rotor = ambient.rotor
-        cells = rotor.cells
-        n_findex, n_turbines = rotor.x.shape
-        result = np.zeros((n_findex, n_turbines, cells.n**2))
-        dx = rotor.x - x_i[:, 0, 0]
-        f, j = np.nonzero(dx > ROTOR_PLANE_MARGIN)
-        if f.size == 0:
-            return result.reshape(u_initial.shape)
-        abl = ambient.abl
-        hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
-        track = (self.wake_expansion == "local_turbulence" and wakes.rule is not None
-                 and wakes.turbulence_model is not None)
-        if track:
-            # The turbulence at turbine i with the overlaps as areas (RotorWakes).
-            source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
-                               axis=1)
-            turbulence = wakes.turbulence[np.arange(n_findex), source][:, None, None, None]
-        else:
-            # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added
-            # turbulence is counted per point); its wake takes one expansion rate, from the
-            # rotor's mean.
-            turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
-        k_w = self.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
-                                  ambient.floris_turbulence)
-        pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
-        per_pair = {
-            "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
-            "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
-        }
-        per_pair = {k: pick(v) for k, v in per_pair.items()}
-        x_pair = dx[f, j]
-        width = self.width_bound(x_pair, per_pair["k_w"], per_pair["radius"], per_pair["ct"],
-                                 per_pair["yaw"])
-        # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
-        # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
-        amplitude = self.amplitude_bound(x_pair, per_pair["k_w"], per_pair["radius"],
-                                         per_pair["ct"], per_pair["yaw"])
-        reach_squared = 2.0 * width**2 * np.log(
-            np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
-        rows_at = getattr(deflection_field_i, "rows_at", None)
-        if rows_at is not None and cells.n > 1:
-            # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
-            # widened by its spread plus R/4 on either side (the centre at the rows beyond
-            # +-R/2, twice the linear extrapolation, and between them) are not integrated and
-            # their rows not evaluated.
-            points = deflection_field_i[f, j, 0, :]
-            spread = np.max(points, axis=1) - np.min(points, axis=1)
-            margin = spread + 0.25 * rotor.radius[f, j]
-            offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
-            lateral_gap = np.maximum(np.maximum(offset - np.max(points, axis=1),
-                                                np.min(points, axis=1) - offset)
-                                     - margin - rotor.radius[f, j], 0.0)
-            vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
-                                      - rotor.radius[f, j], 0.0)
-            near = lateral_gap**2 + vertical_gap**2 < reach_squared
-            f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
-            per_pair = {k: v[near] for k, v in per_pair.items()}
-            if f.size == 0:
-                return result.reshape(u_initial.shape)
-        if rows_at is None:
-            # Another deflection model: its centre at the point rows, interpolated in height.
-            # (A sum over the n points, not a matrix product: BLAS would block the product by
-            # the number of pairs, i.e. by the batch.)
-            centre = np.sum(deflection_field_i[f, j, 0, :, None]
-                            * row_interpolation(cells.n, cells.row_z), axis=1)
-        else:
-            # In chunks of rotors, so that the deflection's temporaries stay small.
-            centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
-                                     for k in range(0, f.size, PAIR_CHUNK)])
-        lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
-        dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
-        kind = rotor.kind[f, j]
-        radius_j = rotor.radius[f, j][:, None]
-        gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
-        # Row by row: only the rows the wake reaches are integrated.
-        p, r = np.nonzero(gap < reach_squared[:, None])  # (pair, row) entries
-        if p.size == 0:
-            return result.reshape(u_initial.shape)
-        reached = p[np.flatnonzero(np.diff(p, prepend=-1))]  # p is sorted
-        self._check_resolution(x_pair[reached], per_pair, reached, centre[reached],
-                               radius_j[reached], cells, rotor.warned)
-        flat = f * n_turbines + j
-        moment = rotor.moment[f, j]
-        n2 = cells.n**2
-        # Per entry (a pair's row): the moment removed on each cell stretch the row crosses
-        # and the row's overlap, summed into the pairs' cells once after the loop, in entry
-        # order (a pair's rows in ascending order): a condition's sums then do not depend on
-        # the grouping and chunking below, which depend on the whole batch.
-        nodes = cells.nodes
-        stretches = np.zeros((p.size, cells.sub_y.shape[1] // nodes))
-        row_overlap = np.zeros(p.size) if track else None
-        # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
-        # padding; few: all at once (the padding costs less than more calls).
-        widths = cells.row_width[r]
-        if p.size <= ROW_CHUNK:
-            groups = [np.arange(p.size)]
-        else:
-            order = np.argsort(widths, kind="stable")
-            groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
-        for group in groups:
-            width = int(np.max(widths[group]))
-            for start in range(0, group.size, ROW_CHUNK):
-                chunk = group[start:start + ROW_CHUNK]
-                pe, re = p[chunk], r[chunk]
-                fe = f[pe]
-                pair = {k: v[pe][:, None] for k, v in per_pair.items()}
-                u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
-                v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
-                dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
-                wake = _TurbineWake(
-                    dx=x_pair[pe][:, None],
-                    dy=dy,
-                    dz=dz[pe, re][:, None],
-                    yaw=pair["yaw"],
-                    ct=pair["ct"],
-                    radius=pair["radius"],
-                    hub_speed=pair["hub_speed"],
-                    k_w=pair["k_w"],
-                    local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
-                    local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
-                    friction_velocity=pair["friction_velocity"],
-                )
-                # No flow (at and below z0): no wake.
-                ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-                du = self.sub_point_deficit(wake) * pair["hub_speed"]
-                stretches[chunk, :width // nodes] = wakes.superpose(
-                    flat[pe], re, du, ambient_u, moment[pe][:, None],
-                ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
-                if track:
-                    # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
-                    # rotor laterally, here as the area of the disk where it holds.
-                    inside = (du > WAKE_OVERLAP_VELOCITY) & (
-                        np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
-                    row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
-        removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
-                              weights=stretches.ravel(), minlength=f.size * n2)
-        overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None
-        u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
-        result[f[reached], j[reached]] = wakes.cell_returns(
-            flat[reached], removed.reshape(f.size, n2)[reached], u_cell,
-            moment[reached][:, None])
-        if track:
-            self._add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
-                                 axial_induction_i, overlap[reached], ambient)
-        return result.reshape(u_initial.shape)
-
-    @staticmethod
-    def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient):
-        """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
-        the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it."""
-        column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
-        x_j, x_source = ambient.rotor.x[f, j], column(x_i)
-        diameter = 2.0 * column(radius_i)
-        ambient_turbulence = column(ambient.floris_turbulence)
-        added = wakes.turbulence_model.function(
-            ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
-        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
-            x_j <= x_source + 15.0 * diameter)
-        wakes.add_turbulence(f, j, added, ambient_turbulence)
-
-    def sub_point_deficit(self, wake: _TurbineWake) -> np.ndarray:
+    def sub_point_deficit(self, wake: TurbineWake) -> np.ndarray:
         """Delta u / U_h of the wake at the sub-points (each model's normalised deficit)."""
         return self.normalised_deficit(wake)
 
@@ -670,31 +308,7 @@ class _EkmanWakeModel(BaseModel):
                 stacklevel=4,
             )
 
-    def _check_resolution(self, x, per_pair, reached, centre, radius_j, cells, warned):
-        """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
-        if "rows" in warned:
-            return
-        k_w, radius, ct, yaw = (per_pair[k][reached] for k in ("k_w", "radius", "ct", "yaw"))
-        width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
-            stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
-        height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
-        shear = np.abs(centre[:, -1] - centre[:, 0]) / height
-        thickness = width / np.sqrt(1.0 + shear**2)
-        spacing = 2.0 * radius_j[:, 0] / cells.rows
-        if np.any(thickness < MIN_BAND_PER_ROW * spacing):
-            warned.add("rows")
-            ratio = float(np.min(thickness / spacing))
-            warnings.warn(
-                f"a veer-sheared wake band is {ratio:.2f} sub-row spacings thin on a rotor, "
-                f"below the {MIN_BAND_PER_ROW} that its rotor-cell average resolves to 1 % in "
-                f"power: raise solver.turbine_grid_points (now {cells.n}; the cells' "
-                f"sub-quadrature has {cells.rows} rows per rotor, {ROWS_PER_POINT} per grid "
-                "point)",
-                RuntimeWarning,
-                stacklevel=4,
-            )
-
-    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
+    def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         """Delta u / U_h of one wake; each model defines it."""
         raise NotImplementedError("BaseModel.normalised_deficit")
 
@@ -710,7 +324,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     deflection field (this package's ``ekman_veer`` deflection: yaw + veer, varying with z).
 
     Parameters (``wake_velocity_parameters.ekman_veer``):
-        atmosphere: the Ekman atmosphere (see floris_ekman_veer.coupling.inflow).
+        atmosphere: the Ekman atmosphere (see floris_ekman_veer.plugin.inflow).
         curl: polar-angle dependent (curled) width; False keeps the initial ellipse xi_hat = 1.
         polar_angle_centre: "wake_centre" (paper: theta about the full yaw + veer centre) or
             "yaw_centre" (the authors' published code: theta about the yaw-only centre while the
@@ -722,7 +336,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
-    def sub_point_deficit(self, wake: _TurbineWake) -> np.ndarray:
+    def sub_point_deficit(self, wake: TurbineWake) -> np.ndarray:
         if self.polar_angle_centre != "wake_centre":
             return super().sub_point_deficit(wake)
         # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
@@ -732,7 +346,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
         )
         return deficit_on_rows(wake.dy, wake.dz, parameters)
 
-    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
+    def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0
         safe_u = np.where(flowing, wake.local_u, 1.0)
         polar_dy = None
@@ -798,7 +412,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
                                 local_v, ambient.abl.friction_velocity)
         # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
         # heights, downstream of turbine i only (upstream there is no wake: 0), and at the rows
-        # of the rotor cells (coupling/rotor.py) only for the rotors the velocity model
+        # of the rotor cells (plugin/rotor.py) only for the rotors the velocity model
         # integrates (RotorDeflection.rows_at).
         rotor = ambient.rotor
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
@@ -885,7 +499,7 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
         k_star = k_w if self.k_star is None else self.k_star
         return k_star * x + WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, 0.0))
 
-    def normalised_deficit(self, wake: _TurbineWake) -> np.ndarray:
+    def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star
         diameter = 2.0 * wake.radius
         return bastankhah2014_deficit(

@@ -21,8 +21,8 @@ import pandas as pd
 from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.coupling.energy import record_energy
-from floris_ekman_veer.coupling.inflow import set_atmosphere
+from floris_ekman_veer.studies.energy import record_energy
+from floris_ekman_veer.plugin.inflow import set_atmosphere
 
 #: Column names of the measured speeds and directions: the height in metres is in the name.
 SPEED_COLUMN = re.compile(r"^speed_(\d+(?:\.\d+)?)m$")

@@ -23,13 +23,13 @@ import functools
 
 import numpy as np
 
-from floris_ekman_veer.coupling.inflow import (
+from floris_ekman_veer.plugin.inflow import (
     _patch,
     _replaced_atmosphere,
     atmosphere_of,
     set_atmosphere,
 )
-from floris_ekman_veer.coupling.optimization import atmosphere_groups
+from floris_ekman_veer.studies.optimization import atmosphere_groups
 
 
 def _per_condition_set_uncertain(original):

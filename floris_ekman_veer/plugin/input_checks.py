@@ -1,6 +1,6 @@
 """Checks of a FLORIS Core's layout, conditions, turbines and operation for this package's models.
 
-Called by the inflow hook (:mod:`floris_ekman_veer.coupling.inflow`): :func:`check_core` when a
+Called by the inflow hook (:mod:`floris_ekman_veer.plugin.inflow`): :func:`check_core` when a
 Core is built (FlorisModel(), ``set()``, ``copy()``; before FLORIS builds its grid, which is where
 an empty layout would otherwise fail), :func:`check_operation` and :func:`check_points` when a
 Core solves. They act only on a Core that uses the package (an atmosphere block, an ``ekman_veer``
@@ -18,13 +18,13 @@ import numpy as np
 import floris_ekman_veer.warnings as package_warnings
 
 from floris_ekman_veer._validation import number, require_each
-from floris_ekman_veer.coupling.names import (
+from floris_ekman_veer.plugin.names import (
     ATMOSPHERE_PATH,
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
 )
-from floris_ekman_veer.coupling.turbine import OPERATION_MODEL_NAME, disk_parameters
+from floris_ekman_veer.plugin.turbine import OPERATION_MODEL_NAME, disk_parameters
 
 
 def uses_wake_models(core) -> bool:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from floris_ekman_veer.validation.cases import HORNS_REV
-from floris_ekman_veer.validation.models import arc_directions
+from floris_ekman_veer.studies.validation.cases import HORNS_REV
+from floris_ekman_veer.studies.validation.models import arc_directions
 
 #: Reference kinds of a single-wake arc, in the order the tables give them.
 REFERENCES = ("measured", "les")

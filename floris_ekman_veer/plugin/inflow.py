@@ -31,8 +31,8 @@ Per condition, the ABL is driven by FLORIS's wind speed at ``reference_wind_heig
 solved once for all conditions in one vectorised call. Any atmosphere value may instead be a list
 of length ``n_findex`` (e.g. a day/night cycle of cooling rates); it binds by position to FLORIS's
 conditions. ParFlorisModel and the visualisation methods slice them; UncertainFlorisModel, which
-expands and deduplicates conditions, carries them through (coupling/uncertain.py), and the yaw
-optimisers, which tile and mask them, run once per distinct atmosphere (coupling/optimization.py).
+expands and deduplicates conditions, carries them through (studies/uncertain.py), and the yaw
+optimisers, which tile and mask them, run once per distinct atmosphere (studies/optimization.py).
 
 What the hook sets
 ------------------
@@ -47,7 +47,7 @@ What the hook sets
   ``wind_shear`` is ignored (the atmosphere defines the shear); 2-D/3-D heterogeneous speed
   multipliers, if also given, multiply the profile. On a ``turbine_grid`` each rotor point gets
   instead the mean of the profile over its rotor cell, <U^m>^(1/m) with m = 3 (power curves) or
-  1 (the actuator disk) (:mod:`floris_ekman_veer.coupling.rotor`, docs/coupling.md#rotor-average).
+  1 (the actuator disk) (:mod:`floris_ekman_veer.plugin.rotor`, docs/coupling.md#rotor-average).
 * ``dudz_initial_sorted`` = dU/dz of that same hub-aligned U, by a centred difference of the
   analytic profile (relative step 1e-4: relative error about 1e-8; EkmanABL exposes no analytic
   gradient), 0 below the ground. GCH's secondary steering uses it.
@@ -63,7 +63,7 @@ What the hook sets
   ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The veer reaches this package's own
   deflection model through :func:`solved_atmosphere` instead.
 * Turbulence intensities remain FLORIS's inputs (see
-  :func:`floris_ekman_veer.coupling.comparison.builtin_inflow_settings` for values consistent with
+  :func:`floris_ekman_veer.studies.comparison.builtin_inflow_settings` for values consistent with
   the atmosphere).
 
 For wake models
@@ -110,7 +110,7 @@ def _check_floris_version(version: str) -> None:
     lower, upper = SUPPORTED_FLORIS
     if match is None or not lower <= (int(match[1]), int(match[2])) < upper:
         raise ImportError(
-            f"floris_ekman_veer.coupling.inflow patches FLORIS internals and supports "
+            f"floris_ekman_veer.plugin.inflow patches FLORIS internals and supports "
             f"floris>={lower[0]}.{lower[1]},<{upper[0]}.{upper[1]}, but floris {version} is "
             f"installed. Install a supported FLORIS (pip install 'floris>=4.7,<4.8')."
         )
@@ -122,7 +122,7 @@ from floris.core import Core, FlowField, TurbineGrid  # noqa: E402  (only after 
 from floris.floris_model import FlorisModel  # noqa: E402
 
 import floris_ekman_veer.warnings as package_warnings  # noqa: E402
-from floris_ekman_veer.coupling.rotor import (  # noqa: E402
+from floris_ekman_veer.plugin.rotor import (  # noqa: E402
     TURBINE_MOMENTS,
     WAKE_MODELS,
     turbine_grid_inflow,
@@ -256,7 +256,7 @@ class AtmosphereSpec:
                 f"{per_condition} must have one value per condition (length n_findex = "
                 f"{n_findex}) or be a single number; got {self.n_conditions} values (replace the "
                 "atmosphere and the conditions together with "
-                "floris_ekman_veer.coupling.inflow.set_atmosphere)"
+                "floris_ekman_veer.plugin.inflow.set_atmosphere)"
             )
 
     def sliced(self, index) -> dict:
@@ -295,7 +295,7 @@ def atmosphere_of(core: Core) -> AtmosphereSpec | None:
     atmosphere = read_atmosphere(core.wake.wake_velocity_parameters)
     if atmosphere is None:
         return None
-    from floris_ekman_veer.coupling.input_checks import zero_power_speed
+    from floris_ekman_veer.plugin.input_checks import zero_power_speed
 
     spec = AtmosphereSpec.from_mapping(atmosphere)
     spec.check_conditions(core.flow_field.n_findex)
@@ -417,7 +417,7 @@ def _distinct_heights(z: np.ndarray):
 
 #: The last few (ABL, heights, reference height) -> (U, V) of :func:`ambient_velocity` on small
 #: height sets, and of :func:`ambient_rows`: a solve's rotor cells are evaluated for the inflow
-#: (coupling/rotor.py) and again for the crossflow (coupling/yawed_rotor.py) at the same heights.
+#: (plugin/rotor.py) and again for the crossflow (plugin/yawed_rotor.py) at the same heights.
 _AMBIENT_CACHE: OrderedDict = OrderedDict()
 _AMBIENT_CACHE_SIZE = 2
 _AMBIENT_CACHED_HEIGHTS = 4096
@@ -540,7 +540,7 @@ def _profile_and_gradient(abl, z, reference_height):
 _ACTIVE: contextvars.ContextVar = contextvars.ContextVar("ekman_veer_atmosphere", default=None)
 
 #: Context managers ``make(core)`` entered around every wrapped Core solve (the veer-aware rotor,
-#: coupling/yawed_rotor.py, gives the operation models the Core's ambient V this way).
+#: plugin/yawed_rotor.py, gives the operation models the Core's ambient V this way).
 CORE_CONTEXTS: list = []
 _SOLVED: dict = {}  # id(flow_field) -> (weakref to the flow field, EkmanABL)
 
@@ -598,7 +598,7 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
         self.wind_shear = wind_shear
     U, dUdz = inflow_profile(abl, grid.z_sorted, self.reference_wind_height)
     if isinstance(grid, TurbineGrid):
-        # Each rotor point carries the cubic mean of U over its rotor cell (coupling/rotor.py).
+        # Each rotor point carries the cubic mean of U over its rotor cell (plugin/rotor.py).
         # (U alone: the gradient's two extra profile evaluations would be discarded.)
         U = turbine_grid_inflow(
             lambda heights: ambient_rows(abl, heights, self.reference_wind_height)[0], grid
@@ -620,8 +620,8 @@ def _initialize_velocity_field(self: FlowField, grid) -> None:
 def _with_core_atmosphere(method):
     """Run a Core method with the Core's atmosphere (or None) active for flow-field set-ups,
     after checking the operation (yaw) and, for ``solve_for_points``, the sample coordinates
-    (:mod:`floris_ekman_veer.coupling.input_checks`)."""
-    from floris_ekman_veer.coupling import input_checks
+    (:mod:`floris_ekman_veer.plugin.input_checks`)."""
+    from floris_ekman_veer.plugin import input_checks
 
     points = method.__name__ == "solve_for_points"
     full_flow = points or method.__name__ == "solve_for_viz"
@@ -635,7 +635,7 @@ def _with_core_atmosphere(method):
                 input_checks.check_points(*args, **kwargs)
         with contextlib.ExitStack() as stack:
             # The atmosphere, which rotor average each turbine takes, and how the solver
-            # combines wakes and adds turbulence (coupling/rotor.py), for the solve only.
+            # combines wakes and adds turbulence (plugin/rotor.py), for the solve only.
             for variable, value in ((_ACTIVE, atmosphere),
                                     (TURBINE_MOMENTS,
                                      turbine_moments(self.farm.turbine_definitions)),
@@ -704,9 +704,9 @@ def _without_reversed_flow(flow_field: FlowField, result):
 
 def _validating_post_init(method):
     """Validate the atmosphere, and the layout, conditions and turbines of a Core using the
-    package (:func:`floris_ekman_veer.coupling.input_checks.check_core`, before FLORIS builds
+    package (:func:`floris_ekman_veer.plugin.input_checks.check_core`, before FLORIS builds
     its grid), when a Core is built (FlorisModel(), set(), copy())."""
-    from floris_ekman_veer.coupling import input_checks, shallow
+    from floris_ekman_veer.plugin import input_checks, shallow
 
     @functools.wraps(method)
     def wrapper(self: Core) -> None:
@@ -737,7 +737,7 @@ def _reference_height(core: Core) -> float | None:
 
 
 def _check_shallow(core: Core, abl, height: float, stage: str) -> None:
-    from floris_ekman_veer.coupling import shallow
+    from floris_ekman_veer.plugin import shallow
 
     shallow.check_rotor_inside(
         core.wake.wake_velocity_parameters.get(PARAMETER_BLOCK),
@@ -749,7 +749,7 @@ def _check_shallow(core: Core, abl, height: float, stage: str) -> None:
 
 def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
     """Count a Core's conditions whose boundary layer is shallower than a rotor top in one
-    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` (coupling/shallow.py), at
+    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` (plugin/shallow.py), at
     the user's run: every Core solve, the ParFlorisModel parent before its workers (sent with
     the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
     Core's atmosphere, if known (else read)."""
@@ -762,7 +762,7 @@ def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
 
 
 def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
-    """At build: the shallow-boundary-layer policy ``raise`` (coupling/shallow.py; ``warn``
+    """At build: the shallow-boundary-layer policy ``raise`` (plugin/shallow.py; ``warn``
     counts them at the first run instead, :func:`warn_shallow`), hubs in the roughness
     sublayer, and a heterogeneous map given with the atmosphere (warned)."""
     flow_field = core.flow_field
@@ -856,9 +856,9 @@ def install_inflow_hook() -> None:
     ``solve_for_points``, ``solve_for_velocity_deficit_profiles`` (atmosphere context);
     ``FlorisModel.set_for_viz`` (slices per-condition lists). ParFlorisModel's condition
     splitting, UncertainFlorisModel's expansion and the yaw optimisers are installed by
-    :func:`floris_ekman_veer.coupling.parallel.install_parallel_hook`,
-    :func:`floris_ekman_veer.coupling.uncertain.install_uncertain_hook` and
-    :func:`floris_ekman_veer.coupling.optimization.install_optimizer_hook` (this module imports
+    :func:`floris_ekman_veer.plugin.parallel.install_parallel_hook`,
+    :func:`floris_ekman_veer.studies.uncertain.install_uncertain_hook` and
+    :func:`floris_ekman_veer.studies.optimization.install_optimizer_hook` (this module imports
     none of them: imports point one way, docs/coupling.md#parallel-workers).
     """
     _patch(

@@ -11,7 +11,7 @@ classes, each an atmosphere (the ``ekman_veer.atmosphere`` block of the FLORIS i
   class and the class frequencies follow from the records.
 
 For every model (``ekman_veer``, the input's own wake model, and FLORIS's built-ins of
-:data:`~floris_ekman_veer.coupling.comparison.BUILTIN_WAKES`, GCH by default),
+:data:`~floris_ekman_veer.studies.comparison.BUILTIN_WAKES`, GCH by default),
 :func:`annual_energy` runs every condition of every class with non-zero frequency as one
 vectorised FLORIS model, each condition carrying its class's atmosphere (a per-condition
 atmosphere block, docs/coupling.md#annual-energy), in chunks of ``chunk_size`` conditions that
@@ -30,7 +30,7 @@ records each carry their own atmosphere.
 
 Each model sees the atmosphere the way it can (docs/coupling.md#annual-energy): the ekman_veer
 models take their wake expansion from the ABL itself; FLORIS's built-ins get the comparison of
-:func:`~floris_ekman_veer.coupling.comparison.comparison_set_kwargs` (the one
+:func:`~floris_ekman_veer.studies.comparison.comparison_set_kwargs` (the one
 ``examples/yaw_study.py`` uses): per condition the turbulence intensity I_u(z_h) of the class's
 atmosphere, and FLORIS's ``wind_veer`` = 0 (the veer is in the Ekman inflow and the rotor; gauss's
 scalar wind_veer would narrow its wake by cos(wind_veer), docs/yaw_steering.md). With
@@ -49,20 +49,20 @@ import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries, WindRose
 
-from floris_ekman_veer.coupling.comparison import (
+from floris_ekman_veer.studies.comparison import (
     BUILTIN_WAKES,
     builtin_model,
     comparison_set_kwargs,
 )
-from floris_ekman_veer.coupling.inflow import (
+from floris_ekman_veer.plugin.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
     AtmosphereSpec,
     set_atmosphere,
 )
-from floris_ekman_veer.coupling.input_checks import zero_power_speed
-from floris_ekman_veer.coupling.names import VELOCITY_MODEL_NAME as MODEL_NAME
-from floris_ekman_veer.coupling.optimization import check_optimizer_options, optimize_yaw
+from floris_ekman_veer.plugin.input_checks import zero_power_speed
+from floris_ekman_veer.plugin.names import VELOCITY_MODEL_NAME as MODEL_NAME
+from floris_ekman_veer.studies.optimization import check_optimizer_options, optimize_yaw
 
 #: Keys of one class of a stability distribution.
 CLASS_KEYS = ("frequency", "atmosphere")
@@ -237,8 +237,8 @@ class AnnualEnergy:
         return ax
 
     def __attrs_post_init__(self):
-        # print(result.table) shows every column in a plain terminal (coupling/tables.py).
-        from floris_ekman_veer.coupling.tables import FullTable
+        # print(result.table) shows every column in a plain terminal (studies/tables.py).
+        from floris_ekman_veer.studies.tables import FullTable
 
         object.__setattr__(self, "table", FullTable(self.table))
 
@@ -405,7 +405,7 @@ def _check_client(fmodel, client) -> None:
     from floris import FlorisModel
     from floris.par_floris_model import ParFlorisModel
 
-    from floris_ekman_veer.coupling.distributed import _check_workers, _import_distributed
+    from floris_ekman_veer.studies.distributed import _check_workers, _import_distributed
 
     if isinstance(fmodel, ParFlorisModel) or not isinstance(fmodel, FlorisModel):
         raise ValueError(
@@ -586,7 +586,7 @@ def _remote_chunk(chunk, config, model, ti_source, optimizer_class, setting):
     from floris import FlorisModel
 
     import floris_ekman_veer.warnings as package_warnings
-    from floris_ekman_veer.coupling.parallel import prepare_worker
+    from floris_ekman_veer.plugin.parallel import prepare_worker
 
     prepare_worker()
     package_warnings.apply_setting(setting)
@@ -604,7 +604,7 @@ def _remote_chunk(chunk, config, model, ti_source, optimizer_class, setting):
 def _rows_of(optimizer_kwargs, index):
     """The optimiser's options for the wind data's conditions ``index`` (per-condition arrays
     cut to them)."""
-    from floris_ekman_veer.coupling.optimization import PER_CONDITION_OPTIONS
+    from floris_ekman_veer.studies.optimization import PER_CONDITION_OPTIONS
 
     return {name: np.asarray(value, dtype=float)[index]
             if name in PER_CONDITION_OPTIONS and np.ndim(value) == 2 else value

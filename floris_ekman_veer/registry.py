@@ -4,7 +4,7 @@
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
 bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
 inflow hook, the support of ParFlorisModel, UncertainFlorisModel and the yaw optimisers, and the
-conversion of FLORIS wake inputs (coupling/wake_settings.py).
+conversion of FLORIS wake inputs (plugin/wake_settings.py).
 Importing ``floris_ekman_veer`` calls it.
 
 This is the top of the coupling layer: it imports the model, turbine, inflow, parallel, uncertain
@@ -16,7 +16,7 @@ from __future__ import annotations
 import difflib
 from collections.abc import MutableMapping
 
-from floris_ekman_veer.coupling.names import (  # noqa: F401  (part of the registry's interface)
+from floris_ekman_veer.plugin.names import (  # noqa: F401  (part of the registry's interface)
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
@@ -92,7 +92,7 @@ def register_operation_model() -> type:
     """
     from floris.core.turbine import turbine as floris_turbine
 
-    from floris_ekman_veer.coupling.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
+    from floris_ekman_veer.plugin.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
 
     name_checked(floris_turbine.TURBINE_MODEL_MAP, OPERATION_MODEL_PATH)
     return register_in(
@@ -106,17 +106,17 @@ def register() -> None:
     ParFlorisModel support."""
     from floris.core.wake import MODEL_MAP
 
-    from floris_ekman_veer.coupling.inflow import install_inflow_hook
-    from floris_ekman_veer.coupling.models import (
+    from floris_ekman_veer.plugin.inflow import install_inflow_hook
+    from floris_ekman_veer.plugin.models import (
         EkmanVeerVelocityDeficit,
         EkmanVeerVelocityDeflection,
         Gaussian2014VelocityDeficit,
     )
-    from floris_ekman_veer.coupling.optimization import install_optimizer_hook
-    from floris_ekman_veer.coupling.parallel import install_parallel_hook
-    from floris_ekman_veer.coupling.uncertain import install_uncertain_hook
-    from floris_ekman_veer.coupling.wake_settings import install_wake_settings_hook
-    from floris_ekman_veer.coupling.yawed_rotor import install_yawed_rotor_hook
+    from floris_ekman_veer.studies.optimization import install_optimizer_hook
+    from floris_ekman_veer.plugin.parallel import install_parallel_hook
+    from floris_ekman_veer.studies.uncertain import install_uncertain_hook
+    from floris_ekman_veer.plugin.wake_settings import install_wake_settings_hook
+    from floris_ekman_veer.plugin.yawed_rotor import install_yawed_rotor_hook
 
     name_checked(MODEL_MAP, MODEL_PATHS)
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,

@@ -26,7 +26,7 @@ from __future__ import annotations
 import functools
 
 import floris_ekman_veer.warnings as package_warnings
-from floris_ekman_veer.coupling.names import (
+from floris_ekman_veer.plugin.names import (
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
@@ -118,6 +118,6 @@ def install_wake_settings_hook() -> None:
     """Wrap FLORIS's WakeModelManager (idempotent; ``uninstall_inflow_hook`` restores it)."""
     from floris.core.wake import WakeModelManager
 
-    from floris_ekman_veer.coupling.inflow import _patch
+    from floris_ekman_veer.plugin.inflow import _patch
 
     _patch(WakeModelManager, "__attrs_post_init__", _converting_post_init)

@@ -26,8 +26,8 @@ import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-from floris_ekman_veer.coupling.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
-from floris_ekman_veer.coupling.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
+from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 #: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
 PER_CONDITION_OPTIONS = (

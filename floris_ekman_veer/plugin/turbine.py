@@ -34,7 +34,7 @@ cubic mean, which belongs to power curves and would overstate the disk's power i
 Veer-aware yawed disk
 ---------------------
 In a veered inflow the disk-normal velocity is u_n = U cos beta + V sin beta per rotor cell (U, V
-hub-aligned; coupling/yawed_rotor.py, docs/yaw_steering.md), and the disk takes its disk mean
+hub-aligned; plugin/yawed_rotor.py, docs/yaw_steering.md), and the disk takes its disk mean
 <u_n> = <U> gamma, gamma = cos beta + sin beta <V>/<U>, wherever the formulas above take
 <U> cos beta: a(gamma) = C_T' gamma^2 / (4 + C_T' gamma^2), P = 1/2 rho A C_T' [(1 - a) <U> gamma]^3,
 and ct_i = C_T(gamma) gamma^2 / cos beta, so that the wake sees the rotor-normal loading
@@ -73,7 +73,7 @@ setpoints, AWC (the LES disk has none of these); |yaw| must stay below 90 deg. F
 below FLORIS's default raises ValueError (a fixed-C_T' disk has no controller to derate).
 
 Registration: importing ``floris_ekman_veer`` registers the model (in every process, including
-ParFlorisModel workers); :func:`floris_ekman_veer.coupling.registry.register_operation_model`
+ParFlorisModel workers); :func:`floris_ekman_veer.registry.register_operation_model`
 does it alone.
 """
 
@@ -90,7 +90,7 @@ from floris.core.turbine.operation_models import (
 from floris.type_dec import NDArrayFloat
 
 from floris_ekman_veer._validation import number
-from floris_ekman_veer.coupling.crossflow import VEER_AWARE_KEY, ambient_crossflow
+from floris_ekman_veer.plugin.crossflow import VEER_AWARE_KEY, ambient_crossflow
 
 OPERATION_MODEL_NAME = "actuator-disk"
 
@@ -210,7 +210,7 @@ def disk_parameters(
         if key not in power_thrust_table:
             raise ValueError(
                 f"{path} needs '{key}' (build the table with "
-                "floris_ekman_veer.coupling.turbine.actuator_disk_power_thrust_table)"
+                "floris_ekman_veer.plugin.turbine.actuator_disk_power_thrust_table)"
             )
     ct_prime = _ct_prime(power_thrust_table["ct_prime"], f"{path}.ct_prime")
     diameter = _positive(power_thrust_table["rotor_diameter"], f"{path}.rotor_diameter")

@@ -1,6 +1,6 @@
 """The validation cases and their reference data (measured, LES, RANS).
 
-The data ship in ``floris_ekman_veer/validation/data/`` (DTU PyWake's validation data, MIT
+The data ship in ``floris_ekman_veer/studies/validation/data/`` (DTU PyWake's validation data, MIT
 licence; attribution and the original studies in that folder's README.md and in
 docs/validation.md#measured-wakes-and-farms). This module only reads them: each single-wake case
 is a :class:`SingleWakeCase` with its arcs, Horns Rev 1 a :class:`HornsRevCase`.

@@ -4,7 +4,7 @@ One FLORIS input per case, atmosphere reading (validation.atmospheres) and wake 
 turbines and layout of the case, FLORIS's reference height at the hub, the atmosphere block in
 ``wake_velocity_parameters.ekman_veer.atmosphere`` (so every model, FLORIS's own included, runs
 on the Ekman U(z)), FLORIS's turbulence intensity = I_u(z_h) of that atmosphere and the rotor
-veer and shear of ``coupling.comparison.fair_builtin_set_kwargs``. The wake models
+veer and shear of ``studies.comparison.fair_builtin_set_kwargs``. The wake models
 (:data:`WAKE_MODELS`): the paper's M-1, M-2 and M-3 and FLORIS 4.7's gauss, GCH, cc, TurbOPark
 (``turboparkgauss``, A = 0.04) and empirical Gauss with FLORIS's default parameters. Results (docs/validation.md#measured-wakes-and-farms):
 
@@ -20,13 +20,13 @@ import numpy as np
 from floris import FlorisModel, UncertainFlorisModel
 from floris.uncertain_floris_model import map_turbine_values_uncertain
 
-from floris_ekman_veer.coupling.comparison import (
+from floris_ekman_veer.studies.comparison import (
     BUILTIN_WAKES,
     GCH_SWITCHES,
     fair_builtin_set_kwargs,
 )
-from floris_ekman_veer.validation.atmospheres import atmosphere, hub_turbulence
-from floris_ekman_veer.validation.cases import (
+from floris_ekman_veer.studies.validation.atmospheres import atmosphere, hub_turbulence
+from floris_ekman_veer.studies.validation.cases import (
     ARC_HALF_WIDTH,
     HORNS_REV,
     constant_thrust_turbine,
@@ -81,7 +81,7 @@ def floris_input(case, reading: str, model: str, turbine: dict, layout) -> dict:
     x, y = layout
     return {
         "name": f"{case.name} {model} ({reading})",
-        "description": "floris_ekman_veer.validation",
+        "description": "floris_ekman_veer.studies.validation",
         "floris_version": "v4",
         "logging": {"console": {"enable": True, "level": "WARNING"},
                     "file": {"enable": False, "level": "WARNING"}},

@@ -10,7 +10,7 @@ FLORIS's ``"concurrent"`` code path driven by the Executor that ``Client.get_exe
 nothing about the chunking or the merging of results is rewritten here.
 
 Dask workers are separate processes, often on other machines, started without this package
-imported. The chunks sent to them are :class:`~floris_ekman_veer.coupling.parallel.WorkerDict`
+imported. The chunks sent to them are :class:`~floris_ekman_veer.plugin.parallel.WorkerDict`
 inputs, which register the package's models and install the inflow hook on the worker when they
 arrive (docs/coupling.md#parallel-workers); per-condition atmosphere lists are cut with the
 conditions. When the model is built, every current worker imports the package once and reports its
@@ -30,7 +30,7 @@ from floris.par_floris_model import ParFlorisModel as _FlorisParFlorisModel
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._version import __version__
-from floris_ekman_veer.coupling.parallel import prepare_worker
+from floris_ekman_veer.plugin.parallel import prepare_worker
 
 DASK = "dask"
 

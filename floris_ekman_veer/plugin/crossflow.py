@@ -15,7 +15,7 @@ cell of the turbines using that table, shaped ``(n_findex, 1, *cells)`` so that 
 against the velocities FLORIS passes (sorted or not, filtered to one turbine or not: every turbine
 of one turbine type has the same hub height and diameter, hence the same V cells). Outside such a
 context, and for FLORIS inputs without an atmosphere, the look-up is None and every operation
-model is exactly FLORIS's. :mod:`floris_ekman_veer.coupling.yawed_rotor` sets it.
+model is exactly FLORIS's. :mod:`floris_ekman_veer.plugin.yawed_rotor` sets it.
 
 The formulas here are plain numpy (no FLORIS state): the rotor-normal velocity per cell and the
 two factors by which the veer-aware rotor differs from the cosine law.
@@ -53,7 +53,7 @@ MOMENTS = ("U1", "U3", "V", "UV", "VV", "UUV", "UVV", "VVV")
 def cell_moments(u_rows, v_rows, cell_sums=None, area=1.0):
     """The :data:`MOMENTS` of each cell from U, V at sub-point rows ``u_rows``, ``v_rows``
     (..., rows): ``cell_sums(values)`` sums the rows' area weights into each cell (e.g.
-    :func:`~floris_ekman_veer.coupling.rotor.row_cell_sums`), of total ``area`` per cell; None:
+    :func:`~floris_ekman_veer.plugin.rotor.row_cell_sums`), of total ``area`` per cell; None:
     every row is a cell of its own (the points of a cubature grid), the moments are point
     values, in O(points) work and memory."""
     def mean(values):

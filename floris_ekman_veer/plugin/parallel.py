@@ -23,8 +23,8 @@ import functools
 import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
-from floris_ekman_veer.coupling import shallow
-from floris_ekman_veer.coupling.inflow import (
+from floris_ekman_veer.plugin import shallow
+from floris_ekman_veer.plugin.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
     _patch,
