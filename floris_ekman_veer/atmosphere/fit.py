@@ -406,41 +406,35 @@ class _ProfileModel:
             )
         return g, mu, z0, valid, h
 
-    def abl(self, g, mu, z0, index):
-        """The ABLs of states (g, mu, z0) of records ``index``, and which of them the class
-        solves (a state the ABL class refuses, its own checks stricter than :meth:`state`'s in
-        the last bits, is replaced by a neutral stand-in and marked False: one record's trial
-        step never aborts the others')."""
+    def abl(self, log_u, g, mu, z0, valid, index):
+        """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
+        (``EkmanABL._solved_at``: G was computed from u*, the fit never solves for it again).
+        A state that is no model state (``valid`` False, from :meth:`state`) is replaced by a
+        neutral stand-in, G = 10 m/s, solved for those records only: one record's trial step
+        never aborts the others'."""
         fixed = self.fixed_at(index)
-        try:
-            return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
-                            **fixed), np.ones(len(index), bool)
-        except ValueError:
-            pass
-        solved = np.ones(len(index), bool)
-        for k in range(len(index)):  # only after a refusal: find the refused states
-            try:
-                self.cls(geostrophic_wind=g[k], stability_parameter=mu[k],
-                         roughness_length=np.broadcast_to(z0, (len(index),))[k],
-                         **{n: (v[k] if np.ndim(v) else v) for n, v in fixed.items()})
-            except ValueError:
-                solved[k] = False
-        g, mu = np.where(solved, g, 10.0), np.where(solved, mu, 0.0)
-        return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
-                        **fixed), solved
+        if not np.all(valid):
+            bad = np.flatnonzero(~valid)
+            stand_in = self.cls(geostrophic_wind=10.0, stability_parameter=0.0,
+                                roughness_length=np.broadcast_to(z0, valid.shape)[bad],
+                                **{k: (v if np.ndim(v) == 0 else np.asarray(v)[bad])
+                                   for k, v in fixed.items()})
+            log_u, g, mu = log_u.copy(), g.copy(), mu.copy()
+            log_u[bad] = np.log(stand_in.friction_velocity)
+            g[bad], mu[bad] = 10.0, 0.0
+        return self.cls._solved_at(log_u, g, stability_parameter=mu, roughness_length=z0,
+                                   **fixed)
 
     def residuals(self, x, index):
         """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
         g, mu, z0, valid, _ = self.state(x, index)
         # Invalid trial states are evaluated at a harmless stand-in and discarded.
-        g = np.where(valid, g, 10.0)
-        mu = np.where(valid, mu, 0.0)
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl, solved = self.abl(g, mu, z0, index)
-        valid = valid & solved
-        z = np.transpose(self.z[index])
-        speed = np.transpose(abl.speed(z))
-        angle = None if self.d is None else np.transpose(abl.wind_angle(z))
+        abl = self.abl(x[:, 0], g, mu, z0, valid, index)
+        # One evaluation of the profile gives the speeds and the flow angles.
+        u, v = abl._velocity(np.transpose(self.z[index]))
+        speed = np.transpose(np.hypot(u, v))
+        angle = None if self.d is None else np.transpose(np.rad2deg(np.arctan2(v, u)))
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
             self.sigma_s, self.sigma_d, offset=True)
