@@ -282,3 +282,17 @@ def test_a_backing_front_is_refused_within_the_model_error():
     assert not fit.fits
     kind, text = fit.reason(0)
     assert kind == "backing" and "backs with height by 20 deg from 30 m to 150 m" in text
+
+
+def test_a_top_below_the_lowest_measurement_is_never_shown():
+    """A light-wind record of the mast year (a convective afternoon, speeds peaking at 110 m by
+    2.5 times speed_noise over 150 m): a stable top at 20 m, below every measurement, is not
+    shown by that maximum (refused as no top); one at 90 m, with measurements below it, is
+    (docs/measurements.md#a-top-the-data-show)."""
+    from floris_ekman_veer.atmosphere.fit import _hidden_top
+
+    heights = np.array([[30.0, 70.0, 110.0, 150.0]] * 2)
+    speeds = np.array([[1.83, 2.01, 2.01, 1.76]] * 2)
+    directions = np.array([[80.0, 80.0, 79.0, 79.6]] * 2)
+    hidden = _hidden_top(heights, speeds, directions, np.array([20.0, 90.0]), 0.1, 0.5)
+    assert hidden.tolist() == [True, False]

@@ -284,7 +284,8 @@ class ProfileFit:
                 and np.reshape(self.refusal_misfit, -1)[i]
                 <= np.reshape(self.misfit_tolerance, -1)[i]
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
-                                depth, self.speed_noise, self.direction_noise)[0]):
+                                depth, self.speed_noise,
+                                np.hypot(self.direction_noise, self.direction_model_error))[0]):
             return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
                                                 depth[0], self.speed_noise, self.direction_noise)
         return misfit_reason(self.heights[i], self.speeds[i],
@@ -628,7 +629,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
             the chi-square quantile of this upper-tail probability (degrees of freedom: data
             minus unknowns) fits no atmosphere of the model: with dof = 11 (7 heights, speeds
-            and directions) that is a ``refusal_misfit`` above 2.07, with dof = 1 above 4.9.
+            and directions) that is a ``refusal_misfit`` above 2.11, with dof = 1 above 4.9.
         direction_model_error: [deg] >= 0, default 1: added in variance to
             ``direction_noise`` in that test only (not in the fit's weights): the model's
             turning with height is the Ekman layer's, and a measured one differs by a few
@@ -818,8 +819,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         # A stable layer shallower than the highest measurement only where the data show its
         # top (docs/measurements.md#a-top-the-data-show).
         _, _, _, _, depth = model.state(x, index)
+        # (a veer stopping is a top only beyond the directions' model error too)
         fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
-                                      float(direction_noise)))
+                                      float(np.hypot(direction_noise, direction_model_error))))
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, refusal_misfit, model, misfit_tolerance,
@@ -1132,14 +1134,15 @@ def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
     than two noise standard deviations), the shear stopping at the top (the speed grows from the
     lowest height to the first one at or above the top by more than three standard deviations of
     a difference more than it changes from there to the highest) or the veer stopping (the same
-    for the direction's turning)."""
+    for the direction's turning). A top below the lowest measurement is never shown: above it
+    the model's wind is uniform, and no measurement reaches below it."""
     top = np.nanmax(np.where(np.isfinite(speeds), heights, np.nan), axis=1)
     shallow = np.isfinite(depth) & (depth < top)
     if not np.any(shallow):
         return shallow
     c = _top_changes(heights, speeds, directions, np.where(shallow, depth, np.inf))
     step_s, step_d = 3.0 * np.sqrt(2.0) * sigma_s, 3.0 * np.sqrt(2.0) * sigma_d
-    shown = c["peak"] > 2.0 * sigma_s
+    shown = c["below"] & (c["peak"] > 2.0 * sigma_s)
     shown |= c["below"] & (c["speed_below"] - np.abs(c["speed_above"]) > step_s)
     if directions is not None:
         shown |= c["below"] & (np.abs(c["turn_below"]) - np.abs(c["turn_above"]) > step_d)
