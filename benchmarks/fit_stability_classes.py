@@ -20,6 +20,14 @@ shallow); u* uniform in 0.2..0.6 m/s; mixed_layer_height 1000 m; the same noise.
 above plus, for the convective class, the share and the largest of the relative errors of the
 fitted I_u(90 m) against Panofsky et al. (1977)'s sigma_u/u* = (12 - 0.5 z_i/L)^(1/3), z_i =
 1000 m, without and with that I_u given as measured (``turbulence_intensity``).
+
+Last, neutral records whose direction turns with height more than the model's neutral layer does
+(``turning_records``, docs/measurements.md#direction-model-error): the log law (u* 0.2-0.6 m/s in
+12 steps, 7 records each: 84 records, hub speeds 3.4-10.2 m/s) with the direction turning
+linearly by +5 deg (veering), -5 deg (backing) or 0 from 30 to 150 m, the same noise (seed 3);
+printed per turning: the records accepted with the default ``direction_model_error`` (1 deg) and
+with 0, the fitted classes, and the largest hub speed error of the accepted records with hub
+speed >= 6 m/s and below.
 """
 
 import sys
@@ -110,6 +118,35 @@ def published_confusion(n=200):
     return out
 
 
+TURNING_FRICTION_VELOCITIES = np.repeat(np.linspace(0.2, 0.6, 12), 7)
+
+
+def turning_records(turn, seed=3):
+    """(hub speed, speeds, directions) of the 84 neutral log-law records with the direction
+    turning linearly by ``turn`` [deg] from 30 to 150 m, 0.1 m/s and 0.5 deg of noise."""
+    rng = np.random.default_rng(seed)
+    u_star = TURNING_FRICTION_VELOCITIES[:, None]
+    z0 = SITE["roughness_length"]
+    speeds = u_star / 0.4 * np.log(HEIGHTS / z0) + rng.normal(0.0, 0.1, (u_star.size, HEIGHTS.size))
+    directions = (250.0 + turn * (HEIGHTS - HEIGHTS[0]) / (HEIGHTS[-1] - HEIGHTS[0])
+                  + rng.normal(0.0, 0.5, speeds.shape))
+    return u_star[:, 0] / 0.4 * np.log(90.0 / z0), speeds, directions
+
+
+def turning_acceptance(turn, **options):
+    """(accepted, {fitted class: count}, largest hub error of the accepted at hub >= 6 m/s, and
+    below) for :func:`turning_records` fitted with ``stability="either"``."""
+    hub, speeds, directions = turning_records(turn)
+    fit = EkmanABL.fit_profile(HEIGHTS, speeds, directions, on_misfit="flag", stability="either",
+                               speed_noise=0.1, direction_noise=0.5, **SITE,
+                               **options).profile_fit
+    error = np.abs(fit.speed(np.array([90.0]))[:, 0] / hub - 1.0)
+    fits = np.asarray(fit.fits)
+    largest = [float(np.max(error[fits & part], initial=0.0)) for part in (hub >= 6.0, hub < 6.0)]
+    return (int(np.sum(fits)), {k: int(np.sum(fit.stability_class[fits] == k)) for k in CLASSES},
+            *largest)
+
+
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 200
     print(f"{n} records per class; fitted class counts, refused, max hub speed error")
@@ -124,3 +161,12 @@ if __name__ == "__main__":
         for true, (counts, refused, error) in table.items():
             print(f"  {true:10s} " + "  ".join(f"{k} {v:3d}" for k, v in counts.items())
                   + f"  refused {refused}  max error {100 * error:.2f} %")
+    print(f"neutral log law turning with height, {TURNING_FRICTION_VELOCITIES.size} records each: "
+          "accepted with direction_model_error 1 deg (default) and 0; classes and largest hub "
+          "speed error of the accepted (hub >= 6 m/s / below)")
+    for turn in (5.0, -5.0, 0.0):
+        accepted, classes, high, low = turning_acceptance(turn)
+        alone = turning_acceptance(turn, direction_model_error=0.0)[0]
+        print(f"  turning {turn:+g} deg: accepted {accepted} (with 0: {alone})  "
+              + "  ".join(f"{k} {v:2d}" for k, v in classes.items())
+              + f"  max error {100 * high:.2f} % / {100 * low:.2f} %")

@@ -250,3 +250,27 @@ def test_any_model_profile_is_recovered(speed, inverse_length, latitude, log_z0,
     speed_error, direction_error = profile_errors(fit, abl)
     assert speed_error < 0.005 and direction_error < 0.3
     assert fit.misfit < 1e-4
+
+
+def test_states_set_at_their_known_friction_velocity_are_the_solved_ones():
+    """The fit's trial states are set at their u* (EkmanABL._solved_at, no re-solve,
+    docs/measurements.md#fit-time): the same ABL as the solve from their G, stable, neutral and
+    convective, both hemispheres, to the solver's tolerance."""
+    lengths = np.array([-40.0, -300.0, np.inf, 400.0, 120.0, 60.0])
+    f = np.array([1e-4, -1e-4, 1.2e-4, -0.8e-4, 1e-4, 1.1e-4])
+    solved = EkmanABL.from_reference_wind(np.linspace(5.0, 12.0, 6), 90.0, obukhov_length=lengths,
+                                          coriolis_parameter=f, roughness_length=0.1,
+                                          mixed_layer_height=900.0)
+    mu = np.asarray(solved.stability_parameter)
+    at = EkmanABL._solved_at(np.log(solved.friction_velocity), solved.geostrophic_wind,
+                             stability_parameter=mu, coriolis_parameter=f, roughness_length=0.1,
+                             mixed_layer_height=900.0)
+    again = EkmanABL(geostrophic_wind=solved.geostrophic_wind, stability_parameter=mu,
+                     coriolis_parameter=f, roughness_length=0.1, mixed_layer_height=900.0)
+    z = MAST[:, None]
+    for name in ("friction_velocity", "boundary_layer_height", "cross_isobaric_angle"):
+        np.testing.assert_allclose(getattr(at, name), getattr(again, name), rtol=1e-10)
+    np.testing.assert_allclose(at.speed(z), again.speed(z), rtol=1e-10)
+    np.testing.assert_allclose(at.wind_angle(z), again.wind_angle(z), atol=1e-8)
+    np.testing.assert_allclose(at.turbulence_intensity(z), again.turbulence_intensity(z),
+                               rtol=1e-10)

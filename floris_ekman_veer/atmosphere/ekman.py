@@ -430,6 +430,21 @@ class EkmanABL:
             raise ValueError("check_inputs takes the inputs without geostrophic_wind")
         return cls(geostrophic_wind=_INPUTS_ONLY, **inputs)
 
+    @classmethod
+    def _solved_at(cls, log_u_star, geostrophic_wind, **inputs):
+        """The ABL of ``inputs`` and ``geostrophic_wind`` whose solve's root ln u* is already
+        known: the state of Eq. (GDL) is explicit in u* for a given stability (the reference-wind
+        solve's parametrisation, docs/atmosphere.md#reference-wind-solve), so a caller that
+        found G from u* (the profile fit, docs/measurements.md#fit-time) sets the solution
+        without solving for u* again. The caller vouches that the state is a model state (a
+        physical GDL branch, a surface layer above z0, h at least the shallowest accepted)."""
+        abl = cls.check_inputs(**inputs)
+        abl.geostrophic_wind = np.asarray(geostrophic_wind, dtype=float)
+        params, shape = abl._parameters(abl.geostrophic_wind, np.shape(log_u_star))
+        abl._params = params
+        abl._set_solution(np.broadcast_to(np.asarray(log_u_star, dtype=float), shape), params)
+        return abl
+
     @staticmethod
     def valid_range(name):
         """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`)."""

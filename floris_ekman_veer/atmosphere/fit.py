@@ -34,7 +34,10 @@ that top (a speed maximum, or the shear or the veer stopping at it); otherwise i
 
 Refusal: a record whose best fit misses the data by more than the model plus the stated noise
 would with probability ``refusal_probability`` (1e-6; a chi-square test) fits no atmosphere of
-the model (directions backing with height in the northern
+the model. The test widens the direction variance by ``direction_model_error`` (1 deg: the
+model's turning is that of a horizontally homogeneous Ekman layer, a few degrees of thermal-wind
+turning across a mast are not in it, docs/measurements.md#direction-model-error); the fit itself
+weighs the directions by their measurement noise alone (directions backing with height in the northern
 hemisphere, speeds falling from the lowest height, a profile kinked beyond the model's...):
 ValueError naming the record and what in its data the model cannot follow, unless
 ``on_misfit="flag"``, which keeps the fits and marks them in ``ProfileFit.fits``.
@@ -57,7 +60,7 @@ from floris_ekman_veer._validation import real_array, require_at
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
                "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
-               "turbulence_intensity", "turbulence_noise")
+               "turbulence_intensity", "turbulence_noise", "direction_model_error")
 #: Default noise of a measured turbulence intensity, relative to its value: the order of the
 #: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
 DEFAULT_TURBULENCE_NOISE = 0.1
@@ -72,6 +75,10 @@ STABILITY_CHOICES = ("stable", "convective", "either")
 #: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
 DEFAULT_SPEED_NOISE = 0.2
 DEFAULT_DIRECTION_NOISE = 1.0
+#: Default model error of the directions [deg], added in variance to ``direction_noise`` in the
+#: chi-square refusal only (docs/measurements.md#direction-model-error): a neutral layer with 5 deg
+#: of thermal-wind turning between 30 and 150 m is accepted at 0.5 deg of vane noise.
+DEFAULT_DIRECTION_MODEL_ERROR = 1.0
 #: A record is refused (or flagged) when the model plus the stated noise would give a misfit as
 #: large as its best fit's with a probability below this (chi-square test of its residuals).
 DEFAULT_REFUSAL_PROBABILITY = 1e-6
@@ -114,7 +121,11 @@ class ProfileFit:
         direction_residual: rms of the direction misfit [deg] (NaN without directions).
         misfit: rms normalised residual per degree of freedom (about 1 for the model plus the
             stated noise).
-        fits: the record passes the chi-square test of ``refusal_probability``.
+        fits: the record passes the chi-square test of ``refusal_probability``: its
+            ``refusal_misfit`` at most ``misfit_tolerance``.
+        refusal_misfit: ``misfit`` with the direction residuals normalised by
+            sqrt(direction_noise^2 + direction_model_error^2) (equal to it without directions or
+            with ``direction_model_error=0``).
         iterations, converged: of the Levenberg-Marquardt iteration.
         labels: Record names used in messages (index by default).
         fixed_inputs: The fixed EkmanABL inputs as given.
@@ -148,8 +159,12 @@ class ProfileFit:
     single: bool
     #: "convective", "neutral" or "stable" per record (`_stability_class` of the fitted L).
     stability_class: np.ndarray | str | None = None
-    #: The refusal threshold of ``misfit`` per record (the chi-square test).
+    #: The refusal threshold of ``refusal_misfit`` per record (the chi-square test).
     misfit_tolerance: np.ndarray | float = np.inf
+    #: The misfit the chi-square test reads: directions with their model error added.
+    refusal_misfit: np.ndarray | float | None = None
+    #: [deg] the directions' model error of the refusal (docs/measurements.md#direction-model-error).
+    direction_model_error: float = 0.0
 
     def speed(self, heights):
         """Fitted speed [m/s] at ``heights`` ((n_heights,) or (n_records, n_heights)), shaped
@@ -266,9 +281,11 @@ class ProfileFit:
         depth = np.reshape(self.boundary_layer_height, -1)[i : i + 1]
         directions = None if self.directions is None else self.directions[i : i + 1]
         if (np.reshape(self.obukhov_length, -1)[i] > 0
-                and np.reshape(self.misfit, -1)[i] <= np.reshape(self.misfit_tolerance, -1)[i]
+                and np.reshape(self.refusal_misfit, -1)[i]
+                <= np.reshape(self.misfit_tolerance, -1)[i]
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
-                                depth, self.speed_noise, self.direction_noise)[0]):
+                                depth, self.speed_noise,
+                                np.hypot(self.direction_noise, self.direction_model_error))[0]):
             return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
                                                 depth[0], self.speed_noise, self.direction_noise)
         return misfit_reason(self.heights[i], self.speeds[i],
@@ -390,41 +407,35 @@ class _ProfileModel:
             )
         return g, mu, z0, valid, h
 
-    def abl(self, g, mu, z0, index):
-        """The ABLs of states (g, mu, z0) of records ``index``, and which of them the class
-        solves (a state the ABL class refuses, its own checks stricter than :meth:`state`'s in
-        the last bits, is replaced by a neutral stand-in and marked False: one record's trial
-        step never aborts the others')."""
+    def abl(self, log_u, g, mu, z0, valid, index):
+        """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
+        (``EkmanABL._solved_at``: G was computed from u*, the fit never solves for it again).
+        A state that is no model state (``valid`` False, from :meth:`state`) is replaced by a
+        neutral stand-in, G = 10 m/s, solved for those records only: one record's trial step
+        never aborts the others'."""
         fixed = self.fixed_at(index)
-        try:
-            return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
-                            **fixed), np.ones(len(index), bool)
-        except ValueError:
-            pass
-        solved = np.ones(len(index), bool)
-        for k in range(len(index)):  # only after a refusal: find the refused states
-            try:
-                self.cls(geostrophic_wind=g[k], stability_parameter=mu[k],
-                         roughness_length=np.broadcast_to(z0, (len(index),))[k],
-                         **{n: (v[k] if np.ndim(v) else v) for n, v in fixed.items()})
-            except ValueError:
-                solved[k] = False
-        g, mu = np.where(solved, g, 10.0), np.where(solved, mu, 0.0)
-        return self.cls(geostrophic_wind=g, stability_parameter=mu, roughness_length=z0,
-                        **fixed), solved
+        if not np.all(valid):
+            bad = np.flatnonzero(~valid)
+            stand_in = self.cls(geostrophic_wind=10.0, stability_parameter=0.0,
+                                roughness_length=np.broadcast_to(z0, valid.shape)[bad],
+                                **{k: (v if np.ndim(v) == 0 else np.asarray(v)[bad])
+                                   for k, v in fixed.items()})
+            log_u, g, mu = log_u.copy(), g.copy(), mu.copy()
+            log_u[bad] = np.log(stand_in.friction_velocity)
+            g[bad], mu[bad] = 10.0, 0.0
+        return self.cls._solved_at(log_u, g, stability_parameter=mu, roughness_length=z0,
+                                   **fixed)
 
     def residuals(self, x, index):
         """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
         g, mu, z0, valid, _ = self.state(x, index)
         # Invalid trial states are evaluated at a harmless stand-in and discarded.
-        g = np.where(valid, g, 10.0)
-        mu = np.where(valid, mu, 0.0)
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl, solved = self.abl(g, mu, z0, index)
-        valid = valid & solved
-        z = np.transpose(self.z[index])
-        speed = np.transpose(abl.speed(z))
-        angle = None if self.d is None else np.transpose(abl.wind_angle(z))
+        abl = self.abl(x[:, 0], g, mu, z0, valid, index)
+        # One evaluation of the profile gives the speeds and the flow angles.
+        u, v = abl._velocity(np.transpose(self.z[index]))
+        speed = np.transpose(np.hypot(u, v))
+        angle = None if self.d is None else np.transpose(np.rad2deg(np.arctan2(v, u)))
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
             self.sigma_s, self.sigma_d, offset=True)
@@ -604,7 +615,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
                 on_misfit="raise", labels=None, max_iterations=100, stability="stable",
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
-                turbulence_noise=DEFAULT_TURBULENCE_NOISE, **fixed_inputs):
+                turbulence_noise=DEFAULT_TURBULENCE_NOISE,
+                direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -617,7 +629,12 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
             the chi-square quantile of this upper-tail probability (degrees of freedom: data
             minus unknowns) fits no atmosphere of the model: with dof = 11 (7 heights, speeds
-            and directions) that is a ``misfit`` above 2.07, with dof = 1 above 4.9.
+            and directions) that is a ``refusal_misfit`` above 2.11, with dof = 1 above 4.9.
+        direction_model_error: [deg] >= 0, default 1: added in variance to
+            ``direction_noise`` in that test only (not in the fit's weights): the model's
+            turning with height is the Ekman layer's, and a measured one differs by a few
+            degrees of thermal-wind turning either way, veering or backing
+            (docs/measurements.md#direction-model-error); 0 tests against the noise alone.
         on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
         labels: a name per record for messages (e.g. time stamps); default its index.
         max_iterations: of the Levenberg-Marquardt iteration.
@@ -654,7 +671,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
             max_iterations=max_iterations, chunk_size=chunk_size,
             turbulence_intensity=turbulence_intensity, turbulence_noise=turbulence_noise,
-            **fixed_inputs)
+            direction_model_error=direction_model_error, **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -702,6 +719,11 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 or not 0 < value < upper):
             valid = "in (0, 1)" if name == "refusal_probability" else "> 0"
             raise ValueError(f"fit_profile: {name} must be a number {valid}; got {value!r}")
+    if (isinstance(direction_model_error, bool)
+            or not isinstance(direction_model_error, (int, float, np.integer, np.floating))
+            or not np.isfinite(direction_model_error) or direction_model_error < 0):
+        raise ValueError(f"fit_profile: direction_model_error must be a number >= 0 [deg]; got "
+                         f"{direction_model_error!r}")
     if on_misfit not in ("raise", "flag"):
         raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
     if not isinstance(fit_roughness, bool):
@@ -786,17 +808,25 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     else:
         count = np.maximum(np.sum(np.isfinite(directions), axis=1), 1)
         direction_rms = np.sqrt(np.sum(r[:, m:2 * m] ** 2, axis=1) / count) * direction_noise
-    fits = misfit <= misfit_tolerance
+    # The refusal's chi-square: the direction residuals (columns m to 2 m) with the model's
+    # direction error added to their variance (docs/measurements.md#direction-model-error).
+    widen = np.ones(r.shape[1])
+    if directions is not None:
+        widen[m:2 * m] = direction_noise**2 / (direction_noise**2 + direction_model_error**2)
+    refusal_misfit = np.where(valid, np.sqrt(np.sum(r**2 * widen, axis=1) / dof), np.inf)
+    fits = refusal_misfit <= misfit_tolerance
     if sign > 0:
         # A stable layer shallower than the highest measurement only where the data show its
         # top (docs/measurements.md#a-top-the-data-show).
         _, _, _, _, depth = model.state(x, index)
+        # (a veer stopping is a top only beyond the directions' model error too)
         fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
-                                      float(direction_noise)))
+                                      float(np.hypot(direction_noise, direction_model_error))))
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
-                            speed_rms, direction_rms, misfit, model, misfit_tolerance,
-                            float(refusal_probability), depth if sign > 0 else None)
+                            speed_rms, direction_rms, refusal_misfit, model, misfit_tolerance,
+                            float(refusal_probability), depth if sign > 0 else None,
+                            float(direction_model_error))
 
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
@@ -824,7 +854,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
         speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
         stability_class=shape(_stability_class(obukhov)),
-        misfit_tolerance=shape(misfit_tolerance),
+        misfit_tolerance=shape(misfit_tolerance), refusal_misfit=shape(refusal_misfit),
+        direction_model_error=float(direction_model_error),
     )
     abl.profile_fit = fit
     return abl
@@ -852,13 +883,18 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     ]
     stable, convective = fits
     passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
-    take = np.where(passes_s == passes_c, np.asarray(convective.misfit) < np.asarray(stable.misfit),
-                    passes_c)
+    # Convective where it misses the data less; among equally good fits (data that do not tell
+    # the signs apart, e.g. two speeds for two unknowns, both met to round-off) the stable or
+    # neutral one, the paper's classes, whatever the round-off of the two iterations.
+    m_s, m_c = np.asarray(stable.misfit), np.asarray(convective.misfit)
+    better = m_c < m_s * (1.0 - 1e-6) - 1e-6
+    take = np.where(passes_s == passes_c, better, passes_c)
     chosen = {}
     for field in attrs.fields(ProfileFit):
         a, b = getattr(stable, field.name), getattr(convective, field.name)
         if field.name in ("abl", "heights", "speeds", "directions", "labels", "fixed_inputs",
-                          "speed_noise", "direction_noise", "single", "fitted"):
+                          "speed_noise", "direction_noise", "single", "fitted",
+                          "direction_model_error"):
             chosen[field.name] = a
         else:
             chosen[field.name] = np.where(take, b, a)[()]
@@ -868,9 +904,11 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         i = int(np.argmin(passes))
         raise ValueError(
             f"fit_profile: record {fit.labels[i]} fits no atmosphere of the model, stable or "
-            f"convective: misfit {np.atleast_1d(stable.misfit)[i]:.3g} stable, "
-            f"{np.atleast_1d(convective.misfit)[i]:.3g} convective (about 1 for the model plus "
-            f"the stated noise; {np.sum(~passes)} record(s) refused); fit it with "
+            f"convective: misfit {np.atleast_1d(stable.refusal_misfit)[i]:.3g} stable, "
+            f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective (about 1 for the "
+            f"model plus the stated noise, refused above "
+            f"{np.atleast_1d(stable.misfit_tolerance)[i]:.3g}; {np.sum(~passes)} record(s) "
+            "refused); fit it with "
             "stability='stable' for what in its data the model cannot follow"
         )
     mu = np.asarray(fit.stability_parameter, float)
@@ -1096,14 +1134,15 @@ def _hidden_top(heights, speeds, directions, depth, sigma_s, sigma_d):
     than two noise standard deviations), the shear stopping at the top (the speed grows from the
     lowest height to the first one at or above the top by more than three standard deviations of
     a difference more than it changes from there to the highest) or the veer stopping (the same
-    for the direction's turning)."""
+    for the direction's turning). A top below the lowest measurement is never shown: above it
+    the model's wind is uniform, and no measurement reaches below it."""
     top = np.nanmax(np.where(np.isfinite(speeds), heights, np.nan), axis=1)
     shallow = np.isfinite(depth) & (depth < top)
     if not np.any(shallow):
         return shallow
     c = _top_changes(heights, speeds, directions, np.where(shallow, depth, np.inf))
     step_s, step_d = 3.0 * np.sqrt(2.0) * sigma_s, 3.0 * np.sqrt(2.0) * sigma_d
-    shown = c["peak"] > 2.0 * sigma_s
+    shown = c["below"] & (c["peak"] > 2.0 * sigma_s)
     shown |= c["below"] & (c["speed_below"] - np.abs(c["speed_above"]) > step_s)
     if directions is not None:
         shown |= c["below"] & (np.abs(c["turn_below"]) - np.abs(c["turn_above"]) > step_d)
@@ -1134,7 +1173,7 @@ def _hidden_top_reason(heights, speeds, directions, depth, sigma_s, sigma_d):
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability, depth=None):
+                  model, tolerance, probability, depth=None, model_error=0.0):
     i = int(failing[0])
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
     _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
@@ -1161,7 +1200,9 @@ def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direc
     return ValueError(
         f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
         f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
-        f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg; refused "
+        f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg"
+        + (f" with direction_model_error={model_error:g} deg" if directions is not None else "")
+        + "; refused "
         f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
         f"{reason}{more}. Give "
         "on_misfit='flag' to keep the fits and read profile_fit.fits"

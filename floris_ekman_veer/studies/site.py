@@ -398,6 +398,9 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     if single:
         heights, speeds = heights[0], speeds[0]
         directions = None if directions is None else directions[0]
+    # The veer is met within veer_tolerance as stated: no model error of the directions is
+    # added to it (docs/measurements.md#direction-model-error).
+    fit_options_and_inputs.setdefault("direction_model_error", 0.0)
     try:
         return EkmanABL.fit_profile(
             heights, speeds, directions,
