@@ -508,7 +508,8 @@ def _rows_velocity(abl, heights: np.ndarray, reference_height: float):
 def _ambient_velocity(abl, z, reference_height: float, frame=None):
     above = z >= 0.0
     if np.all(above):
-        return abl.hub_aligned_velocity(z, reference_height, frame)
+        # Arrays also for a scalar height: callers cache them read-only.
+        return tuple(np.asarray(a) for a in abl.hub_aligned_velocity(z, reference_height, frame))
     U, V = abl.hub_aligned_velocity(np.where(above, z, 0.0), reference_height, frame)
     return np.where(above, U, 0.0), np.where(above, V, 0.0)
 
