@@ -295,11 +295,19 @@ def atmosphere_of(core: Core) -> AtmosphereSpec | None:
     atmosphere = read_atmosphere(core.wake.wake_velocity_parameters)
     if atmosphere is None:
         return None
+    spec = farm_atmosphere(atmosphere, core.farm)
+    spec.check_conditions(core.flow_field.n_findex)
+    return spec
+
+
+def farm_atmosphere(atmosphere, farm) -> AtmosphereSpec:
+    """The ``ekman_veer.atmosphere`` block as the inflow hook solves it for ``farm``: its
+    conditions at rest below the farm's zero-power speed. A study that solves the same block
+    before the model is built (the GCH comparison) finds its solve in the solve cache."""
     from floris_ekman_veer.plugin.input_checks import zero_power_speed
 
-    spec = AtmosphereSpec.from_mapping(atmosphere)
-    spec.check_conditions(core.flow_field.n_findex)
-    return attrs.evolve(spec, rest_below=zero_power_speed(core.farm.turbine_definitions))
+    return attrs.evolve(AtmosphereSpec.from_mapping(atmosphere),
+                        rest_below=zero_power_speed(farm.turbine_definitions))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -58,9 +58,9 @@ from floris_ekman_veer.plugin.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
     AtmosphereSpec,
+    farm_atmosphere,
     set_atmosphere,
 )
-from floris_ekman_veer.plugin.input_checks import zero_power_speed
 from floris_ekman_veer.plugin.names import VELOCITY_MODEL_NAME as MODEL_NAME
 from floris_ekman_veer.studies.optimization import check_optimizer_options, optimize_yaw
 
@@ -620,10 +620,8 @@ def _chunk_model(template, model: str, chunk: _Chunk, ti_source: str):
                   turbulence_intensities=chunk.wind_ti)
     if ti_source == "atmosphere" or model != MODEL_NAME:
         farm = template.core.farm
-        spec = attrs.evolve(AtmosphereSpec.from_mapping(chunk.atmosphere),
-                            rest_below=zero_power_speed(farm.turbine_definitions))
         fair = comparison_set_kwargs(
-            spec, chunk.speeds, template.core.flow_field.reference_wind_height,
+            farm_atmosphere(chunk.atmosphere, farm), chunk.speeds, template.core.flow_field.reference_wind_height,
             float(farm.hub_heights.reshape(-1, farm.n_turbines)[0, 0]),
             float(farm.rotor_diameters.reshape(-1, farm.n_turbines)[0, 0]))
         if ti_source == "atmosphere":
