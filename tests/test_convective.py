@@ -18,6 +18,7 @@ from floris_ekman_veer import EkmanABL
 from floris_ekman_veer.atmosphere.ekman import (
     air_heat_capacity,
     boundary_layer_height_hat,
+    gdl_coefficients,
     stability_term,
     unstable_phi_m,
     unstable_psi_m,
@@ -176,6 +177,76 @@ def test_deep_mixed_layer_has_weak_shear_and_veer():
     assert abs(mixed.cross_isobaric_angle) < 0.7 * abs(neutral.cross_isobaric_angle)
     # across the rotor both turn the wind by less than a degree (the published V backs there)
     assert abs(mixed.wind_direction_change(27.0, 153.0)) < 1.0
+
+
+# ------------------------------------------------------------------ the drag law's A and B
+#: The drag-law sweep of docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer.
+DRAG_LAW_LENGTHS = np.array([-1e5, -1e4, -1e3, -300.0, -100.0, -30.0, -10.0])
+
+
+@pytest.mark.parametrize("mixed_layer_height", [None, 1500.0])
+def test_drag_law_a_is_the_neutral_a_plus_the_surface_layer_psi_m(mixed_layer_height):
+    """A = A_N + psi_m(0.2 z_i/L) - psi_m(z0/L), A_N Eq. (A_model_GDL) at mu = 0 for the same
+    h_hat and Ro, solved for all L at once; by hand at L = -100 m with the default z_i:
+    0.2 h = 211.8 m, psi_m(-2.118) - psi_m(-0.001) = 1.525 (the page's table)."""
+    extra = {} if mixed_layer_height is None else dict(mixed_layer_height=mixed_layer_height)
+    abl = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=DRAG_LAW_LENGTHS, **SITE, **extra)
+    neutral_a, neutral_b = gdl_coefficients(
+        0.0, 61.0, abl.h_hat, abl.friction_rossby_number, 0.41, 1.43, 0.83, 0.2)
+    psi = unstable_psi_m(0.2 * abl.boundary_layer_height / DRAG_LAW_LENGTHS) - unstable_psi_m(
+        0.1 / DRAG_LAW_LENGTHS)
+    np.testing.assert_allclose(abl.gdl_a - neutral_a, psi, rtol=1e-10, atol=1e-13)
+    np.testing.assert_allclose(abl.gdl_b, neutral_b, rtol=1e-14)
+    assert np.all(np.diff(abl.gdl_a) > 0)  # A grows with instability
+    if mixed_layer_height is None:
+        k = list(DRAG_LAW_LENGTHS).index(-100.0)
+        z_m = 0.2 * abl.boundary_layer_height[k]
+        x_m, x_0 = (1.0 + 16.0 * z_m / 100.0) ** 0.25, (1.0 + 16.0 * 0.1 / 100.0) ** 0.25
+        by_hand = [2 * np.log((1 + x) / 2) + np.log((1 + x * x) / 2) - 2 * np.arctan(x) + np.pi / 2
+                   for x in (x_m, x_0)]
+        assert z_m == pytest.approx(211.8, abs=0.1)
+        assert abl.gdl_a[k] - neutral_a[k] == pytest.approx(by_hand[0] - by_hand[1], rel=1e-12)
+        assert abl.gdl_a[k] - neutral_a[k] == pytest.approx(1.525, abs=5e-4)
+
+
+def test_drag_law_a_grows_like_ln_minus_mu_in_strong_convection():
+    """For -0.2 h/L >> 1 psi_m -> ln(1 - gamma z/L) - 3 ln 2 - pi/2, so at fixed h_hat and Ro
+    d A/d ln(-mu) -> 1 and A -> ln(-kappa mu) + ln(gamma/8) - pi/2 - psi_m(z0/L) - kappa E
+    (E the bracket of Eq. A_model_GDL without its stability term), for both gammas; the slope is
+    below 1 and rises towards it, A stays above the limit and closes on it (psi_m approaches
+    its asymptote like (-z/L)^(-1/4)). A limit of the formula: Ro = 1e16 keeps z0/L small while
+    -0.2 h/L reaches 1e10."""
+    h_hat, rossby, mu_n = 0.19, 1e16, 61.0
+    mu = -np.logspace(2, 12, 11)
+    for gamma in (16.0, 19.3):
+        a, _ = gdl_coefficients(mu, mu_n, h_hat, rossby, 0.41, 1.43, 0.83, 0.2, gamma)
+        slope = np.diff(a) / np.diff(np.log(-mu))
+        assert np.all(np.diff(slope) > 0) and np.all(slope < 1.0)
+        assert slope[-1] == pytest.approx(1.0, abs=3e-3)
+        neutral, _ = gdl_coefficients(0.0, mu_n, h_hat, rossby, 0.41, 1.43, 0.83, 0.2)
+        kappa_e = -np.log(0.2 * h_hat) - neutral
+        limit = (np.log(-0.41 * mu) + np.log(gamma / 8) - np.pi / 2
+                 - unstable_psi_m(0.41 * mu / rossby, gamma) - kappa_e)
+        gap = a - limit
+        assert np.all(gap > 0) and np.all(np.diff(gap) < 0) and gap[-1] < 1e-2
+
+
+def test_drag_law_b_is_the_mixed_layer_momentum_budget():
+    """B = 1.5 kappa u*/(f z_i): with the default z_i the CNBL's B at every L; with z_i = 1500 m
+    B grows with u*, hence with instability; and f int_0^z_i (V - V_g) dz = u*^2 (the mixed
+    layer's momentum budget) by quadrature at every L."""
+    cnbl = EkmanABL.from_reference_wind(8.0, 90.0, **SITE)
+    default = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=DRAG_LAW_LENGTHS, **SITE)
+    np.testing.assert_allclose(default.gdl_b, cnbl.gdl_b, rtol=1e-12)
+    deep = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=DRAG_LAW_LENGTHS,
+                                        mixed_layer_height=1500.0, **SITE)
+    np.testing.assert_allclose(deep.gdl_b, 1.5 * 0.41 * deep.friction_velocity / (1e-4 * 1500.0),
+                               rtol=1e-12)
+    assert np.all(np.diff(deep.gdl_b) > 0)
+    z = np.linspace(0.0, 1500.0, 20001)[:, None]
+    v = deep.velocity(z)[1]
+    budget = 1e-4 * np.trapezoid(v - deep.geostrophic_components[1], z[:, 0], axis=0)
+    np.testing.assert_allclose(budget / deep.friction_velocity**2, 1.0, atol=2e-4)
 
 
 def test_roughness_sublayer_is_the_tangent_in_a_convective_layer():
