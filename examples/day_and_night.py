@@ -11,7 +11,8 @@ stability class, the veer across the NREL 5 MW rotor, I_u(90 m) and whether the 
 inside the paper's validated envelope (floris_ekman_veer.validity_report), then the farm power
 of FLORIS's gauss and the package's ekman_veer on the day's inflow (same inflow hook). Last, the
 convective layer against the paper's CNBL at 8 m/s at 90 m: how it departs from it as L goes
-from -1e5 m to -10 m, with z_i the default (the neutral height) and 1500 m.
+from -1e5 m to -10 m, with z_i the default (the neutral height) and 1500 m, and the geostrophic
+drag law's A and B over that range (docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer).
 
 Run: python examples/day_and_night.py
 """
@@ -26,6 +27,7 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL
+from floris_ekman_veer.atmosphere.ekman import gdl_coefficients
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
@@ -34,6 +36,9 @@ SITE = dict(coriolis_parameter=1e-4, roughness_length=0.1, brunt_vaisala_frequen
             reference_potential_temperature=265.0)
 #: Convective Obukhov lengths of the sweep: near-neutral to about +350 W/m^2 at 8 m/s at 90 m.
 OBUKHOV_LENGTHS = [-1e5, -1e3, -300.0, -150.0, -100.0]
+#: Obukhov lengths of the drag-law table, with the labels the page prints them by.
+DRAG_LAW_LENGTHS = {-1e5: "-1e5", -1e4: "-1e4", -1e3: "-1000", -300.0: "-300", -100.0: "-100",
+                    -30.0: "-30", -10.0: "-10"}
 SPEEDS = [3.0, 4.0, 6.0, 8.0, 10.0, 11.0, 12.0, 15.0, 19.5, 25.0]
 
 
@@ -97,6 +102,23 @@ def cnbl_limit(length=-1e5, speed=8.0, height=90.0):
     }
 
 
+def drag_law_sweep(mixed_layer_height=None, speed=8.0, height=90.0):
+    """Rows (L, sensible heat flux [W/m^2], mu, A, A - A_N, B, alpha_0 [deg]) of the geostrophic
+    drag law for the CNBL (L = inf) and each of DRAG_LAW_LENGTHS, driven by ``speed`` at
+    ``height``. A_N is Eq. (A_model_GDL) at mu = 0 with the same h_hat and surface Rossby number:
+    A - A_N is the stability dependence of A alone."""
+    lengths = np.array([np.inf, *DRAG_LAW_LENGTHS])
+    extra = {} if mixed_layer_height is None else {"mixed_layer_height": mixed_layer_height}
+    abl = EkmanABL.from_reference_wind(speed, height, obukhov_length=lengths, **SITE, **extra)
+    neutral_a, _ = gdl_coefficients(
+        0.0, abl.zilitinkevich_number, abl.h_hat, abl.friction_rossby_number, abl.von_karman,
+        abl.c_g, abl.stress_decay, abl.matching_fraction, abl.businger_dyer_gamma)
+    return np.column_stack([
+        lengths, abl.sensible_heat_flux + 0.0, abl.stability_parameter + 0.0, abl.gdl_a,
+        abl.gdl_a - neutral_a, abl.gdl_b, abl.cross_isobaric_angle,
+    ])
+
+
 def deep_mixed_layer(speed=8.0):
     """The deep mixed layer's weak shear and veer: (z_i = 2000 m, L = -20 m) and the CNBL at
     G = ``speed``: speed ratio across a 27-153 m rotor minus 1, turning of the wind from 0.2 h to
@@ -132,6 +154,13 @@ def main():
         for row in convective_sweep(mixed_layer_height=z_i):
             print(f"  {row[0]:10.4g}  {row[1]:8.4f}  {row[2]:7.1f}  {row[3]:11.2f}  {row[4]:7.4f}"
                   f"  {row[5]:7.4f}  {row[6]:16.2f}  {row[7]:12.4f}  {row[8]:9.1f}")
+    default, deep = drag_law_sweep(), drag_law_sweep(mixed_layer_height=1500.0)
+    print("\nDrag-law coefficients at 8 m/s at 90 m: L [m], H [W/m^2], mu, then A, A - A_N, B, "
+          "alpha0 [deg] with the default z_i, then A, B, alpha0 [deg] with z_i = 1500 m")
+    for row, other in zip(default, deep):
+        label = "inf" if np.isinf(row[0]) else DRAG_LAW_LENGTHS[row[0]]
+        print(f"  {label:>6s}  {row[1]:7.0f}  {row[2]:8.2f}  {row[3]:6.3f}  {row[4]:6.3f}  "
+              f"{row[5]:6.3f}  {row[6]:6.1f}  {other[3]:6.3f}  {other[5]:6.3f}  {other[6]:6.1f}")
     print("\nDeep mixed layer against the CNBL (G = 8 m/s): rotor shear U(153)/U(27) - 1, turning "
           "0.2 h to h [deg], cross-isobaric angle [deg]")
     for name, (shear, turn, angle) in deep_mixed_layer().items():

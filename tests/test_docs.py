@@ -361,6 +361,12 @@ SCRIPT_NUMBERS = [
      ("examples/site_fit.py",),
      r"ekman_veer\s+([\d.]+)\s+([\d.]+)\s+([+\-]?[\d.]+)"),
 ]
+#: docs/atmosphere.md's drag-law table, row by row: L's label, then the nine numbers.
+SCRIPT_NUMBERS += [
+    ("docs/atmosphere.md", rf"\| {label} \|" + r" (-?[\d.]+) \|" * 9, ("examples/day_and_night.py",),
+     rf"Drag-law coefficients.*?\n\s+{label}" + r"\s+(-?[\d.]+)" * 9)
+    for label in ("-1e5", "-1e4", "-1000", "-300", "-100", "-30", "-10")
+]
 
 
 def page_numbers(page: str, pattern: str) -> list[str]:
