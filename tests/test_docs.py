@@ -361,6 +361,13 @@ SCRIPT_NUMBERS = [
      ("examples/site_fit.py",),
      r"ekman_veer\s+([\d.]+)\s+([\d.]+)\s+([+\-]?[\d.]+)"),
 ]
+SCRIPT_NUMBERS += [
+    ("docs/atmosphere.md", r"differs from the paper's CNBL by \+([\d.]+) % in u\* and h, ([\d.]+) % in U "
+                           r"and ([\d.]+) % in V \(of the 8 m/s, over 1-1000 m\) and \+([\d.]+) % in k_w",
+     ("examples/day_and_night.py",),
+     r"At L = -1e5 m against the CNBL.*?u\* \+([\d.]+) %, h \+[\d.]+ %, U \+([\d.]+) %, "
+     r"V \+([\d.]+) %, k_w \+([\d.]+) %"),
+]
 #: docs/atmosphere.md's drag-law table, row by row: L's label, then the nine numbers.
 SCRIPT_NUMBERS += [
     ("docs/atmosphere.md", rf"\| {label} \|" + r" (-?[\d.]+) \|" * 9, ("examples/day_and_night.py",),
