@@ -2,8 +2,11 @@
 hypothesis profiles."""
 
 import copy
+import inspect
 import os
+import types
 
+import floris.type_dec
 import pytest
 from floris import FlorisModel
 from hypothesis import HealthCheck, Phase, settings
@@ -26,6 +29,14 @@ settings.register_profile(
     "long", max_examples=2000, deadline=None, suppress_health_check=_RELAXED, phases=_PHASES,
 )
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+# FLORIS's convert_to_path (every FlorisModel build and set(): the turbine library path) reads
+# only the file names of inspect.stack()[1] and [-1], but inspect.stack() also reads each frame's
+# source line, which under pytest (dozens of frames, runpy's frozen ones among them) scans every
+# loaded module per frame: about half the time of a test that builds FLORIS models. The frames'
+# file names do not depend on the context asked for (inspect.getframeinfo computes them first),
+# so FLORIS here gets inspect.stack without source lines: the same paths, without the scan.
+floris.type_dec.inspect = types.SimpleNamespace(stack=lambda context=0: inspect.stack(context))
 
 #: The stable atmosphere of the issue's example (EkmanABL inputs without the wind speed).
 STABLE_ATMOSPHERE = {

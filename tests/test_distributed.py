@@ -187,6 +187,10 @@ SCRIPT = textwrap.dedent(
 )
 
 
+# The cluster run is a long study (a fresh interpreter, a LocalCluster of two worker processes, a
+# FLORIS optimiser and steered annual-energy studies on it, each against its serial run): its
+# tests carry the marker study and run in .ci/run after the fast suite (README, "Set up"); the
+# bad-input tests below stay in the fast suite.
 @pytest.fixture(scope="module")
 def cluster_results(tmp_path_factory):
     # 325 s measured at a load average of 10-12 on the 2-core machine: the timeout catches a hang,
@@ -204,6 +208,7 @@ def cluster_results(tmp_path_factory):
     return json.loads(lines[-1][len("RESULT "):])
 
 
+@pytest.mark.study
 def test_dask_model_is_the_serial_model(cluster_results):
     assert cluster_results["interface"] == "dask"
     assert cluster_results["max_workers"] == 2  # two single-threaded workers
@@ -213,12 +218,14 @@ def test_dask_model_is_the_serial_model(cluster_results):
         assert cluster_results[key] == 0.0, key
 
 
+@pytest.mark.study
 def test_dask_model_in_floris_optimiser(cluster_results):
     assert cluster_results["yaw_steered"] > 0.0  # the case does steer
     assert cluster_results["yaw_angles"] == 0.0
     assert cluster_results["yaw_power"] == 0.0
 
 
+@pytest.mark.study
 def test_dask_model_in_annual_energy(cluster_results):
     assert cluster_results["aep_gain"] > 0.0
     assert cluster_results["aep"] == 0.0
@@ -228,6 +235,7 @@ def test_dask_model_in_annual_energy(cluster_results):
     assert cluster_results["floris_aep"] == 0.0  # FLORIS's get_farm_AEP on a wind rose
 
 
+@pytest.mark.study
 def test_annual_energy_chunks_as_dask_tasks(cluster_results):
     """annual_energy(client=) sends the chunks with client.map: bitwise the serial study."""
     assert cluster_results["client_steered"] > 0.0  # the record steers
@@ -237,6 +245,7 @@ def test_annual_energy_chunks_as_dask_tasks(cluster_results):
     assert cluster_results["client_gch"]
 
 
+@pytest.mark.study
 def test_dask_model_in_uncertain_floris_model(cluster_results):
     assert cluster_results["uncertain"] == 0.0
 

@@ -14,6 +14,9 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
 BLOCK = re.compile(r"^```python\n(.*?)^```", flags=re.M | re.S)
+#: A snippet that runs one of FLORIS's yaw optimisers (a steered study) or starts a Dask cluster is
+#: a long study: marked ``study``, it runs in .ci/run after the fast suite (README, "Set up").
+STUDY = re.compile(r"YawOptimization|LocalCluster")
 
 
 def snippets():
@@ -21,7 +24,8 @@ def snippets():
         text = page.read_text()
         for match in BLOCK.finditer(text):
             line = text[: match.start()].count("\n") + 1
-            yield pytest.param(match[1], id=f"{page.relative_to(REPO)}:{line}")
+            marks = pytest.mark.study if STUDY.search(match[1]) else ()
+            yield pytest.param(match[1], id=f"{page.relative_to(REPO)}:{line}", marks=marks)
 
 
 SNIPPETS = list(snippets())
