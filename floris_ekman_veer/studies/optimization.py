@@ -667,9 +667,8 @@ def _reinitialize_conditions(self, **kwargs):
     FLORIS's yaw optimisers set each evaluation's conditions (tiled and masked rows of the
     subset) on a copy of the subset, which rebuilds the whole Core: the farm re-reads every
     turbine's YAML file and builds its turbines anew, resolving the library path through
-    ``inspect.stack`` twice per turbine type, and the package re-validates the conditions;
-    measured 0.3-0.6 s per evaluation, a third of a steered study
-    (docs/performance.md#both-signs-of-yaw). Neither the layout nor the turbines change here,
+    ``inspect.stack`` twice per turbine type, and the package re-validates the conditions:
+    38 % of a steered study's time (docs/performance.md#both-signs-of-yaw). Neither the layout nor the turbines change here,
     and every condition is one of the subset's, already validated; the flow field, the wake
     models (with the atmosphere the subset now carries), the per-condition set-points and the
     grid are built as FLORIS builds them (``Core.__attrs_post_init__``). Results are bitwise
