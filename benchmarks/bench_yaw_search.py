@@ -10,7 +10,13 @@
    interleaved in this process, best of ``--repeats``; with the FLORIS runs and the conditions
    they evaluated (counted in YawOptimization._calculate_farm_power), and the mean and the
    lowest per-condition farm-power gain of the both-signs optimum over FLORIS's.
-2. Shortfall: 3-turbine rows held out from the yaw study (tests/test_yaw_search.py): the farm
+2. Cost on the 3-turbine rows of the shortfall table: each row's time (interleaved, best of
+   ``--repeats``), FLORIS runs and evaluated conditions, for FLORIS's run and the both-signs
+   search.
+3. Rebuild: the 3 x 3 night farm with an Obukhov length per condition, both signs, with the
+   optimiser subsets' condition rebuild and with FLORIS's full Core rebuild per evaluation
+   (studies/optimization.py ``_reinitialize_conditions``): time and bitwise comparison.
+4. Shortfall: 3-turbine rows held out from the yaw study (tests/test_yaw_search.py): the farm
    power of FLORIS's single run and of the both-signs search against a brute-force search on a
    1-degree grid of all three yaws refined by Nelder-Mead (the reference the tests build), for
    bounds -25..25 deg.
@@ -30,6 +36,7 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import optimize_yaw
+from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -90,6 +97,75 @@ def cost(repeats: int):
         f"{name}: {', '.join(f'{t:.2f}' for t in values)}" for name, values in times.items()))
 
 
+def cost_rows(repeats: int):
+    """Item 1 on single rows: the held-out 3-turbine rows of the shortfall table, each timed
+    interleaved with FLORIS's run, best of ``repeats``."""
+    rows = reference.NIGHT_ROWS + reference.ROWS
+    print(f"\ncost on the held-out 3-turbine rows, -25..25 deg, best of {repeats}, interleaved")
+    print("| row | FLORIS's run: time [s], FLORIS runs, conditions | both signs: time [s], "
+          "FLORIS runs, conditions | x FLORIS's: time, conditions |")
+    print("|---|---|---|---:|")
+    totals = np.zeros(4)
+    for spec in rows:
+        fmodel = reference.row(*spec)
+        times = {"floris": [], "both": []}
+        counts = {}
+        for _ in range(repeats):
+            for name, method in (("floris", floris_single), ("both", both_signs)):
+                with counting() as count:
+                    start = time.perf_counter()
+                    method(fmodel)
+                    times[name].append(time.perf_counter() - start)
+                counts[name] = dict(count)
+        best = {name: min(values) for name, values in times.items()}
+        totals += [best["floris"], counts["floris"]["conditions"], best["both"],
+                   counts["both"]["conditions"]]
+        spacing, atmosphere, direction, speed = spec
+        print(f"| {spacing} D, {atmosphere}, {direction:.0f} deg, {speed:.0f} m/s | "
+              f"{best['floris']:.2f}, {counts['floris']['runs']}, "
+              f"{counts['floris']['conditions']} | {best['both']:.2f}, {counts['both']['runs']}, "
+              f"{counts['both']['conditions']} | {best['both'] / best['floris']:.2f}, "
+              f"{counts['both']['conditions'] / counts['floris']['conditions']:.2f} |")
+    print(f"| all {len(rows)} rows | {totals[0]:.2f}, {totals[1]:.0f} | {totals[2]:.2f}, "
+          f"{totals[3]:.0f} | {totals[2] / totals[0]:.2f}, {totals[3] / totals[1]:.2f} |")
+
+
+def rebuild(repeats: int):
+    """Item 4: the evaluations' model rebuild. The 3 x 3 night farm's 24 conditions, each with
+    its own Obukhov length (one row-following run), both signs, with the optimiser subsets'
+    condition rebuild and with FLORIS's full Core rebuild at every evaluation, interleaved, best
+    of ``repeats``; the two results compared bit for bit."""
+    from floris_ekman_veer.studies import optimization
+
+    quick = optimization._reinitialize_conditions
+    full = FlorisModel._reinitialize  # bound to each subset as the condition rebuild is
+    lengths = np.resize([80.0, 100.0, 150.0, 300.0, 1000.0], 24)
+    fmodel = night_farm()
+    atmosphere = dict(atmosphere_of(fmodel.core).inputs, obukhov_length=list(lengths))
+    set_atmosphere(fmodel, atmosphere)
+    times, frames = {"condition rebuild": [], "full rebuild": []}, {}
+    for _ in range(repeats):
+        for name, method in (("condition rebuild", quick), ("full rebuild", full)):
+            optimization._reinitialize_conditions = method
+            try:
+                start = time.perf_counter()
+                frames[name] = both_signs(fmodel)
+                times[name].append(time.perf_counter() - start)
+            finally:
+                optimization._reinitialize_conditions = quick
+    same = all(np.array_equal(np.vstack(frames["condition rebuild"][column]),
+                              np.vstack(frames["full rebuild"][column]))
+               for column in ("yaw_angles_opt", "farm_power_opt", "farm_power_baseline"))
+    print(f"\nrebuild per evaluation: 3 x 3 night farm, 24 conditions of 5 Obukhov lengths, both "
+          f"signs, best of {repeats}, interleaved")
+    print("| optimiser subsets' set() | time [s] | times per repeat [s] |")
+    print("|---|---:|---|")
+    for name, values in times.items():
+        print(f"| {name} | {min(values):.2f} | {', '.join(f'{t:.2f}' for t in values)} |")
+    print(f"condition / full: {min(times['condition rebuild']) / min(times['full rebuild']):.2f}; "
+          f"yaw angles and powers bitwise equal: {same}")
+
+
 def shortfall():
     rows = reference.NIGHT_ROWS + reference.ROWS
     pairs, angles, tables = reference.brute_force_tables(rows)
@@ -118,6 +194,8 @@ def main():
     args = parser.parse_args()
     warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
     cost(args.repeats)
+    cost_rows(args.repeats)
+    rebuild(args.repeats)
     if not args.skip_shortfall:
         shortfall()
 

@@ -234,3 +234,32 @@ def test_plain_floris_optimizer_and_uncertain_model_are_bitwise_unchanged():
             ufmodel.get_turbine_powers()
 
     assert_as_plain_floris(outputs)
+
+
+@pytest.mark.parametrize("per_condition_atmosphere", [True, False], ids=["rows", "scalar"])
+def test_condition_rebuild_is_bitwise_floris_full_rebuild(monkeypatch, per_condition_atmosphere):
+    """The optimiser's subsets rebuild only what new conditions change
+    (studies/optimization.py ``_reinitialize_conditions``): the both-signs search of a
+    per-condition (row-following) and of a scalar atmosphere gives bit for bit the yaw angles
+    and powers of FLORIS's full Core rebuild at every evaluation."""
+    from floris_ekman_veer.studies import optimization
+
+    atmosphere = per_condition(CLASSES) if per_condition_atmosphere else STABLE
+    options = OPTIMIZERS["sr"][1]
+
+    def outputs():
+        df = optimize_yaw(ekman_row(atmosphere, SPEEDS, DIRECTIONS), YawOptimizationSR,
+                          progress=False, **options)
+        return [np.vstack(df.yaw_angles_opt)] + [
+            df[column].to_numpy(float) for column in ("farm_power_opt", "farm_power_baseline")]
+
+    calls = []
+    quick = optimization._reinitialize_conditions
+    monkeypatch.setattr(optimization, "_reinitialize_conditions",
+                        lambda self, **kwargs: calls.append(1) or quick(self, **kwargs))
+    rebuilt = outputs()
+    assert len(calls) > 10  # every evaluation took the condition rebuild
+    monkeypatch.setattr(optimization, "_reinitialize_conditions",
+                        lambda self, **kwargs: FlorisModel._reinitialize(self, **kwargs))
+    for new, full in zip(rebuilt, outputs()):
+        np.testing.assert_array_equal(new, full)

@@ -14,6 +14,7 @@ result of running each distinct atmosphere on its own (tests/test_optimization.p
 from __future__ import annotations
 
 import contextlib
+import copy
 import functools
 import io
 import inspect
@@ -23,6 +24,8 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
+from floris import FlorisModel
+from floris.core import FlowField, TurbineCubatureGrid, TurbineGrid, WakeModelManager
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
@@ -59,9 +62,10 @@ SEARCHES = ("both_signs", "single")
 REFINE_FRACTION = 1.0 / 8.0
 
 #: Steering seeds of the both-signs search, per sign, as fractions of each turbine's reach (its
-#: largest |bound|): 9 common yaws from 5 to 25 deg for +-25 deg, each sign
+#: largest |bound|): 4 common yaws, 6.25 to 25 deg for +-25 deg, each sign; the serial
+#: refine's first pass then spans each steering turbine's whole range from the best of them
 #: (docs/yaw_steering.md#how-both-signs-are-searched).
-SEED_FRACTIONS = np.linspace(0.2, 1.0, 9)
+SEED_FRACTIONS = np.array([0.25, 0.5, 0.75, 1.0])
 
 #: Single-turbine moves from the best seed, as a fraction of the reach: +-6.25 deg for +-25 deg.
 SEED_MOVE_FRACTION = 0.25
@@ -98,7 +102,8 @@ def optimize_yaw(
     docs/yaw_steering.md#how-both-signs-are-searched): measured within 0.05 % of farm power of
     a brute-force 1-degree search refined by Nelder-Mead on held-out 3-turbine rows
     (tests/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
-    own run on a 3 x 3 farm (tests/test_yaw_search.py, benchmarks/bench_yaw_search.py). Other
+    own run on a 3 x 3 farm and on 3-turbine rows (tests/test_yaw_search.py,
+    benchmarks/bench_yaw_search.py). Other
     optimisers reporting farm power (``YawOptimizationScipy``) run over the given bounds, over
     their negative and positive parts, and once more within +-:data:`REFINE_FRACTION` of each
     turbine's bound range around each result, keeping per condition the best;
@@ -199,14 +204,15 @@ class BothSignsRefinement:
     1. steering seeds (:data:`SEED_FRACTIONS` of each sign of each turbine's reach, its
        largest |bound|): every turbine that wakes another at one common yaw, the others at the
        start; where a seed beats the start, each of those turbines moved alone by
-       +-:data:`SEED_MOVE_FRACTION` of its reach (2 x 9 + 2 x n_steering evaluations);
-    2. the serial refine's own passes, from that start;
+       +-:data:`SEED_MOVE_FRACTION` of its reach (2 x 4 + 2 x n_steering evaluations);
+    2. the serial refine's own passes, from that start, over the steering turbines (those
+       that wake none, as FLORIS's ``exclude_downstream_turbines`` would leave out, keep their
+       start: their yaw moves their own power alone, which stage 3 places);
     3. per step h of :data:`QUADRATIC_STEPS`, a quadratic model of the farm power around the
        best yaws: in the first, two points along each turbine's yaw and one along each pair of
        steering turbines one in the other's wake (gradient and Hessian); in the later ones one
        point along each yaw (the gradient, with the first's Hessian); and the model's maximum,
-       limited to 4 h in each yaw and to the bounds, at full and half length together with
-       each yaw's own move;
+       limited to 4 h in each yaw and to the bounds, together with each yaw's own move;
     4. the mirror of the serial refine's result (every sign flipped, clipped to the bounds),
        refined by the same steps beside it where its power is within :data:`MIRROR_WINDOW` of
        the best (a veered atmosphere makes the two signs differ by little where steering pays
@@ -230,6 +236,12 @@ class BothSignsRefinement:
         self.print_progress = print_progress  # read by _calc_powers_with_memory
         self._wakes = self._wake_pairs()
         self._seed_start()
+        # The serial refine's passes move the steering turbines only: a turbine that wakes none
+        # moves its own power alone, which the quadratic steps place (stage 3). Bounds closed
+        # on its start make each of its grids the start, which the memory does not evaluate.
+        steering = self._wakes.any(axis=2)
+        self._yaw_lbs = np.where(steering, self._yaw_lbs, self._yaw_angles_opt_subset)
+        self._yaw_ubs = np.where(steering, self._yaw_ubs, self._yaw_angles_opt_subset)
         return super().optimize(print_progress=print_progress)
 
     def _finalize(self, *args, **kwargs):
@@ -285,8 +297,7 @@ class BothSignsRefinement:
                 gradient, hessian = stencil.fit(values - centre_power, hessian)
             moves = _newton_moves(gradient, hessian, centre, tracks.lower, tracks.upper,
                                   4.0 * step)
-            tracks.keep_best(np.clip(centre + np.concatenate([moves, 0.5 * moves[:1]]),
-                                     tracks.lower, tracks.upper), self._evaluate)
+            tracks.keep_best(np.clip(centre + moves, tracks.lower, tracks.upper), self._evaluate)
 
     def _wake_pairs(self):
         """(n_findex, n, n): turbine i wakes turbine j, by FLORIS's conservative linear wake cone
@@ -636,7 +647,64 @@ def condition_subset(fmodel, index, atmosphere: Mapping | None):
         }
     subset = fmodel.copy()
     set_atmosphere(subset, atmosphere, **set_kwargs)
+    if type(subset) is FlorisModel:
+        # The optimiser's set() per evaluation gives only conditions (and set-points): rows
+        # of this subset, checked when it was built above.
+        subset._reinitialize = types.MethodType(_reinitialize_conditions, subset)
     return subset
+
+
+#: The inputs :func:`_reinitialize_conditions` rebuilds; any other goes through FLORIS's own
+#: ``_reinitialize``.
+_CONDITION_INPUTS = frozenset({"wind_directions", "wind_speeds", "turbulence_intensities"})
+
+
+def _reinitialize_conditions(self, **kwargs):
+    """FlorisModel._reinitialize of an optimiser's subset, for new conditions only: the same
+    Core as FLORIS's ``Core.from_dict(core.as_dict())`` with those conditions, reusing the
+    farm's turbines and their tables.
+
+    FLORIS's yaw optimisers set each evaluation's conditions (tiled and masked rows of the
+    subset) on a copy of the subset, which rebuilds the whole Core: the farm re-reads every
+    turbine's YAML file and builds its turbines anew, resolving the library path through
+    ``inspect.stack`` twice per turbine type, and the package re-validates the conditions:
+    38 % of a steered study's time (docs/performance.md#both-signs-of-yaw). Neither the layout nor the turbines change here,
+    and every condition is one of the subset's, already validated; the flow field, the wake
+    models (with the atmosphere the subset now carries), the per-condition set-points and the
+    grid are built as FLORIS builds them (``Core.__attrs_post_init__``). Results are bitwise
+    those of the full rebuild (tests/test_yaw_search.py).
+    """
+    given = {k for k, v in kwargs.items() if v is not None}
+    core = self.core
+    if (not given <= _CONDITION_INPUTS or self._wind_data is not None
+            or core.solver["type"] not in ("turbine_grid", "turbine_cubature_grid")):
+        return FlorisModel._reinitialize(self, **kwargs)
+    floris_dict = core.as_dict()
+    flow_field_dict = floris_dict["flow_field"]
+    for name in given:
+        flow_field_dict[name] = kwargs[name]
+    new = copy.copy(core)
+    farm = copy.copy(core.farm)
+    # Past attrs' converters (they would rebuild from a dict): these are built objects.
+    object.__setattr__(new, "wake", WakeModelManager.from_dict(floris_dict["wake"]))
+    object.__setattr__(new, "flow_field", FlowField.from_dict(flow_field_dict))
+    object.__setattr__(new, "farm", farm)
+    n_findex = new.flow_field.n_findex
+    farm.set_yaw_angles_to_ref_yaw(n_findex)
+    farm.set_tilt_to_ref_tilt(n_findex)
+    farm.set_power_setpoints_to_ref_power(n_findex)
+    farm.set_awc_modes_to_ref_mode(n_findex)
+    farm.set_awc_amplitudes_to_ref_amp(n_findex)
+    farm.set_awc_frequencies_to_ref_freq(n_findex)
+    grid_class = TurbineGrid if core.solver["type"] == "turbine_grid" else TurbineCubatureGrid
+    object.__setattr__(new, "grid", grid_class(
+        turbine_coordinates=farm.coordinates,
+        turbine_diameters=farm.rotor_diameters,
+        wind_directions=new.flow_field.wind_directions,
+        grid_resolution=new.solver["turbine_grid_points"],
+    ))
+    farm.expand_farm_properties(n_findex, new.grid.sorted_coord_indices)
+    self.core = new
 
 
 def check_optimizer_options(optimizer_class, options: Mapping, n_findex: int, n_turbines: int):
