@@ -368,9 +368,9 @@ def test_steered_records_do_not_depend_on_the_chunking(row, monkeypatch):
         powers.shape[0], dtype=bool))
     results.append(study())
     # (records optimised, of them at rated, conditions per optimiser run): the records at rated
-    # never reach the optimiser; by default one run per chunk (9,216 conditions x turbines over
+    # never reach the optimiser; by default one run per chunk (4,608 conditions x turbines over
     # 3 turbines).
-    assert optimised == [(1, 0, 3072), (1, 0, 3072), (2, 0, 1), (4, 2, 3072)]
+    assert optimised == [(1, 0, 1536), (1, 0, 1536), (2, 0, 1), (4, 2, 1536)]
     first = _steered(results[0])
     for other in results[1:]:
         for a, b in zip(first, _steered(other)):

@@ -82,7 +82,7 @@ DEFAULT_CHUNK_SIZE = 1024
 #: optimiser pays a fixed cost per iteration (a FLORIS model set up for its yaw grid), so larger
 #: runs cost less per condition; the optimiser evaluates tens of yaw sets of every condition at
 #: once, so the memory grows with conditions x turbines (docs/performance.md#a-steered-year).
-STEERING_TURBINE_CONDITIONS = 9216
+STEERING_TURBINE_CONDITIONS = 4608
 #: Operation models whose power never exceeds the maximum of the turbine's power table: FLORIS
 #: interpolates the table (the package's veer-aware rotor scales the speed it is read at,
 #: docs/yaw_steering.md), derating only lowers it. A condition with every turbine at that
@@ -292,7 +292,7 @@ def annual_energy(
             it).
         steering_chunk_size: Conditions per run of the yaw optimiser within a chunk (bounds its
             memory; results do not depend on it); None: :data:`STEERING_TURBINE_CONDITIONS`
-            over the farm's turbines (1,024 on a 3 x 3 farm). Conditions whose every turbine
+            over the farm's turbines (512 on a 3 x 3 farm). Conditions whose every turbine
             is at the maximum of its power table skip the optimiser and keep zero yaw: steering
             cannot raise their power (:func:`_cannot_gain`, docs/yaw_steering.md).
         client: A ``dask.distributed.Client``: the chunks run on its workers, each a
