@@ -34,7 +34,8 @@ study's: 4,608 conditions x turbines over the farm's turbines, at most a chunk),
 time of a year is extrapolated linearly, t(8,760) = t(N) x 8,760 / N (the chunks are independent
 and alike, so the time is proportional to their number; docs/performance.md). Printed with it:
 the process's CPU time, the records the optimiser ran on (the others, every turbine at rated,
-skip it) and the peak resident memory of the process so far. With
+skip it), the conditions FLORIS evaluated per record (every ``FlorisModel.run`` of the study:
+the load does not change them) and the study's peak resident memory. With
 ``--dask-workers W`` the same study runs again on a ``LocalCluster`` of W single-threaded worker
 processes (``client=``), its numbers are checked bitwise against the serial run, and the
 speed-up serial / cluster is printed (the cluster's start-up not counted).
@@ -280,14 +281,21 @@ def steered(fmodel, series, stability, names, args) -> None:
         optimised.append(fmodel.core.flow_field.n_findex)
         return original(fmodel, *arguments, **options)
 
-    energy.optimize_yaw = counting
+    evaluated = []
+    run = FlorisModel.run
+
+    def counting_run(self, *arguments, **options):
+        evaluated.append(self.core.flow_field.n_findex)
+        return run(self, *arguments, **options)
+
+    energy.optimize_yaw, FlorisModel.run = counting, counting_run
     resident = reset_peak_resident()
     try:
         start, cpu = time.perf_counter(), time.process_time()
         serial = annual_energy(fmodel, subset, stability, YawOptimizationSR, **kwargs)
         elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
     finally:
-        energy.optimize_yaw = original
+        energy.optimize_yaw, FlorisModel.run = original, run
     study_memory = ("" if resident is None else
                     f"; the study's peak resident memory {(peak_resident() - resident) / 1e6:.0f} MB "
                     "above the process's before it")
@@ -303,7 +311,8 @@ def steered(fmodel, series, stability, names, args) -> None:
           f"{elapsed / n:.3f} s per record (CPU {cpu:.1f} s = {cpu / n:.3f} s); a year of "
           f"8,760 records: {elapsed / n * 8760 / 60:.1f} min (t x 8,760 / {n}; CPU "
           f"{cpu / n * 8760 / 60:.1f} min); optimised {sum(optimised)} of {n * runs} records "
-          f"(the others at rated); gain {', '.join(f'{g:+.3f} %' for g in year.gain_percent)}"
+          f"(the others at rated); {sum(evaluated) / n:.1f} conditions evaluated per record in "
+          f"{len(evaluated)} FLORIS runs; gain {', '.join(f'{g:+.3f} %' for g in year.gain_percent)}"
           f"{study_memory}; load {os.getloadavg()[0]:.1f} (1 min)", flush=True)
     if not args.dask_workers:
         return

@@ -23,7 +23,9 @@ the year's)
 * the baseline AEP (every turbine aligned with the hub-height wind: the yaw angles are measured
   from the wind direction at FLORIS's reference height) and
 * the AEP with wake steering: the yaw angles of :func:`~floris_ekman_veer.optimize_yaw` (any
-  FLORIS yaw optimiser) per condition.
+  FLORIS yaw optimiser) per condition, run over ``steering_chunk_size`` conditions at a time;
+  conditions whose every turbine is at the maximum of its power table keep zero yaw without it,
+  which is what it returns for them (:func:`_cannot_gain`, docs/yaw_steering.md#in-a-years-study).
 
 :func:`record_energy` (``SiteAtmosphere.annual_energy``) does the same for a time series whose
 records each carry their own atmosphere.
