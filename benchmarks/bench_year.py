@@ -28,9 +28,14 @@ The AEP lines are reported against plain gauss and against the same model on one
 two costs).
 
 ``--steered N``: ``annual_energy(..., YawOptimizationSR)`` of the first N records (``--steered-
-models``, default ekman_veer), in chunks of ``--steered-chunk`` with its progress bar, run once;
-the time of a year is extrapolated linearly, t(8,760) = t(N) x 8,760 / N (the chunks are
-independent and alike, so the time is proportional to their number; docs/performance.md). With
+models``, default ekman_veer), in chunks of ``--steered-chunk`` (default the study's, 1,024) with
+its progress bar, the optimiser over ``--steering-chunk`` conditions at a time (default the
+study's: 4,608 conditions x turbines over the farm's turbines, at most a chunk), run once; the
+time of a year is extrapolated linearly, t(8,760) = t(N) x 8,760 / N (the chunks are independent
+and alike, so the time is proportional to their number; docs/performance.md). Printed with it:
+the process's CPU time, the records the optimiser ran on (the others, every turbine at rated,
+skip it), the conditions FLORIS evaluated per record (every ``FlorisModel.run`` of the study:
+the load does not change them) and the study's peak resident memory. With
 ``--dask-workers W`` the same study runs again on a ``LocalCluster`` of W single-threaded worker
 processes (``client=``), its numbers are checked bitwise against the serial run, and the
 speed-up serial / cluster is printed (the cluster's start-up not counted).
@@ -106,8 +111,12 @@ def main():
                         help=f"comma-separated, of {list(LINES)} (or none)")
     parser.add_argument("--steered", type=int, default=0, metavar="N",
                         help="also run a steered study of the first N records")
-    parser.add_argument("--steered-chunk", type=int, default=24, metavar="K")
+    parser.add_argument("--steered-chunk", type=int, default=None, metavar="K")
+    parser.add_argument("--steering-chunk", type=int, default=None, metavar="S")
     parser.add_argument("--steered-models", default="ekman_veer")
+    parser.add_argument("--rated", action="store_true",
+                        help="print the share of records with every turbine at rated (the "
+                             "steered study's skip) and within a loss to rated of 1e-4, 1e-3")
     parser.add_argument("--dask-workers", type=int, default=0, metavar="W",
                         help="run the steered study on a LocalCluster of W processes too")
     args = parser.parse_args()
@@ -172,10 +181,12 @@ def main():
                   f"{peaks[key] / 1e6:.0f} |")
         if "gch" in best and "plain_gch" in best:
             print(f"annual_energy gch / plain FLORIS GCH: {best['gch'] / best['plain_gch']:.2f}")
+    print(f"process peak resident memory: {peak_resident() / 1e6:.0f} MB; load "
+          f"{os.getloadavg()[0]:.1f} (1 min)", flush=True)
+    if args.rated:
+        at_rated(fmodel, series, stability, names)
     if args.steered:
         steered(fmodel, series, stability, names, args)
-    print(f"process peak resident memory: {peak_resident() / 1e6:.0f} MB; load "
-          f"{os.getloadavg()[0]:.1f} (1 min)")
 
 
 #: The benchmark's lines (``--lines``) and their labels.
@@ -198,8 +209,54 @@ def peak_resident() -> float:
     import resource
     import sys
 
+    if sys.platform.startswith("linux"):
+        # VmHWM follows a reset by reset_peak_resident (ru_maxrss does not).
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return float(line.split()[1]) * 1024
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     return float(peak if sys.platform == "darwin" else peak * 1024)
+
+
+def at_rated(fmodel, series, stability, names) -> None:
+    """The records' baseline (one run, each record with its class's atmosphere): the share with
+    every turbine at the maximum of its power table (which a steered study does not optimise)
+    and, for a tolerance that was considered instead, within 1e-4 and 1e-3 of the record's
+    power of it (the loss to rated summed over the turbines)."""
+    from floris_ekman_veer.studies import energy
+
+    model = fmodel.copy()
+    atmosphere = {key: [stability[name]["atmosphere"][key] for name in names]
+                  for key in next(iter(stability.values()))["atmosphere"]}
+    directions, speeds, _, _ = series.unpack_for_reinitialize()
+    set_atmosphere(model, atmosphere, wind_directions=directions, wind_speeds=speeds,
+                   turbulence_intensities=np.full(speeds.size, 0.06))
+    model.run()
+    powers = model.get_turbine_powers()
+    loss = np.sum(energy._rated_powers(model) - powers, axis=1)
+    farm = np.sum(powers, axis=1)
+    shares = ", ".join(f"{100 * np.mean(loss <= tol * farm):.2f} % within {tol:g}"
+                       for tol in (1e-4, 1e-3))
+    print(f"{speeds.size} records: {100 * np.mean(loss == 0.0):.2f} % with every turbine at "
+          f"rated (loss to rated 0); {shares} of the record's power", flush=True)
+
+
+def reset_peak_resident():
+    """Reset the process's peak resident memory to its current one (Linux: ``5`` written to
+    /proc/self/clear_refs) and return that [bytes]; None where it cannot be reset (then
+    :func:`peak_resident` keeps the peak of the whole process)."""
+    import gc
+
+    gc.collect()
+    try:
+        with open("/proc/self/clear_refs", "w") as refs:
+            refs.write("5")
+        with open("/proc/self/status") as status:
+            rss = next(line for line in status if line.startswith("VmRSS:"))
+    except (OSError, StopIteration):
+        return None
+    return float(rss.split()[1]) * 1024
 
 
 def steered(fmodel, series, stability, names, args) -> None:
@@ -207,20 +264,56 @@ def steered(fmodel, series, stability, names, args) -> None:
     a LocalCluster; times, the extrapolation to 8,760 records and the bitwise check."""
     from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
+    from floris_ekman_veer.studies import energy
+
     n = min(args.steered, len(names))
     subset = TimeSeries(series.wind_directions[:n], series.wind_speeds[:n],
                         turbulence_intensities=0.06)
-    kwargs = dict(records=names[:n], models=args.steered_models.split(","), progress=True,
-                  chunk_size=args.steered_chunk)
-    start = time.perf_counter()
-    serial = annual_energy(fmodel, subset, stability, YawOptimizationSR, **kwargs)
-    elapsed = time.perf_counter() - start
+    kwargs = dict(records=names[:n], models=args.steered_models.split(","), progress=True)
+    if args.steered_chunk is not None:
+        kwargs["chunk_size"] = args.steered_chunk
+    if args.steering_chunk is not None:
+        kwargs["steering_chunk_size"] = args.steering_chunk
+    optimised = []
+    original = energy.optimize_yaw
+
+    def counting(fmodel, *arguments, **options):
+        optimised.append(fmodel.core.flow_field.n_findex)
+        return original(fmodel, *arguments, **options)
+
+    evaluated = []
+    run = FlorisModel.run
+
+    def counting_run(self, *arguments, **options):
+        evaluated.append(self.core.flow_field.n_findex)
+        return run(self, *arguments, **options)
+
+    energy.optimize_yaw, FlorisModel.run = counting, counting_run
+    resident = reset_peak_resident()
+    try:
+        start, cpu = time.perf_counter(), time.process_time()
+        serial = annual_energy(fmodel, subset, stability, YawOptimizationSR, **kwargs)
+        elapsed, cpu = time.perf_counter() - start, time.process_time() - cpu
+    finally:
+        energy.optimize_yaw, FlorisModel.run = original, run
+    study_memory = ("" if resident is None else
+                    f"; the study's peak resident memory {(peak_resident() - resident) / 1e6:.0f} MB "
+                    "above the process's before it")
     year = serial.table[serial.table.stability == "all"]
+    chunk = kwargs.get("chunk_size", energy.DEFAULT_CHUNK_SIZE)
+    # (A package before steering_chunk_size ran the optimiser 256 conditions at a time.)
+    steering = kwargs.get("steering_chunk_size", getattr(
+        energy, "STEERING_TURBINE_CONDITIONS", 256 * fmodel.core.farm.n_turbines)
+        // fmodel.core.farm.n_turbines)
+    runs = len(args.steered_models.split(","))
     print(f"steered ({YawOptimizationSR.__name__}, {args.steered_models}, {n} records, chunks of "
-          f"{args.steered_chunk}): {elapsed:.1f} s = {elapsed / n:.2f} s per record; a year of "
-          f"8,760 records: {elapsed / n * 8760 / 60:.1f} min (t x 8,760 / {n}); gain "
-          f"{', '.join(f'{g:+.2f} %' for g in year.gain_percent)}; load "
-          f"{os.getloadavg()[0]:.1f} (1 min)", flush=True)
+          f"{chunk}, optimiser runs of at most {min(chunk, steering)}): {elapsed:.1f} s = "
+          f"{elapsed / n:.3f} s per record (CPU {cpu:.1f} s = {cpu / n:.3f} s); a year of "
+          f"8,760 records: {elapsed / n * 8760 / 60:.1f} min (t x 8,760 / {n}; CPU "
+          f"{cpu / n * 8760 / 60:.1f} min); optimised {sum(optimised)} of {n * runs} records "
+          f"(the others at rated); {sum(evaluated) / n:.1f} conditions evaluated per record in "
+          f"{len(evaluated)} FLORIS runs; gain {', '.join(f'{g:+.3f} %' for g in year.gain_percent)}"
+          f"{study_memory}; load {os.getloadavg()[0]:.1f} (1 min)", flush=True)
     if not args.dask_workers:
         return
     from distributed import Client, LocalCluster

@@ -185,6 +185,8 @@ def test_bad_models_and_options(row, atmospheres, no_work):
         annual_energy(row, ROSE, stability, minimum_yaw_angle=-20.0)
     with pytest.raises(ValueError, match="turbulence_intensities must be one of"):
         annual_energy(row, ROSE, stability, turbulence_intensities="input")
+    with pytest.raises(ValueError, match=r"steering_chunk_size must be an integer >= 1; got 0"):
+        annual_energy(row, ROSE, stability, YawOptimizationSR, steering_chunk_size=0)
     with pytest.raises(ValueError, match="WindRose or floris.TimeSeries"):
         annual_energy(row, {"wind_speeds": [8.0]}, stability)
 
@@ -315,6 +317,106 @@ def test_per_record_results_do_not_depend_on_the_chunking(row):
     alone.run()
     assert first.conditions["ekman_veer"]["farm_power_baseline"].iloc[4] == np.sum(
         alone.get_turbine_powers())
+
+
+# ----------------------------------------------------------------------------- steered year
+
+
+def _steered_records(row):
+    """Four records of their own atmospheres along the row: two at 19 m/s, where every turbine,
+    waked or not, is at rated power (steering cannot gain), two below rated that steer."""
+    series, atmosphere, labels = _year_of_records(row, n=4, seed=3)
+    speeds = series.wind_speeds.copy()
+    speeds[[1, 3]] = 19.0
+    series = TimeSeries(series.wind_directions, speeds, turbulence_intensities=0.06)
+    return series, atmosphere, labels
+
+
+def _steered(result):
+    """Per record: steered and baseline farm power, optimal yaws, the optimiser's powers."""
+    frames = [result.optima["ekman_veer", name] for name in
+              dict.fromkeys(result.conditions["ekman_veer"]["stability"])]
+    return (result.conditions["ekman_veer"]["farm_power_steered"].to_numpy(),
+            result.conditions["ekman_veer"]["farm_power_baseline"].to_numpy(),
+            np.vstack([np.vstack(f["yaw_angles_opt"]) for f in frames]),
+            np.concatenate([f["farm_power_opt"].to_numpy(float) for f in frames]),
+            np.concatenate([f["farm_power_baseline"].to_numpy(float) for f in frames]))
+
+
+def test_steered_records_do_not_depend_on_the_chunking(row, monkeypatch):
+    """The optimiser's result for a record is its own: chunks of 1 record, optimiser runs of
+    1 within a chunk of all and a chunk of all give every number bitwise; the records at rated
+    skip the optimiser and get exactly what it gives them (zero yaw, the baseline power)."""
+    series, atmosphere, labels = _steered_records(row)
+    optimised = []
+    original = energy.optimize_yaw
+
+    def counting(fmodel, *args, **kwargs):
+        speeds = fmodel.core.flow_field.wind_speeds
+        optimised.append((speeds.size, int(np.sum(speeds == 19.0)), kwargs["chunk_size"]))
+        return original(fmodel, *args, **kwargs)
+
+    monkeypatch.setattr(energy, "optimize_yaw", counting)
+
+    def study(**sizes):
+        return energy.record_energy(row, series, atmosphere, labels, YawOptimizationSR,
+                                    models=["ekman_veer"], progress=False, **YAW, **sizes)
+
+    results = [study(chunk_size=1), study(steering_chunk_size=1)]
+    # Without the skip every record is optimised, in one run, with the same numbers.
+    monkeypatch.setattr(energy, "_cannot_gain", lambda fmodel, powers, *_: np.zeros(
+        powers.shape[0], dtype=bool))
+    results.append(study())
+    # (records optimised, of them at rated, conditions per optimiser run): the records at rated
+    # never reach the optimiser; by default one run per chunk (4,608 conditions x turbines over
+    # 3 turbines).
+    assert optimised == [(1, 0, 1536), (1, 0, 1536), (2, 0, 1), (4, 2, 1536)]
+    first = _steered(results[0])
+    for other in results[1:]:
+        for a, b in zip(first, _steered(other)):
+            np.testing.assert_array_equal(a, b)
+    steered, baseline, yaws, _, _ = first
+    rated = series.wind_speeds == 19.0
+    assert np.all(yaws[rated] == 0.0) and np.all(steered[rated] == baseline[rated])
+    assert np.all(steered[rated] == 3 * 5e6)
+    assert np.all(steered[~rated] > baseline[~rated])  # the others steer and gain
+
+
+def test_what_steering_cannot_gain(row):
+    """The skip: every turbine at the maximum of its power table, zero yaw allowed, the
+    baseline at zero yaw and weights not negative; for the farm-power optimisers only. Its
+    bound is the rated power, not the no-wake power: a lone turbine in the veered SBL-6 wind
+    (no wake loss) gains by turning 2 deg against the veer."""
+    from floris.optimization.yaw_optimization.yaw_optimizer_geometric import (
+        YawOptimizationGeometric,
+    )
+
+    lone = row.copy()
+    lone.set(layout_x=[0.0], layout_y=[0.0], wind_directions=[270.0] * 2,
+             wind_speeds=[8.0] * 2, turbulence_intensities=[0.06] * 2,
+             yaw_angles=[[0.0], [-2.0]])
+    lone.run()
+    unyawed, against_veer = lone.get_turbine_powers()[:, 0]
+    assert against_veer > unyawed
+    case = row.copy()
+    case.set(wind_directions=[270.0] * 3, wind_speeds=[19.0, 8.0, 12.0],
+             turbulence_intensities=[0.06] * 3)
+    case.run()
+    powers = case.get_turbine_powers()
+    # 12 m/s: the front turbine at rated, the waked ones below.
+    assert powers[2, 0] == 5e6 and np.all(powers[2, 1:] < 5e6)
+
+    def skip(optimizer=YawOptimizationSR, **options):
+        return energy._cannot_gain(case, powers, optimizer, options).tolist()
+
+    assert skip() == [True, False, False]
+    assert skip(**YAW) == [True, False, False]
+    assert skip(minimum_yaw_angle=5.0) == [False, False, False]  # zero yaw not allowed
+    assert skip(yaw_angles_baseline=[[0.0, 0.0, 0.0], [0.0] * 3, [0.0] * 3]) == [True, False,
+                                                                                   False]
+    assert skip(yaw_angles_baseline=[2.0, 0.0, 0.0]) == [False, False, False]
+    assert skip(turbine_weights=[1.0, -1.0, 1.0]) == [False, False, False]
+    assert skip(YawOptimizationGeometric) == [False, False, False]
 
 
 def test_the_comparison_solves_each_chunks_abl_once(row, monkeypatch):

@@ -23,7 +23,9 @@ the year's)
 * the baseline AEP (every turbine aligned with the hub-height wind: the yaw angles are measured
   from the wind direction at FLORIS's reference height) and
 * the AEP with wake steering: the yaw angles of :func:`~floris_ekman_veer.optimize_yaw` (any
-  FLORIS yaw optimiser) per condition.
+  FLORIS yaw optimiser) per condition, run over ``steering_chunk_size`` conditions at a time;
+  conditions whose every turbine is at the maximum of its power table keep zero yaw without it,
+  which is what it returns for them (:func:`_cannot_gain`, docs/yaw_steering.md#in-a-years-study).
 
 :func:`record_energy` (``SiteAtmosphere.annual_energy``) does the same for a time series whose
 records each carry their own atmosphere.
@@ -41,12 +43,15 @@ wind data). Every input is checked before any FLORIS run.
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Mapping, Sequence
 
 import attrs
 import numpy as np
 import pandas as pd
+from floris.optimization.yaw_optimization.yaw_optimizer_scipy import YawOptimizationScipy
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 from floris.wind_data import TimeSeries, WindRose
 
 from floris_ekman_veer.studies.comparison import (
@@ -74,6 +79,19 @@ HOURS_PER_YEAR = 8760.0
 #: Conditions per FLORIS model of a study: enough to keep FLORIS's vectorisation efficient, few
 #: enough to bound the memory of a 100-turbine farm to a few hundred MB.
 DEFAULT_CHUNK_SIZE = 1024
+#: Conditions x turbines per run of the yaw optimiser in a steered study (``steering_chunk_size``
+#: None: this over the farm's turbines, at most ``chunk_size`` conditions). Every run of the
+#: optimiser pays a fixed cost per iteration (a FLORIS model set up for its yaw grid), so larger
+#: runs cost less per condition; the optimiser evaluates tens of yaw sets of every condition at
+#: once, so the memory grows with conditions x turbines (docs/performance.md#a-steered-year).
+STEERING_TURBINE_CONDITIONS = 4608
+#: Operation models whose power never exceeds the maximum of the turbine's power table: FLORIS
+#: interpolates the table (the package's veer-aware rotor scales the speed it is read at,
+#: docs/yaw_steering.md), derating only lowers it. A condition with every turbine at that
+#: maximum cannot gain from steering (:func:`_cannot_gain`).
+CAPPED_OPERATION_MODELS = ("simple", "cosine-loss", "simple-derating")
+#: The optimisers that maximise the farm power (and keep the baseline where nothing beats it).
+POWER_OPTIMIZERS = (YawOptimizationSR, YawOptimizationScipy)
 
 COLUMNS = ("model", "stability", "frequency", "n_conditions", "aep_baseline_gwh",
            "aep_steered_gwh", "gain_percent")
@@ -254,6 +272,7 @@ def annual_energy(
     turbulence_intensities: str = "atmosphere",
     progress: bool | None = None,
     chunk_size: int = DEFAULT_CHUNK_SIZE,
+    steering_chunk_size: int | None = None,
     client=None,
     **optimizer_kwargs,
 ) -> AnnualEnergy:
@@ -273,6 +292,11 @@ def annual_energy(
         progress: tqdm bar over the study's conditions (None: with an optimiser).
         chunk_size: Conditions per FLORIS model (bounds the memory; results do not depend on
             it).
+        steering_chunk_size: Conditions per run of the yaw optimiser within a chunk (bounds its
+            memory; results do not depend on it); None: :data:`STEERING_TURBINE_CONDITIONS`
+            over the farm's turbines (512 on a 3 x 3 farm). Conditions whose every turbine
+            is at the maximum of its power table skip the optimiser and keep zero yaw: steering
+            cannot raise their power (:func:`_cannot_gain`, docs/yaw_steering.md).
         client: A ``dask.distributed.Client``: the chunks run on its workers, each a
             self-contained task (the chunk's FLORIS model, its run and its yaw optimisation),
             gathered in order, so the numbers are bitwise those of the serial study
@@ -282,7 +306,7 @@ def annual_energy(
     """
     classes = stability_classes(stability, wind_data, records)
     study = _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
-                         chunk_size, optimizer_kwargs, client)
+                         chunk_size, optimizer_kwargs, client, steering_chunk_size)
     groups = {}
     for k, c in enumerate(classes):
         # Classes giving the same EkmanABL inputs run together, one atmosphere per condition.
@@ -308,8 +332,8 @@ def annual_energy(
 def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Sequence[str],
                   optimizer_class=None, *, models: Sequence[str] = (MODEL_NAME, "gch"),
                   turbulence_intensities: str = "atmosphere", progress: bool | None = None,
-                  chunk_size: int = DEFAULT_CHUNK_SIZE, client=None,
-                  **optimizer_kwargs) -> AnnualEnergy:
+                  chunk_size: int = DEFAULT_CHUNK_SIZE, steering_chunk_size: int | None = None,
+                  client=None, **optimizer_kwargs) -> AnnualEnergy:
     """:func:`annual_energy` of a ``TimeSeries`` whose records each have their own atmosphere
     (``atmosphere``: the block with one value per record, as ``SiteAtmosphere.atmosphere``).
 
@@ -318,7 +342,7 @@ def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Seque
     classes and records, without a class mapping per record.
     """
     study = _check_study(fmodel, series, optimizer_class, models, turbulence_intensities,
-                         chunk_size, optimizer_kwargs, client)
+                         chunk_size, optimizer_kwargs, client, steering_chunk_size)
     wind_frequencies = np.asarray(series.unpack_freq(), dtype=float).reshape(-1)
     n = wind_frequencies.size
     spec = AtmosphereSpec.from_mapping(atmosphere)
@@ -364,7 +388,7 @@ class _Conditions:
 
 
 def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
-                 chunk_size, optimizer_kwargs, client=None) -> dict:
+                 chunk_size, optimizer_kwargs, client=None, steering_chunk_size=None) -> dict:
     """Check a study's options before any FLORIS run; the wind data's arrays and models."""
     models = list(models)
     allowed = [MODEL_NAME, *BUILTIN_WAKES]
@@ -378,10 +402,13 @@ def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensit
     if turbulence_intensities not in TURBULENCE_SOURCES:
         raise ValueError(f"annual energy: turbulence_intensities must be one of "
                          f"{list(TURBULENCE_SOURCES)}, got {turbulence_intensities!r}")
-    if (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
-            or chunk_size < 1):
-        raise ValueError(f"annual energy: chunk_size must be an integer >= 1; got "
-                         f"{chunk_size!r}")
+    for name, size in (("chunk_size", chunk_size), ("steering_chunk_size", steering_chunk_size)):
+        if size is None and name == "steering_chunk_size":
+            continue
+        if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1:
+            raise ValueError(f"annual energy: {name} must be an integer >= 1; got {size!r}")
+    if steering_chunk_size is None:
+        steering_chunk_size = max(1, STEERING_TURBINE_CONDITIONS // fmodel.core.farm.n_turbines)
     directions, speeds, wind_ti, heterogeneous = wind_data.unpack_for_reinitialize()
     if heterogeneous is not None:
         raise ValueError("annual energy: wind data with a heterogeneous inflow map is not "
@@ -396,7 +423,7 @@ def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensit
         _check_client(fmodel, client)
     return dict(models=models, directions=directions, speeds=speeds, wind_ti=wind_ti,
                 turbulence_intensities=turbulence_intensities, chunk_size=int(chunk_size),
-                client=client)
+                steering_chunk_size=int(steering_chunk_size), client=client)
 
 
 def _check_client(fmodel, client) -> None:
@@ -510,26 +537,35 @@ def _chunk_rows(n: int, chunk_size: int) -> list:
 @attrs.frozen(eq=False)
 class _Chunk:
     """One chunk of a study, self-contained (a Dask task carries it): its conditions, their
-    atmosphere (a plain block: scalars, or one value per condition) and the optimiser's options
-    cut to them."""
+    atmosphere (a plain block: scalars, or one value per condition), the optimiser's options
+    cut to them and the conditions per optimiser run."""
 
     atmosphere: dict
     directions: np.ndarray
     speeds: np.ndarray
     wind_ti: np.ndarray
     optimizer_kwargs: dict
+    steering_chunk_size: int = DEFAULT_CHUNK_SIZE
+
+    def rows(self, rows) -> _Chunk:
+        """The chunk of its conditions ``rows``."""
+        return _Chunk({k: v if np.ndim(v) == 0 else np.asarray(v, dtype=float)[rows].tolist()
+                       for k, v in self.atmosphere.items()},
+                      self.directions[rows], self.speeds[rows], self.wind_ti[rows],
+                      _rows_of(self.optimizer_kwargs, rows), self.steering_chunk_size)
 
 
 def _chunk_of(conditions, rows, study, optimizer_kwargs) -> _Chunk:
     index = conditions.wind_index[rows]
     return _Chunk(conditions.atmosphere_of(rows), study["directions"][index],
                   study["speeds"][index], study["wind_ti"][index],
-                  _rows_of(optimizer_kwargs, index))
+                  _rows_of(optimizer_kwargs, index), study["steering_chunk_size"])
 
 
 def _run_chunk(template, model, chunk, ti_source, optimizer_class) -> dict:
     """Farm powers (baseline and steered), optima and inflow of one chunk, on ``template`` set
-    to the chunk's conditions (one model build)."""
+    to the chunk's conditions (one model build; a second, of the conditions steered, where some
+    cannot gain from steering)."""
     case = _chunk_model(template, model, chunk, ti_source)
     flow_field = case.core.flow_field
     n = chunk.speeds.size
@@ -538,16 +574,102 @@ def _run_chunk(template, model, chunk, ti_source, optimizer_class) -> dict:
            "wind_shear": np.full(n, float(flow_field.wind_shear)),
            "steered": None, "optima": None}
     case.run()
-    out["baseline"] = np.sum(case.get_turbine_powers(), axis=1)
-    if optimizer_class is not None:
-        df_opt = optimize_yaw(case, optimizer_class, progress=False, **chunk.optimizer_kwargs)
+    powers = case.get_turbine_powers()
+    out["baseline"] = np.sum(powers, axis=1)
+    if optimizer_class is None:
+        return out
+    skip = _cannot_gain(case, powers, optimizer_class, chunk.optimizer_kwargs)
+    steer = np.flatnonzero(~skip)
+    out["steered"] = out["baseline"].copy()
+    frames = [_unsteered_frame(case, powers, np.flatnonzero(skip), optimizer_class,
+                               chunk.optimizer_kwargs)] if skip.any() else []
+    if steer.size:
+        options = chunk.optimizer_kwargs
+        if skip.any():
+            # A condition's numbers do not depend on the others run with it: the conditions
+            # steered run on their own.
+            steered = chunk.rows(steer)
+            case, options = _chunk_model(template, model, steered, ti_source), steered.optimizer_kwargs
+        df_opt = optimize_yaw(case, optimizer_class, progress=False,
+                              chunk_size=chunk.steering_chunk_size, **options)
+        df_opt.index = steer
+        frames.append(df_opt)
         case.set(yaw_angles=np.vstack(df_opt["yaw_angles_opt"]))
         case.run()
-        out["steered"] = np.sum(case.get_turbine_powers(), axis=1)
-        out["optima"] = df_opt
+        out["steered"][steer] = np.sum(case.get_turbine_powers(), axis=1)
         # FLORIS's set() keeps non-zero yaw angles: the next chunk's baseline is unyawed.
         case.reset_operation()
+    out["optima"] = pd.concat(frames).sort_index().reset_index(drop=True)
     return out
+
+
+def _rated_powers(fmodel):
+    """The most each turbine's power can be [W] (the maximum of its power table, FLORIS's kW
+    x 1e3), or None where an operation model is not one of :data:`CAPPED_OPERATION_MODELS`
+    (or its table is multi-dimensional)."""
+    rated = []
+    for turbine in fmodel.core.farm.turbine_definitions:
+        if (turbine.get("operation_model", "cosine-loss") not in CAPPED_OPERATION_MODELS
+                or turbine.get("multi_dimensional_cp_ct", False)):
+            return None
+        rated.append(1e3 * float(np.max(turbine["power_thrust_table"]["power"])))
+    return np.array(rated)
+
+
+def _option_rows(optimizer_class, options, name, shape):
+    """The optimiser's option ``name`` (or its default) as an array of ``shape``."""
+    value = options.get(name)
+    if value is None and name not in ("yaw_angles_baseline", "turbine_weights"):
+        value = inspect.signature(optimizer_class.__init__).parameters[name].default
+    return None if value is None else np.broadcast_to(np.asarray(value, dtype=float), shape)
+
+
+def _cannot_gain(fmodel, powers, optimizer_class, options) -> np.ndarray:
+    """Per condition of ``fmodel`` (run, turbine ``powers`` [W]): steering cannot raise its
+    power, so the optimiser is skipped and zero yaw kept (exact: the optimiser keeps the
+    baseline where nothing beats it).
+
+    Where every turbine is at the maximum of its power table (:func:`_rated_powers`), no yaw
+    raises any turbine's power. The bound the search would be judged by, the no-wake power, is
+    not one here: the veer-aware rotor's power is not largest at zero yaw (a lone turbine in a
+    veered wind gains by turning against the veer, docs/yaw_steering.md), so a condition with
+    no wake loss below rated may still gain. Only for optimisers of the farm power
+    (:data:`POWER_OPTIMIZERS`; the geometric one yaws by the layout alone) and where zero yaw is within the bounds, the
+    baseline yaw (``yaw_angles_baseline``) is zero and the turbine weights are not negative.
+    """
+    shape = powers.shape
+    rated = _rated_powers(fmodel)
+    if rated is None or not issubclass(optimizer_class, POWER_OPTIMIZERS):
+        return np.zeros(shape[0], dtype=bool)
+    lower = _option_rows(optimizer_class, options, "minimum_yaw_angle", shape)
+    upper = _option_rows(optimizer_class, options, "maximum_yaw_angle", shape)
+    baseline = _option_rows(optimizer_class, options, "yaw_angles_baseline", shape)
+    weights = _option_rows(optimizer_class, options, "turbine_weights", shape)
+    eligible = (lower <= 0.0) & (upper >= 0.0)
+    if baseline is not None:
+        eligible &= baseline == 0.0
+    if weights is not None:
+        eligible &= weights >= 0.0
+    return np.all(eligible & (powers >= rated), axis=1)
+
+
+def _unsteered_frame(fmodel, powers, rows, optimizer_class, options) -> pd.DataFrame:
+    """FLORIS's ``df_opt`` rows of conditions ``rows`` kept at zero yaw (:func:`_cannot_gain`):
+    the farm power optimised and baseline both the weighted power of the baseline run, as the
+    optimiser computes it."""
+    weights = _option_rows(optimizer_class, options, "turbine_weights", powers.shape)
+    weights = np.ones(powers.shape) if weights is None else weights
+    farm_power = np.sum(np.multiply(weights, powers), axis=1)[rows]
+    flow_field = fmodel.core.flow_field
+    calc_baseline = options.get("calc_baseline_power", True)
+    return pd.DataFrame({
+        "wind_direction": flow_field.wind_directions[rows],
+        "wind_speed": flow_field.wind_speeds[rows],
+        "turbulence_intensity": flow_field.turbulence_intensities[rows],
+        "yaw_angles_opt": list(np.zeros((rows.size, powers.shape[1]))),
+        "farm_power_opt": farm_power,
+        "farm_power_baseline": farm_power if calc_baseline else np.nan,
+    }, index=rows)
 
 
 def _run_on_cluster(client, template, model, chunks, ti_source, optimizer_class, bar) -> list:
