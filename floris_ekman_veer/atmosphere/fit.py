@@ -177,6 +177,79 @@ class ProfileFit:
     mixed_layer_height: np.ndarray | float = np.nan
     #: Whether z_i was fitted (the data reach it) or kept at its given or default value.
     mixed_layer_height_fitted: np.ndarray | bool = False
+    #: (n_records, p, p) the linearised covariance of the unknowns (ln u*, 100 m/L,
+    #: [ln z0], [ln z_i]) at the fit, (J^T J)^-1 of the noise-normalised residuals (the stated
+    #: noise, not the misfit); z_i's row and column 0 where not fitted; NaN where no state
+    #: (docs/measurements.md#how-well-the-data-pin-the-turbulence).
+    covariance: np.ndarray | None = None
+
+    def turbulence_intensity_interval(self, height, reference_height=None):
+        """(low, high): the fitted I_u at ``height`` (`EkmanABL.turbulence_intensity`) minus and
+        plus two linearised standard deviations from :attr:`covariance` (the two-sigma
+        confidence region of :data:`CONFIDENCE_CHI_SQUARE`), low clipped at 0. It measures
+        how well the data and their stated noise pin I_u; a profile whose shape is not the
+        model's (docs/measurements.md#how-well-the-data-pin-the-turbulence) can lie outside it."""
+        x, sign = self._unknowns()
+        z = float(height)
+        ref = None if reference_height is None else float(reference_height)
+        centre = self._intensity_at(x, sign, z, ref)
+        p = x.shape[1]
+        step = 1e-6
+        # (the stability step on the fit's own side of neutral: the two sides are two models)
+        trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
+            np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
+        shifted = self._intensity_at(trial.reshape(-1, p), np.repeat(sign, p), z, ref)
+        gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
+        gradient[:, 1] *= sign
+        cov = np.reshape(self.covariance, (-1, p, p))
+        sigma = np.sqrt(np.einsum("kp,kpq,kq->k", gradient, cov, gradient))
+        shape = (lambda a: a[0]) if self.single else (lambda a: a)
+        return shape(np.maximum(centre - 2.0 * sigma, 0.0)), shape(centre + 2.0 * sigma)
+
+    def _unknowns(self):
+        """(x (n, p), sign (n,)): the unknowns as :attr:`covariance` orders them, 100 m/L
+        signed, and the side of neutral each fit lies on (+1 stable or neutral, -1 convective)."""
+        length = np.reshape(np.asarray(self.obukhov_length, float), -1)
+        columns = [np.log(np.reshape(np.asarray(self.friction_velocity, float), -1)),
+                   _LENGTH_SCALE / length]
+        if "roughness_length" in self.fitted:
+            columns.append(np.log(np.reshape(np.asarray(self.roughness_length, float), -1)))
+        p = np.reshape(self.covariance, (length.size, -1)).shape[1]
+        if int(round(np.sqrt(p))) > len(columns):
+            z_i = np.reshape(np.asarray(self.mixed_layer_height, float), -1)
+            columns.append(np.log(np.where(np.isfinite(z_i), z_i, 1000.0)))
+        return np.stack(columns, axis=1), np.where(length < 0, -1.0, 1.0)
+
+    def _intensity_at(self, x, sign, height, reference_height):
+        """I_u at ``height`` of the model states x (as :meth:`_unknowns`), one per row; rows are
+        the records repeated in blocks (x.shape[0] a multiple of the records)."""
+        n = np.size(self.misfit)
+        repeat = x.shape[0] // n
+        per_row = lambda v: np.repeat(np.reshape(v, -1), repeat) if np.ndim(v) else v  # noqa: E731
+        fixed = {k: per_row(v) for k, v in self.fixed_inputs.items() if k != "roughness_length"}
+        z0 = (np.exp(x[:, 2]) if "roughness_length" in self.fitted
+              else per_row(np.broadcast_to(self.fixed_inputs["roughness_length"], (n,))))
+        if x.shape[1] > 2 + ("roughness_length" in self.fitted):
+            fixed["mixed_layer_height"] = np.exp(x[:, -1])
+        cls = type(self.abl)
+        template = cls.check_inputs(stability_parameter=np.zeros(x.shape[0]), roughness_length=z0,
+                                    **fixed)
+        params, _ = template._parameters(np.nan, (x.shape[0],))
+        log_u = x[:, 0]
+        u_star = np.exp(log_u)
+        with np.errstate(all="ignore"):
+            mu = u_star * np.where(np.isfinite(x[:, 1]), x[:, 1], 0.0) / (
+                _LENGTH_SCALE * template.von_karman * params["f"])
+            params["value"], params["z0"] = mu, z0
+            _, _, _, _, b, along = template._state(log_u, params)
+            g = u_star * np.hypot(along, b) / template.von_karman
+        ok = np.isfinite(g) & (along > 0)
+        abl = cls._solved_at(np.where(ok, log_u, np.log(0.3)), np.where(ok, g, 10.0),
+                             stability_parameter=np.where(ok, mu, 0.0), roughness_length=z0,
+                             **fixed)
+        ref = () if reference_height is None else (reference_height,)
+        intensity = np.reshape(np.asarray(abl.turbulence_intensity(height, *ref), float), -1)
+        return np.where(ok, intensity, np.nan)
 
     def _fitted_depth(self):
         """{"mixed_layer_height": z_i per record} where some record's z_i was fitted (the
@@ -933,6 +1006,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         misfit_tolerance=shape(misfit_tolerance), refusal_misfit=shape(refusal_misfit),
         direction_model_error=float(direction_model_error),
         mixed_layer_height=shape(mixed_layer), mixed_layer_height_fitted=shape(zi_fitted),
+        covariance=shape(_covariance(model, x, valid,
+                                     zi_fitted if model.fit_mixed_layer else None)),
     )
     abl.profile_fit = fit
     return abl
@@ -973,6 +1048,14 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
                           "speed_noise", "direction_noise", "single", "fitted",
                           "direction_model_error"):
             chosen[field.name] = a
+        elif field.name == "covariance":
+            # the stable fit has no z_i unknown: its row and column 0
+            a, b = np.reshape(a, (len(stable.labels), *np.shape(a)[-2:])), np.reshape(
+                b, (len(stable.labels), *np.shape(b)[-2:]))
+            if b.shape[-1] > a.shape[-1]:
+                a = np.pad(a, ((0, 0), (0, 1), (0, 1)))
+            merged = np.where(np.reshape(take, (-1, 1, 1)), b, a)
+            chosen[field.name] = merged[0] if stable.single else merged
         else:
             chosen[field.name] = np.where(take, b, a)[()]
     fit = ProfileFit(**chosen)
@@ -1102,6 +1185,31 @@ def _restart_misfits(model, x, cost, converged, iterations, refused_cost, max_it
 #: own end point), each with z_i at these fractions of the record's highest measurement.
 MIXED_LAYER_STARTING_LENGTHS = (400.0, 100.0, 30.0)
 MIXED_LAYER_STARTING_FRACTIONS = (0.5, 0.75, 1.0)
+
+
+def _covariance(model, x, valid, fitted_depth=None):
+    """(n, p, p): (J^T J)^-1 of the noise-normalised residuals at the fitted unknowns x, the
+    stability unknown signed (100 m/L); z_i's row and column 0 where ``fitted_depth`` is False
+    (it was not an unknown there); NaN where ``valid`` is False."""
+    n, p = x.shape
+    rows = np.arange(n)
+    r0, _, _ = model.residuals(x, rows)
+    # (forward steps: on the fit's own side of neutral for a fit held at 1/L = 0)
+    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
+    rt, _, _ = model.residuals(trial, np.repeat(rows, p))
+    jac = (rt.reshape(n, p, -1) - r0[:, None, :]) / _JACOBIAN_STEP
+    jac[:, 1, :] *= model.sign
+    if fitted_depth is not None:
+        jac[~fitted_depth, -1, :] = 0.0
+    jtj = np.einsum("kpm,kqm->kpq", jac, jac)
+    if fitted_depth is not None:
+        jtj[~fitted_depth, -1, -1] = 1.0
+    cov = np.linalg.pinv(jtj)
+    if fitted_depth is not None:
+        cov[~fitted_depth, -1, :] = 0.0
+        cov[~fitted_depth, :, -1] = 0.0
+    cov[~valid] = np.nan
+    return cov
 
 
 def _fit_mixed_layer(model, x, cost, converged, iterations, max_iterations, model_error):
