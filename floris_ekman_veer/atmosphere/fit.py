@@ -10,6 +10,9 @@ where the wind comes from, clockwise from north] at a few heights. Unknowns (doc
   L rather than mu because the surface-layer shape U/u* = (ln(z/z0) + 5 z/L)/kappa depends on
   1/L alone, which keeps the two unknowns nearly independent;
 * optionally (``fit_roughness=True``) the roughness length z0; otherwise z0 is a site input;
+* in a convective fit without a given ``mixed_layer_height``, the mixed-layer depth z_i where the
+  data reach it (a measurement at or above it, its top shown) and the default cannot follow
+  them; elsewhere its default (docs/measurements.md#mixed-layer-depth);
 * the wind direction is a free rotation (the direction of the surface stress): only the
   direction *change* between heights constrains the physics. It is eliminated in closed form
   (the weighted mean of the measured-minus-model directions) at every evaluation.
@@ -752,7 +755,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         max_iterations: of the Levenberg-Marquardt iteration.
         stability: the sign of 1/L fitted: ``"stable"`` (1/L >= 0, the default), ``"convective"``
             (1/L <= 0: the convective layer of docs/atmosphere.md#convective-boundary-layer, its
-            mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
+            mixed-layer depth a fixed ``mixed_layer_height``, else fitted where the data reach
+            it and the default elsewhere) or ``"either"``:
             both, each record taking the sign whose fit misses its data less
             (``ProfileFit.stability_class`` says which).
         turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
@@ -762,8 +766,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             stability (docs/measurements.md#measured-turbulence).
         turbulence_noise: its noise relative to its value (default 0.1).
         fit_mixed_layer_height: (convective fits without a given ``mixed_layer_height``) fit
-            the mixed-layer depth z_i too where the data reach it: z_i at or below the highest
-            measurement, the data showing that top and telling it from the default; elsewhere
+            the mixed-layer depth z_i too where the data reach it: for records whose default-z_i
+            fit is refused, z_i at or below the highest measurement, the data showing that top
+            and telling it from the default; elsewhere
             z_i keeps its default (``ProfileFit.mixed_layer_height_fitted`` says which,
             docs/measurements.md#mixed-layer-depth). False: the default everywhere.
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
@@ -923,7 +928,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         result = _multistart(part, chunk.size, max_iterations)
         _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
         if zi_stage:
-            result = _fit_mixed_layer(part_model(True), *result, max_iterations,
+            result = _fit_mixed_layer(part_model(True), *result,
+                                      (misfit_tolerance**2 * dof)[chunk], max_iterations,
                                       float(direction_model_error))
         else:
             result = (*result, np.zeros(chunk.size, bool))
@@ -1212,49 +1218,59 @@ def _covariance(model, x, valid, fitted_depth=None):
     return cov
 
 
-def _fit_mixed_layer(model, x, cost, converged, iterations, max_iterations, model_error):
-    """The convective fit with the mixed-layer depth z_i as a further unknown, kept per record
-    only where the data reach z_i (docs/measurements.md#mixed-layer-depth): the fitted z_i at or
-    below the highest measurement, the data showing that top (a speed maximum, or the shear or
-    the veer stopping at it: the test of a stable top, `_hidden_top`), and the chi-square
-    below the default-z_i fit's by more than :data:`CONFIDENCE_CHI_SQUARE` (the data tell the
-    fitted depth from the default). ``model``: the `_ProfileModel` with ``fit_mixed_layer``;
-    x, cost, ...: the default-z_i fit (2 or 3 unknowns). Returns the states with ln z_i
-    appended (the default's own depth where not fitted: the same state) and whether fitted."""
+def _fit_mixed_layer(model, x, cost, converged, iterations, refused_cost, max_iterations,
+                     model_error):
+    """The convective fit with the mixed-layer depth z_i as a further unknown, for the records
+    whose default-z_i fit the chi-square test would refuse (``cost`` above ``refused_cost``: the
+    default depth cannot follow their data), kept per record only where the data reach z_i
+    (docs/measurements.md#mixed-layer-depth): the fitted z_i at or below the highest
+    measurement, the data showing that top (a speed maximum, or the shear or the veer stopping
+    at it: the test of a stable top, `_hidden_top`), and the chi-square below the default-z_i
+    fit's by more than :data:`CONFIDENCE_CHI_SQUARE`. ``model``: the `_ProfileModel` with
+    ``fit_mixed_layer``; x, cost, ...: the default-z_i fit (2 or 3 unknowns). Returns the
+    states with ln z_i appended (the default's own depth where not fitted: the same state) and
+    whether fitted."""
     n = x.shape[0]
     rows = np.arange(n)
-    top = np.nanmax(np.where(model.ms, model.z, np.nan), axis=1)
     # The default fit's depth: for a convective state its z_i, else the neutral height (unused).
     _, _, _, _, depth = _ProfileModel.state(_DefaultDepth(model), x, rows)
     base = np.concatenate([x, np.log(np.where(np.isfinite(depth) & (depth > 0), depth,
                                               1000.0))[:, None]], axis=1)
-    lams = np.concatenate([x[:, 1:2], np.broadcast_to(
-        _LENGTH_SCALE / np.asarray(MIXED_LAYER_STARTING_LENGTHS), (n, len(MIXED_LAYER_STARTING_LENGTHS)))],
+    fitted = np.zeros(n, bool)
+    cost, converged, iterations = cost.copy(), converged.copy(), iterations.copy()
+    candidates = np.flatnonzero(~(cost <= refused_cost))
+    m = candidates.size
+    if m == 0:
+        return base, cost, converged, iterations, fitted
+    top = np.nanmax(np.where(model.ms, model.z, np.nan), axis=1)[candidates]
+    lams = np.concatenate([x[candidates, 1:2], np.broadcast_to(
+        _LENGTH_SCALE / np.asarray(MIXED_LAYER_STARTING_LENGTHS), (m, len(MIXED_LAYER_STARTING_LENGTHS)))],
         axis=1)
     fractions = np.asarray(MIXED_LAYER_STARTING_FRACTIONS)
     k_l, k_f = lams.shape[1], fractions.size
-    starts = _starts(_SubsetModel(model, rows), lams).reshape(n, k_l, -1)
+    starts = _starts(_SubsetModel(model, candidates), lams).reshape(m, k_l, -1)
     # the default fit's own u* at its end point
-    starts[:, 0, 0] = x[:, 0]
+    starts[:, 0, 0] = x[candidates, 0]
     starts = np.repeat(starts, k_f, axis=1)
     log_zi = np.log(np.maximum(top[:, None] * np.tile(fractions, k_l)[None, :],
                                2.0 * model.min_depth))
-    starts = np.concatenate([starts, log_zi[:, :, None]], axis=2).reshape(n * k_l * k_f, -1)
+    starts = np.concatenate([starts, log_zi[:, :, None]], axis=2).reshape(m * k_l * k_f, -1)
     x2, cost2, converged2, iterations2 = _levenberg_marquardt(
-        model, starts, max_iterations, np.repeat(rows, k_l * k_f))
-    pick = _best(x2, cost2, n, k_l * k_f)
+        model, starts, max_iterations, np.repeat(candidates, k_l * k_f))
+    pick = _best(x2, cost2, m, k_l * k_f)
     x2, cost2 = x2[pick], cost2[pick]
-    _, _, _, valid, h = model.state(x2, rows)
-    z_i = np.exp(x2[:, -1])
-    reached = valid & (x2[:, 1] > 0) & (z_i <= top * (1.0 + 1e-9))
-    better = cost2 < cost - CONFIDENCE_CHI_SQUARE
-    shown = ~_hidden_top(model.z, model.s, model.d, np.where(reached, h, np.inf),
-                         model.sigma_s, float(np.hypot(model.sigma_d, model_error)))
-    fitted = reached & better & shown
-    base[fitted] = x2[fitted]
-    cost, converged, iterations = cost.copy(), converged.copy(), iterations.copy()
-    cost[fitted] = cost2[fitted]
-    converged[fitted], iterations[fitted] = converged2[pick][fitted], iterations2[pick][fitted]
+    _, _, _, valid, h = model.state(x2, candidates)
+    reached = valid & (x2[:, 1] > 0) & (np.exp(x2[:, -1]) <= top * (1.0 + 1e-9))
+    better = cost2 < cost[candidates] - CONFIDENCE_CHI_SQUARE
+    d = None if model.d is None else model.d[candidates]
+    shown = ~_hidden_top(model.z[candidates], model.s[candidates], d,
+                         np.where(reached, h, np.inf), model.sigma_s,
+                         float(np.hypot(model.sigma_d, model_error)))
+    keep = reached & better & shown
+    chosen = candidates[keep]
+    fitted[chosen] = True
+    base[chosen], cost[chosen] = x2[keep], cost2[keep]
+    converged[chosen], iterations[chosen] = converged2[pick][keep], iterations2[pick][keep]
     return base, cost, converged, iterations, fitted
 
 
