@@ -195,13 +195,13 @@ class ProfileFit:
         x, sign = self._unknowns()
         z = float(height)
         ref = None if reference_height is None else float(reference_height)
-        centre = self._intensity_at(x, sign, z, ref)
+        centre = self._intensity_at(x, z, ref)
         p = x.shape[1]
         step = 1e-6
         # (the stability step on the fit's own side of neutral: the two sides are two models)
         trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
             np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
-        shifted = self._intensity_at(trial.reshape(-1, p), np.repeat(sign, p), z, ref)
+        shifted = self._intensity_at(trial.reshape(-1, p), z, ref)
         gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
         gradient[:, 1] *= sign
         cov = np.reshape(self.covariance, (-1, p, p))
@@ -217,13 +217,12 @@ class ProfileFit:
                    _LENGTH_SCALE / length]
         if "roughness_length" in self.fitted:
             columns.append(np.log(np.reshape(np.asarray(self.roughness_length, float), -1)))
-        p = np.reshape(self.covariance, (length.size, -1)).shape[1]
-        if int(round(np.sqrt(p))) > len(columns):
+        if np.shape(self.covariance)[-1] > len(columns):
             z_i = np.reshape(np.asarray(self.mixed_layer_height, float), -1)
             columns.append(np.log(np.where(np.isfinite(z_i), z_i, 1000.0)))
         return np.stack(columns, axis=1), np.where(length < 0, -1.0, 1.0)
 
-    def _intensity_at(self, x, sign, height, reference_height):
+    def _intensity_at(self, x, height, reference_height):
         """I_u at ``height`` of the model states x (as :meth:`_unknowns`), one per row; rows are
         the records repeated in blocks (x.shape[0] a multiple of the records)."""
         n = np.size(self.misfit)
