@@ -357,6 +357,33 @@ SCRIPT_NUMBERS = [
      ("examples/site_year.py",),
      r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?convective\s+(\d+) .*?backing\s+(\d+) .*?"
      r"no top\s+(\d+) .*?misfit\s+(\d+) .*?fitted\s+(\d+) "),
+    ("docs/measurements.md", r"\| convective \| no \| (\d+) \| (\d+) \| (\d+) \| (\d+) \| ([\d.]+) % "
+                             r"\| (\d+) of 200 \| (\d+) of 200 \|",
+     ("benchmarks/fit_stability_classes.py",),
+     r"published forms: convective class .*? <= 20 % in \d+ of 200.*?\n  convective convective\s+"
+     r"(\d+)\s+neutral\s+(\d+)\s+stable\s+(\d+)\s+refused (\d+)\s+max error ([\d.]+) %"),
+    ("docs/measurements.md", r"\| convective \| no \| \d+ \| \d+ \| \d+ \| \d+ \| [\d.]+ % "
+                             r"\| (\d+) of 200 \| (\d+) of 200 \|",
+     ("benchmarks/fit_stability_classes.py",),
+     r"published forms: convective class .*? <= 20 % in (\d+) of 200, largest [\d.]+ %; Panofsky "
+     r"inside the fit's two-sigma interval in (\d+);"),
+    ("docs/measurements.md", r"z_i = 1000 m puts (\d+) within 20 % .*? with the fitted u\* and the "
+                             r"true L (\d+), with the true u\* and the fitted L (\d+), as fitted "
+                             r"(\d+), and fitted without the noise (\d+)\. The median fitted L is "
+                             r"([\d.]+) times",
+     ("benchmarks/fit_stability_classes.py",),
+     r"model law at the true state (\d+), fitted u\* with true L (\d+), true u\* with fitted L "
+     r"(\d+), fitted (\d+), fitted without noise (\d+); median fitted L / true L ([\d.]+)"),
+    ("docs/measurements.md", r"z_i fixed at 700, 1500 and 2500 m \(Panofsky's still at 1000 m\) "
+                             r"the fits put (\d+) \(median misfit ([\d.]+)\), (\d+) \(([\d.]+)\) "
+                             r"and (\d+) \(([\d.]+)\) of the 200 within 20 %",
+     ("benchmarks/fit_stability_classes.py",),
+     r"700 m: (\d+) within 20 %, median misfit ([\d.]+), 1500 m: (\d+) within 20 %, median "
+     r"misfit ([\d.]+), 2500 m: (\d+) within 20 %, median misfit ([\d.]+)"),
+    ("docs/measurements.md", r"accepted convective fits is ([\d.]+) % without and ([\d.]+) % with "
+                             r"the measured I_u",
+     ("benchmarks/fit_stability_classes.py",),
+     r"accepted at hub >= 6 m/s ([\d.]+) %.*?accepted at hub >= 6 m/s ([\d.]+) %"),
     ("docs/measurements.md", r"\| ekman_veer \| ([\d.]+) \| ([\d.]+) \| ([+\-][\d.]+) % \|",
      ("examples/site_fit.py",),
      r"ekman_veer\s+([\d.]+)\s+([\d.]+)\s+([+\-]?[\d.]+)"),

@@ -296,3 +296,54 @@ def test_a_top_below_the_lowest_measurement_is_never_shown():
     directions = np.array([[80.0, 80.0, 79.0, 79.6]] * 2)
     hidden = _hidden_top(heights, speeds, directions, np.array([20.0, 90.0]), 0.1, 0.5)
     assert hidden.tolist() == [True, False]
+
+
+def published_thirteen():
+    """The twelve Businger-Dyer surface layers and the mixed-layer record (L = -100 m): speeds,
+    a constant direction, the true L and hub speed."""
+    speeds = np.vstack([businger_dyer_speed(Z[None, :], LENGTHS[:, None]),
+                        mixed_layer_record()[0]])
+    lengths = np.append(LENGTHS, -100.0)
+    return speeds, np.full(speeds.shape, 250.0), lengths, businger_dyer_speed(90.0, lengths)
+
+
+@pytest.mark.parametrize("given_depth", [True, False])
+def test_the_published_profiles_do_not_reach_z_i_and_their_intensity_is_loose(given_depth):
+    """The thirteen published profiles (noise-free, the fit's default noise), with z_i = 1000 m
+    given or left to the fit: all convective within 2 % at the hub; z_i is never fitted (30-150 m
+    does not reach a mixed layer's top; the mixed-layer record's uniform speed above 100 m is
+    its surface layer's top, not z_i), the default kept. I_u(90 m) is within 20 % of Panofsky's
+    for the twelve surface layers but not for the mixed layer (+32 % with z_i = 1000 m, +26 %
+    with the default); the fit's two-sigma interval of I_u contains Panofsky's value for all
+    thirteen, and says how loose it is: +-32 % at L = -1000 m, more than +-100 % from
+    L = -118 m on (docs/measurements.md#how-well-the-data-pin-the-turbulence)."""
+    speeds, directions, lengths, hub = published_thirteen()
+    site = SITE if given_depth else {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
+    abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **site)
+    fit = abl.profile_fit
+    assert list(fit.stability_class) == ["convective"] * 13 and np.all(fit.fits)
+    assert not np.any(fit.mixed_layer_height_fitted)
+    np.testing.assert_array_less(np.abs(fit.speed([90.0])[:, 0] / hub - 1.0), 0.02)
+    intensity = np.reshape(abl.turbulence_intensity(90.0), -1)
+    error = intensity / panofsky_intensity(90.0, lengths) - 1.0
+    np.testing.assert_array_less(np.abs(error[:12]), 0.2)
+    assert error[12] == pytest.approx(0.317 if given_depth else 0.256, abs=0.005)
+    low, high = fit.turbulence_intensity_interval(90.0)
+    panofsky = panofsky_intensity(90.0, lengths)
+    assert np.all((low <= panofsky) & (panofsky <= high))
+    half_width = (high - intensity) / intensity
+    assert 0.3 < half_width[0] < 0.35 and np.all(half_width[6:] > 1.0)
+
+
+def test_a_measured_intensity_narrows_the_interval_to_its_noise():
+    """With sigma_u/U at 90 m measured (noise 10 %), the two-sigma interval of the thirteen
+    published profiles' I_u(90 m) is at most +-20 % of it: the measurement pins it."""
+    speeds, directions, lengths, _ = published_thirteen()
+    measured = panofsky_intensity(90.0, lengths)
+    abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either",
+                               turbulence_intensity=(90.0, measured), **SITE)
+    low, high = abl.profile_fit.turbulence_intensity_interval(90.0)
+    intensity = np.reshape(abl.turbulence_intensity(90.0), -1)
+    np.testing.assert_array_less((high - intensity) / intensity, 0.2)
+    np.testing.assert_array_less(low, measured)
+    np.testing.assert_array_less(measured, high)

@@ -10,6 +10,9 @@ where the wind comes from, clockwise from north] at a few heights. Unknowns (doc
   L rather than mu because the surface-layer shape U/u* = (ln(z/z0) + 5 z/L)/kappa depends on
   1/L alone, which keeps the two unknowns nearly independent;
 * optionally (``fit_roughness=True``) the roughness length z0; otherwise z0 is a site input;
+* in a convective fit without a given ``mixed_layer_height``, the mixed-layer depth z_i where the
+  data reach it (a measurement at or above it, its top shown) and the default cannot follow
+  them; elsewhere its default (docs/measurements.md#mixed-layer-depth);
 * the wind direction is a free rotation (the direction of the surface stress): only the
   direction *change* between heights constrains the physics. It is eliminated in closed form
   (the weighted mean of the measured-minus-model directions) at every evaluation.
@@ -60,7 +63,8 @@ from floris_ekman_veer._validation import real_array, require_at
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
                "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
-               "turbulence_intensity", "turbulence_noise", "direction_model_error")
+               "turbulence_intensity", "turbulence_noise", "direction_model_error",
+               "fit_mixed_layer_height")
 #: Default noise of a measured turbulence intensity, relative to its value: the order of the
 #: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
 DEFAULT_TURBULENCE_NOISE = 0.1
@@ -132,6 +136,11 @@ class ProfileFit:
         stability_class: "convective" (-500 m <= L < 0), "neutral" (|L| > 500 m, Gryning et al.
             2007's neutral class) or "stable" (0 < L <= 500 m); with ``stability="either"`` L
             takes the sign whose fit misses the data less.
+        mixed_layer_height [m], mixed_layer_height_fitted: a convective record's z_i (NaN
+            otherwise) and whether the fit determined it: only where the data reach it (at or
+            below the highest measurement, its top shown); elsewhere the given
+            ``mixed_layer_height`` or the default, the neutral height of Eq. (h_hat_model)
+            (docs/measurements.md#mixed-layer-depth).
     """
 
     abl: object
@@ -165,6 +174,95 @@ class ProfileFit:
     refusal_misfit: np.ndarray | float | None = None
     #: [deg] the directions' model error of the refusal (docs/measurements.md#direction-model-error).
     direction_model_error: float = 0.0
+    #: [m] the mixed-layer depth z_i of each convective record (NaN for stable and neutral ones):
+    #: fitted where ``mixed_layer_height_fitted``, else the given or default one
+    #: (docs/measurements.md#mixed-layer-depth).
+    mixed_layer_height: np.ndarray | float = np.nan
+    #: Whether z_i was fitted (the data reach it) or kept at its given or default value.
+    mixed_layer_height_fitted: np.ndarray | bool = False
+    #: (n_records, p, p) the linearised covariance of the unknowns (ln u*, 100 m/L,
+    #: [ln z0], [ln z_i]) at the fit, (J^T J)^-1 of the noise-normalised residuals (the stated
+    #: noise, not the misfit); z_i's row and column 0 where not fitted; NaN where no state
+    #: (docs/measurements.md#how-well-the-data-pin-the-turbulence).
+    covariance: np.ndarray | None = None
+
+    def turbulence_intensity_interval(self, height, reference_height=None):
+        """(low, high): the fitted I_u at ``height`` (`EkmanABL.turbulence_intensity`) minus and
+        plus two linearised standard deviations from :attr:`covariance` (the two-sigma
+        confidence region of :data:`CONFIDENCE_CHI_SQUARE`), low clipped at 0. It measures
+        how well the data and their stated noise pin I_u; a profile whose shape is not the
+        model's (docs/measurements.md#how-well-the-data-pin-the-turbulence) can lie outside it."""
+        x, sign = self._unknowns()
+        z = float(height)
+        ref = None if reference_height is None else float(reference_height)
+        centre = self._intensity_at(x, z, ref)
+        p = x.shape[1]
+        step = 1e-6
+        # (the stability step on the fit's own side of neutral: the two sides are two models)
+        trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
+            np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
+        shifted = self._intensity_at(trial.reshape(-1, p), z, ref)
+        gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
+        gradient[:, 1] *= sign
+        cov = np.reshape(self.covariance, (-1, p, p))
+        sigma = np.sqrt(np.einsum("kp,kpq,kq->k", gradient, cov, gradient))
+        shape = (lambda a: a[0]) if self.single else (lambda a: a)
+        return shape(np.maximum(centre - 2.0 * sigma, 0.0)), shape(centre + 2.0 * sigma)
+
+    def _unknowns(self):
+        """(x (n, p), sign (n,)): the unknowns as :attr:`covariance` orders them, 100 m/L
+        signed, and the side of neutral each fit lies on (+1 stable or neutral, -1 convective)."""
+        length = np.reshape(np.asarray(self.obukhov_length, float), -1)
+        columns = [np.log(np.reshape(np.asarray(self.friction_velocity, float), -1)),
+                   _LENGTH_SCALE / length]
+        if "roughness_length" in self.fitted:
+            columns.append(np.log(np.reshape(np.asarray(self.roughness_length, float), -1)))
+        if np.shape(self.covariance)[-1] > len(columns):
+            z_i = np.reshape(np.asarray(self.mixed_layer_height, float), -1)
+            columns.append(np.log(np.where(np.isfinite(z_i), z_i, 1000.0)))
+        return np.stack(columns, axis=1), np.where(length < 0, -1.0, 1.0)
+
+    def _intensity_at(self, x, height, reference_height):
+        """I_u at ``height`` of the model states x (as :meth:`_unknowns`), one per row; rows are
+        the records repeated in blocks (x.shape[0] a multiple of the records)."""
+        n = np.size(self.misfit)
+        repeat = x.shape[0] // n
+        per_row = lambda v: np.repeat(np.reshape(v, -1), repeat) if np.ndim(v) else v  # noqa: E731
+        fixed = {k: per_row(v) for k, v in self.fixed_inputs.items() if k != "roughness_length"}
+        z0 = (np.exp(x[:, 2]) if "roughness_length" in self.fitted
+              else per_row(np.broadcast_to(self.fixed_inputs["roughness_length"], (n,))))
+        if x.shape[1] > 2 + ("roughness_length" in self.fitted):
+            fixed["mixed_layer_height"] = np.exp(x[:, -1])
+        cls = type(self.abl)
+        template = cls.check_inputs(stability_parameter=np.zeros(x.shape[0]), roughness_length=z0,
+                                    **fixed)
+        params, _ = template._parameters(np.nan, (x.shape[0],))
+        log_u = x[:, 0]
+        u_star = np.exp(log_u)
+        with np.errstate(all="ignore"):
+            mu = u_star * np.where(np.isfinite(x[:, 1]), x[:, 1], 0.0) / (
+                _LENGTH_SCALE * template.von_karman * params["f"])
+            params["value"], params["z0"] = mu, z0
+            _, _, _, _, b, along = template._state(log_u, params)
+            g = u_star * np.hypot(along, b) / template.von_karman
+        ok = np.isfinite(g) & (along > 0)
+        abl = cls._solved_at(np.where(ok, log_u, np.log(0.3)), np.where(ok, g, 10.0),
+                             stability_parameter=np.where(ok, mu, 0.0), roughness_length=z0,
+                             **fixed)
+        ref = () if reference_height is None else (reference_height,)
+        intensity = np.reshape(np.asarray(abl.turbulence_intensity(height, *ref), float), -1)
+        return np.where(ok, intensity, np.nan)
+
+    def _fitted_depth(self):
+        """{"mixed_layer_height": z_i per record} where some record's z_i was fitted (the
+        others' z_i as they have it, given or default: the same state; a stable or neutral
+        record's boundary layer height, never read), else {}."""
+        if not np.any(self.mixed_layer_height_fitted):
+            return {}
+        z_i = np.asarray(self.mixed_layer_height, float)
+        depth = np.asarray(self.boundary_layer_height, float)
+        depth = np.where(np.isfinite(depth) & (depth >= 10.0), depth, 1000.0)
+        return {"mixed_layer_height": np.where(np.isfinite(z_i), z_i, depth)[()]}
 
     def speed(self, heights):
         """Fitted speed [m/s] at ``heights`` ((n_heights,) or (n_records, n_heights)), shaped
@@ -219,7 +317,7 @@ class ProfileFit:
         if stability_input not in values:
             raise ValueError(f"stability_input must be one of {list(values)}; got "
                              f"{stability_input!r}")
-        block = dict(self.fixed_inputs)
+        block = dict(self.fixed_inputs) | self._fitted_depth()
         if "roughness_length" in self.fitted:
             block["roughness_length"] = self.roughness_length
         block[stability_input] = values[stability_input]
@@ -271,7 +369,9 @@ class ProfileFit:
             angle = np.transpose(abl.wind_angle(z))[index]
         r, observations, _ = _normalised_residuals(speed, angle, speeds, directions,
                                                 self.speed_noise, self.direction_noise)
-        return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted), 1)
+        depth = np.reshape(np.asarray(self.mixed_layer_height_fitted, int), -1)
+        depth = np.broadcast_to(depth, np.shape(self.misfit) or (1,))[index]
+        return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted) - depth, 1)
 
     def reason(self, i):
         """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
@@ -302,6 +402,7 @@ class ProfileFit:
         per_record = lambda v: np.asarray(v)[index]  # noqa: E731
         fixed = {k: (v if np.ndim(v) == 0 else per_record(v)) for k, v in self.fixed_inputs.items()}
         solved = {k: v for k, v in fixed.items() if k != "roughness_length"}
+        solved |= {k: per_record(v) for k, v in self._fitted_depth().items()}
         abl = type(self.abl)(
             geostrophic_wind=np.where(np.isfinite(self.geostrophic_wind), self.geostrophic_wind,
                                       10.0)[index],
@@ -354,11 +455,14 @@ def _wrap(angle):
 
 class _ProfileModel:
     """The model's speeds and direction changes at the data heights for unknowns
-    x = (ln u*, lam = 100 m/L, [ln z0]) per record, and the normalised residuals."""
+    x = (ln u*, lam = 100 m/L, [ln z0], [ln z_i]) per record, and the normalised residuals
+    (``fit_mixed_layer``: the convective mixed-layer depth z_i is the last unknown,
+    docs/measurements.md#mixed-layer-depth)."""
 
     def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
-                 speed_noise, direction_noise, sign=1.0, turbulence=None):
+                 speed_noise, direction_noise, sign=1.0, turbulence=None, fit_mixed_layer=False):
         self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        self.fit_mixed_layer = fit_mixed_layer
         # A measured turbulence intensity per record: (heights (n,), values (n,) NaN missing,
         # relative noise), or None (docs/measurements.md#measured-turbulence).
         self.turbulence = turbulence
@@ -394,6 +498,8 @@ class _ProfileModel:
         mu = self.sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
         p = {k: v[index] for k, v in self.params.items()}
         p["value"], p["z0"] = mu, z0
+        if self.fit_mixed_layer:
+            p["zi"] = np.exp(x[:, -1])
         with np.errstate(all="ignore"):
             _, _, h_hat, _, b, along = self.template._state(log_u, p)
             g = u_star * np.hypot(along, b) / self.kappa
@@ -405,21 +511,27 @@ class _ProfileModel:
                 # a layer as deep as the ABL class accepts (light winds: u* -> 0, h -> 0)
                 & (h >= 1.001 * self.min_depth)
             )
+            if self.fit_mixed_layer:
+                # z_i an input the ABL class accepts, whatever the sign the state takes
+                valid &= np.exp(x[:, -1]) >= 1.001 * self.min_depth
         return g, mu, z0, valid, h
 
-    def abl(self, log_u, g, mu, z0, valid, index):
+    def abl(self, log_u, g, mu, z0, valid, index, mixed_layer_height=None):
         """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
         (``EkmanABL._solved_at``: G was computed from u*, the fit never solves for it again).
         A state that is no model state (``valid`` False, from :meth:`state`) is replaced by a
         neutral stand-in, G = 10 m/s, solved for those records only: one record's trial step
         never aborts the others'."""
         fixed = self.fixed_at(index)
+        if mixed_layer_height is not None:
+            # (a stand-in's z_i is never read: it is neutral)
+            fixed["mixed_layer_height"] = np.where(valid, mixed_layer_height, 1000.0)
         if not np.all(valid):
             bad = np.flatnonzero(~valid)
             stand_in = self.cls(geostrophic_wind=10.0, stability_parameter=0.0,
                                 roughness_length=np.broadcast_to(z0, valid.shape)[bad],
                                 **{k: (v if np.ndim(v) == 0 else np.asarray(v)[bad])
-                                   for k, v in fixed.items()})
+                                   for k, v in fixed.items() if k != "mixed_layer_height"})
             log_u, g, mu = log_u.copy(), g.copy(), mu.copy()
             log_u[bad] = np.log(stand_in.friction_velocity)
             g[bad], mu[bad] = 10.0, 0.0
@@ -431,7 +543,8 @@ class _ProfileModel:
         g, mu, z0, valid, _ = self.state(x, index)
         # Invalid trial states are evaluated at a harmless stand-in and discarded.
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl = self.abl(x[:, 0], g, mu, z0, valid, index)
+        abl = self.abl(x[:, 0], g, mu, z0, valid, index,
+                       np.exp(x[:, -1]) if self.fit_mixed_layer else None)
         # One evaluation of the profile gives the speeds and the flow angles.
         u, v = abl._velocity(np.transpose(self.z[index]))
         speed = np.transpose(np.hypot(u, v))
@@ -616,7 +729,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 on_misfit="raise", labels=None, max_iterations=100, stability="stable",
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
                 turbulence_noise=DEFAULT_TURBULENCE_NOISE,
-                direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, **fixed_inputs):
+                direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
+                **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -640,7 +754,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         max_iterations: of the Levenberg-Marquardt iteration.
         stability: the sign of 1/L fitted: ``"stable"`` (1/L >= 0, the default), ``"convective"``
             (1/L <= 0: the convective layer of docs/atmosphere.md#convective-boundary-layer, its
-            mixed-layer depth a fixed ``mixed_layer_height`` or the default) or ``"either"``:
+            mixed-layer depth a fixed ``mixed_layer_height``, else fitted where the data reach
+            it and the default elsewhere) or ``"either"``:
             both, each record taking the sign whose fit misses its data less
             (``ProfileFit.stability_class`` says which).
         turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
@@ -649,6 +764,12 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             model's I_u at that height (Eq. Iu_model) against it, which constrains u* and the
             stability (docs/measurements.md#measured-turbulence).
         turbulence_noise: its noise relative to its value (default 0.1).
+        fit_mixed_layer_height: (convective fits without a given ``mixed_layer_height``) fit
+            the mixed-layer depth z_i too where the data reach it: for records whose default-z_i
+            fit is refused, z_i at or below the highest measurement, the data showing that top
+            and telling it from the default; elsewhere
+            z_i keeps its default (``ProfileFit.mixed_layer_height_fitted`` says which,
+            docs/measurements.md#mixed-layer-depth). False: the default everywhere.
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
             it: each record's iteration is its own).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
@@ -671,7 +792,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             refusal_probability=refusal_probability, on_misfit=on_misfit, labels=labels,
             max_iterations=max_iterations, chunk_size=chunk_size,
             turbulence_intensity=turbulence_intensity, turbulence_noise=turbulence_noise,
-            direction_model_error=direction_model_error, **fixed_inputs)
+            direction_model_error=direction_model_error,
+            fit_mixed_layer_height=fit_mixed_layer_height, **fixed_inputs)
     speeds = _checked_data("speeds", speeds)
     single = speeds.ndim == 1
     speeds = np.atleast_2d(speeds)
@@ -728,6 +850,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
     if not isinstance(fit_roughness, bool):
         raise ValueError(f"fit_profile: fit_roughness must be True or False; got {fit_roughness!r}")
+    if not isinstance(fit_mixed_layer_height, bool):
+        raise ValueError(f"fit_profile: fit_mixed_layer_height must be True or False; got "
+                         f"{fit_mixed_layer_height!r}")
 
     given = sorted(k for k in fixed_inputs if k in STABILITY_INPUTS or k == "geostrophic_wind")
     if given:
@@ -777,6 +902,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         )
 
     sign = -1.0 if stability == "convective" else 1.0
+    # z_i an unknown of convective fits where not given (docs/measurements.md#mixed-layer-depth)
+    zi_stage = sign < 0 and fit_mixed_layer_height and "mixed_layer_height" not in fixed
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
                           float(speed_noise), float(direction_noise), sign, turbulence)
     from scipy.stats import chi2
@@ -787,18 +914,37 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     # stay bounded, whatever the number of records.
     parts = []
     for chunk in np.array_split(np.arange(n), -(-n // chunk_size)):
-        part = model if chunk.size == n else _ProfileModel(
-            abl_class, heights[chunk], speeds[chunk],
-            None if directions is None else directions[chunk],
-            {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
-            z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
-            float(speed_noise), float(direction_noise), sign,
-            None if turbulence is None else tuple(a[chunk] for a in turbulence))
+        def part_model(fit_mixed_layer=False, chunk=chunk):
+            return _ProfileModel(
+                abl_class, heights[chunk], speeds[chunk],
+                None if directions is None else directions[chunk],
+                {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
+                z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
+                float(speed_noise), float(direction_noise), sign,
+                None if turbulence is None else tuple(a[chunk] for a in turbulence),
+                fit_mixed_layer)
+        part = model if chunk.size == n else part_model()
         result = _multistart(part, chunk.size, max_iterations)
         _restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
+        if zi_stage:
+            result = _fit_mixed_layer(part_model(True), *result,
+                                      (misfit_tolerance**2 * dof)[chunk], max_iterations,
+                                      float(direction_model_error))
+        else:
+            result = (*result, np.zeros(chunk.size, bool))
         parts.append(result)
-    x, cost, converged, iterations = (np.concatenate(a) for a in zip(*parts))
+    x, cost, converged, iterations, zi_fitted = (np.concatenate(a) for a in zip(*parts))
     index = np.arange(n)
+    if np.any(zi_fitted):
+        # every record's state with its z_i (fitted, or the default's own depth: the same state)
+        model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array,
+                              fit_roughness, float(speed_noise), float(direction_noise), sign,
+                              turbulence, True)
+        # one unknown more where z_i is fitted
+        dof = np.maximum(observations - n_unknowns - zi_fitted, 1)
+        misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
+    else:
+        x = x[:, : n_unknowns]
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
@@ -831,12 +977,20 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
     shape = (lambda a: a[0]) if single else (lambda a: a)
+    fitted_depth = {}
+    if np.any(zi_fitted):
+        # (a stable, neutral or stand-in record's z_i is never read)
+        fitted_depth["mixed_layer_height"] = shape(np.where(safe & valid, np.exp(x[:, -1]),
+                                                            1000.0))
     abl = abl_class(
         geostrophic_wind=shape(np.where(safe, g, 10.0)),
         stability_parameter=shape(np.where(safe, mu, 0.0)),
         roughness_length=shape(z0_fit) if fit_roughness or z0_array.ndim else float(z0_array),
-        **({k: shape(v) if np.ndim(v) else v for k, v in fixed.items()}),
+        **({k: shape(v) if np.ndim(v) else v for k, v in fixed.items()}), **fitted_depth,
     )
+    convective = np.reshape(np.asarray(abl.stability_parameter), -1) < 0
+    mixed_layer = np.where(convective & valid,
+                           np.reshape(np.asarray(abl.boundary_layer_height), -1), np.nan)
     u_star = np.exp(x[:, 0])
     kappa_f = model.kappa * model.f
     with np.errstate(divide="ignore"):
@@ -856,6 +1010,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         stability_class=shape(_stability_class(obukhov)),
         misfit_tolerance=shape(misfit_tolerance), refusal_misfit=shape(refusal_misfit),
         direction_model_error=float(direction_model_error),
+        mixed_layer_height=shape(mixed_layer), mixed_layer_height_fitted=shape(zi_fitted),
+        covariance=shape(_covariance(model, x, valid,
+                                     zi_fitted if model.fit_mixed_layer else None)),
     )
     abl.profile_fit = fit
     return abl
@@ -896,6 +1053,14 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
                           "speed_noise", "direction_noise", "single", "fitted",
                           "direction_model_error"):
             chosen[field.name] = a
+        elif field.name == "covariance":
+            # the stable fit has no z_i unknown: its row and column 0
+            a, b = np.reshape(a, (len(stable.labels), *np.shape(a)[-2:])), np.reshape(
+                b, (len(stable.labels), *np.shape(b)[-2:]))
+            if b.shape[-1] > a.shape[-1]:
+                a = np.pad(a, ((0, 0), (0, 1), (0, 1)))
+            merged = np.where(np.reshape(take, (-1, 1, 1)), b, a)
+            chosen[field.name] = merged[0] if stable.single else merged
         else:
             chosen[field.name] = np.where(take, b, a)[()]
     fit = ProfileFit(**chosen)
@@ -914,6 +1079,7 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     mu = np.asarray(fit.stability_parameter, float)
     valid = np.isfinite(np.asarray(fit.geostrophic_wind, float))
     fixed = {k: v for k, v in fit.fixed_inputs.items()}
+    fixed.update(fit._fitted_depth())
     abl = abl_class(
         geostrophic_wind=np.where(valid, fit.geostrophic_wind, 10.0)[()],
         stability_parameter=np.where(valid, mu, 0.0)[()],
@@ -1020,12 +1186,109 @@ def _restart_misfits(model, x, cost, converged, iterations, refused_cost, max_it
     converged[chosen], iterations[chosen] = converged2[pick][better], iterations2[pick][better]
 
 
+#: Starting Obukhov lengths [m] of the fit of the mixed-layer depth (with the default-z_i fit's
+#: own end point), each with z_i at these fractions of the record's highest measurement.
+MIXED_LAYER_STARTING_LENGTHS = (400.0, 100.0, 30.0)
+MIXED_LAYER_STARTING_FRACTIONS = (0.5, 0.75, 1.0)
+
+
+def _covariance(model, x, valid, fitted_depth=None):
+    """(n, p, p): (J^T J)^-1 of the noise-normalised residuals at the fitted unknowns x, the
+    stability unknown signed (100 m/L); z_i's row and column 0 where ``fitted_depth`` is False
+    (it was not an unknown there); NaN where ``valid`` is False."""
+    n, p = x.shape
+    rows = np.arange(n)
+    r0, _, _ = model.residuals(x, rows)
+    # (forward steps: on the fit's own side of neutral for a fit held at 1/L = 0)
+    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
+    rt, _, _ = model.residuals(trial, np.repeat(rows, p))
+    jac = (rt.reshape(n, p, -1) - r0[:, None, :]) / _JACOBIAN_STEP
+    jac[:, 1, :] *= model.sign
+    if fitted_depth is not None:
+        jac[~fitted_depth, -1, :] = 0.0
+    jtj = np.einsum("kpm,kqm->kpq", jac, jac)
+    if fitted_depth is not None:
+        jtj[~fitted_depth, -1, -1] = 1.0
+    cov = np.linalg.pinv(jtj)
+    if fitted_depth is not None:
+        cov[~fitted_depth, -1, :] = 0.0
+        cov[~fitted_depth, :, -1] = 0.0
+    cov[~valid] = np.nan
+    return cov
+
+
+def _fit_mixed_layer(model, x, cost, converged, iterations, refused_cost, max_iterations,
+                     model_error):
+    """The convective fit with the mixed-layer depth z_i as a further unknown, for the records
+    whose default-z_i fit the chi-square test would refuse (``cost`` above ``refused_cost``: the
+    default depth cannot follow their data), kept per record only where the data reach z_i
+    (docs/measurements.md#mixed-layer-depth): the fitted z_i at or below the highest
+    measurement, the data showing that top (a speed maximum, or the shear or the veer stopping
+    at it: the test of a stable top, `_hidden_top`), and the chi-square below the default-z_i
+    fit's by more than :data:`CONFIDENCE_CHI_SQUARE`. ``model``: the `_ProfileModel` with
+    ``fit_mixed_layer``; x, cost, ...: the default-z_i fit (2 or 3 unknowns). Returns the
+    states with ln z_i appended (the default's own depth where not fitted: the same state) and
+    whether fitted."""
+    n = x.shape[0]
+    rows = np.arange(n)
+    # The default fit's depth: for a convective state its z_i, else the neutral height (unused).
+    _, _, _, _, depth = _ProfileModel.state(_DefaultDepth(model), x, rows)
+    base = np.concatenate([x, np.log(np.where(np.isfinite(depth) & (depth > 0), depth,
+                                              1000.0))[:, None]], axis=1)
+    fitted = np.zeros(n, bool)
+    cost, converged, iterations = cost.copy(), converged.copy(), iterations.copy()
+    candidates = np.flatnonzero(~(cost <= refused_cost))
+    m = candidates.size
+    if m == 0:
+        return base, cost, converged, iterations, fitted
+    top = np.nanmax(np.where(model.ms, model.z, np.nan), axis=1)[candidates]
+    lams = np.concatenate([x[candidates, 1:2], np.broadcast_to(
+        _LENGTH_SCALE / np.asarray(MIXED_LAYER_STARTING_LENGTHS), (m, len(MIXED_LAYER_STARTING_LENGTHS)))],
+        axis=1)
+    fractions = np.asarray(MIXED_LAYER_STARTING_FRACTIONS)
+    k_l, k_f = lams.shape[1], fractions.size
+    starts = _starts(_SubsetModel(model, candidates), lams).reshape(m, k_l, -1)
+    # the default fit's own u* at its end point
+    starts[:, 0, 0] = x[candidates, 0]
+    starts = np.repeat(starts, k_f, axis=1)
+    log_zi = np.log(np.maximum(top[:, None] * np.tile(fractions, k_l)[None, :],
+                               2.0 * model.min_depth))
+    starts = np.concatenate([starts, log_zi[:, :, None]], axis=2).reshape(m * k_l * k_f, -1)
+    x2, cost2, converged2, iterations2 = _levenberg_marquardt(
+        model, starts, max_iterations, np.repeat(candidates, k_l * k_f))
+    pick = _best(x2, cost2, m, k_l * k_f)
+    x2, cost2 = x2[pick], cost2[pick]
+    _, _, _, valid, h = model.state(x2, candidates)
+    reached = valid & (x2[:, 1] > 0) & (np.exp(x2[:, -1]) <= top * (1.0 + 1e-9))
+    better = cost2 < cost[candidates] - CONFIDENCE_CHI_SQUARE
+    d = None if model.d is None else model.d[candidates]
+    shown = ~_hidden_top(model.z[candidates], model.s[candidates], d,
+                         np.where(reached, h, np.inf), model.sigma_s,
+                         float(np.hypot(model.sigma_d, model_error)))
+    keep = reached & better & shown
+    chosen = candidates[keep]
+    fitted[chosen] = True
+    base[chosen], cost[chosen] = x2[keep], cost2[keep]
+    converged[chosen], iterations[chosen] = converged2[pick][keep], iterations2[pick][keep]
+    return base, cost, converged, iterations, fitted
+
+
+class _DefaultDepth:
+    """A `_ProfileModel` seen without its z_i unknown (the default mixed-layer depth), for the
+    state of a default-z_i fit's unknowns."""
+
+    def __init__(self, model):
+        self.__dict__.update(model.__dict__)
+        self.fit_mixed_layer = False
+
+
 class _SubsetModel:
     """The data of some records of a `_ProfileModel`, for `_starts`."""
 
     def __init__(self, model, index):
         self.ms, self.z, self.s = model.ms[index], model.z[index], model.s[index]
         self.z0, self.kappa, self.fit_roughness = model.z0[index], model.kappa, model.fit_roughness
+        self.fit_mixed_layer = model.fit_mixed_layer
         self.sign = model.sign
 
 
