@@ -609,6 +609,17 @@ def _solve_normal(jtj, jtr, damping, x_lam, bounded):
     return np.linalg.solve(a, rhs[..., None])[..., 0]
 
 
+def _jacobian(model, x, r, records):
+    """(k, p, m): the forward-difference Jacobian of ``model``'s normalised residuals r (k, m)
+    at unknowns x (k, p) of ``records`` (k,), all unknowns and records in one evaluation; 0
+    where a step leaves the model's states."""
+    k, p = x.shape
+    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
+    rt, vt, _ = model.residuals(trial, np.repeat(records, p))
+    jac = (rt.reshape(k, p, -1) - r[:, None, :]) / _JACOBIAN_STEP
+    return np.where(vt.reshape(k, p)[:, :, None], jac, 0.0)
+
+
 def _levenberg_marquardt(model, x, max_iterations, records):
     """LM iterations for unknowns x (k, p) of ``records`` (k,) (a record may appear with
     several starting points); converged rows are frozen."""
@@ -624,12 +635,7 @@ def _levenberg_marquardt(model, x, max_iterations, records):
         if index.size == 0:
             break
         xa, ra = x[index], r[index]
-        # Forward differences, all unknowns and records in one evaluation.
-        steps = _JACOBIAN_STEP * np.eye(p)
-        trial = (xa[:, None, :] + steps[None]).reshape(-1, p)
-        rt, vt, _ = model.residuals(trial, np.repeat(records[index], p))
-        jac = (rt.reshape(index.size, p, -1) - ra[:, None, :]) / _JACOBIAN_STEP
-        jac = np.where(vt.reshape(index.size, p)[:, :, None], jac, 0.0)
+        jac = _jacobian(model, xa, ra, records[index])
         jtj = np.einsum("kpm,kqm->kpq", jac, jac)
         jtr = np.einsum("kpm,km->kp", jac, ra)
         step = _solve_normal(jtj, jtr, damping[index], xa[:, 1], np.zeros(index.size, bool))
@@ -1196,13 +1202,10 @@ def _covariance(model, x, valid, fitted_depth=None):
     """(n, p, p): (J^T J)^-1 of the noise-normalised residuals at the fitted unknowns x, the
     stability unknown signed (100 m/L); z_i's row and column 0 where ``fitted_depth`` is False
     (it was not an unknown there); NaN where ``valid`` is False."""
-    n, p = x.shape
-    rows = np.arange(n)
+    rows = np.arange(x.shape[0])
     r0, _, _ = model.residuals(x, rows)
     # (forward steps: on the fit's own side of neutral for a fit held at 1/L = 0)
-    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
-    rt, _, _ = model.residuals(trial, np.repeat(rows, p))
-    jac = (rt.reshape(n, p, -1) - r0[:, None, :]) / _JACOBIAN_STEP
+    jac = _jacobian(model, x, r0, rows)
     jac[:, 1, :] *= model.sign
     if fitted_depth is not None:
         jac[~fitted_depth, -1, :] = 0.0

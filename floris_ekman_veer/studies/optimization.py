@@ -668,11 +668,11 @@ def _reinitialize_conditions(self, **kwargs):
     subset) on a copy of the subset, which rebuilds the whole Core: the farm re-reads every
     turbine's YAML file and builds its turbines anew, resolving the library path through
     ``inspect.stack`` twice per turbine type, and the package re-validates the conditions:
-    38 % of a steered study's time (docs/performance.md#both-signs-of-yaw). Neither the layout nor the turbines change here,
+    38 % of a steered study's time (docs/yaw_steering.md#how-both-signs-are-searched). Neither the layout nor the turbines change here,
     and every condition is one of the subset's, already validated; the flow field, the wake
     models (with the atmosphere the subset now carries), the per-condition set-points and the
     grid are built as FLORIS builds them (``Core.__attrs_post_init__``). Results are bitwise
-    those of the full rebuild (tests/test_yaw_search.py).
+    those of the full rebuild (tests/test_optimization.py).
     """
     given = {k for k, v in kwargs.items() if v is not None}
     core = self.core
