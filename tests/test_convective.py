@@ -209,6 +209,31 @@ def test_drag_law_a_is_the_neutral_a_plus_the_surface_layer_psi_m(mixed_layer_he
         assert abl.gdl_a[k] - neutral_a[k] == pytest.approx(1.525, abs=5e-4)
 
 
+@pytest.mark.parametrize("mixed_layer_height", [None, 1500.0])
+def test_surface_layer_top_wind_is_brutsaerts_bulk_mixed_layer_speed(mixed_layer_height):
+    """Brutsaert (1999)'s bulk similarity of the convective layer (a Monin-Obukhov surface layer
+    to alpha_t h_i under a mixed slab): U_m = (u*/kappa) [ln(h_i/z0) - B_w], B_w = -ln(alpha_t) +
+    psi_m(alpha_t h_i/L) - psi_m(z0/L). With alpha_t the matching fraction 0.2 and h_i = z_i, the
+    model's U at the top of its surface layer is that U_m plus the paper's CNBL term
+    0.3 mu_N u* (xi_m - xi_0), for every L: the drag law's A - A_N (test above) is B_w's
+    stability part (docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer). B_w
+    computed here from Paulson's psi_m by hand."""
+    extra = {} if mixed_layer_height is None else dict(mixed_layer_height=mixed_layer_height)
+    abl = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=DRAG_LAW_LENGTHS, **SITE, **extra)
+    z_i, u_star, z0 = abl.boundary_layer_height, abl.friction_velocity, 0.1
+
+    def psi(zeta):
+        x = (1.0 - 16.0 * zeta) ** 0.25
+        return 2 * np.log((1 + x) / 2) + np.log((1 + x * x) / 2) - 2 * np.arctan(x) + np.pi / 2
+
+    alpha_t = 0.2
+    b_w = -np.log(alpha_t) + psi(alpha_t * z_i / DRAG_LAW_LENGTHS) - psi(z0 / DRAG_LAW_LENGTHS)
+    u_m = u_star / 0.41 * (np.log(z_i / z0) - b_w)
+    cnbl = 0.3 * abl.zilitinkevich_number * 1e-4 * (alpha_t * z_i - z0)  # u* 0.3 mu_N (xi - xi0)
+    top = np.diagonal(abl.velocity((alpha_t * z_i)[:, None])[0])
+    np.testing.assert_allclose(top, u_m + cnbl, rtol=1e-12)
+
+
 def test_drag_law_a_grows_like_ln_minus_mu_in_strong_convection():
     """For -0.2 h/L >> 1 psi_m -> ln(1 - gamma z/L) - 3 ln 2 - pi/2, so at fixed h_hat and Ro
     d A/d ln(-mu) -> 1 and A -> ln(-kappa mu) + ln(gamma/8) - pi/2 - psi_m(z0/L) - kappa E

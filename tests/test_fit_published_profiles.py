@@ -347,3 +347,29 @@ def test_a_measured_intensity_narrows_the_interval_to_its_noise():
     np.testing.assert_array_less((high - intensity) / intensity, 0.2)
     np.testing.assert_array_less(low, measured)
     np.testing.assert_array_less(measured, high)
+
+
+def test_no_one_surface_layer_depth_fits_both_kinds_of_published_profile():
+    """The thirteen published profiles fitted with the surface layer's top at 0.1 z_i (the
+    textbook lowest tenth of a convective layer), 0.12 z_i and the paper's 0.2 z_i
+    (``matching_fraction``; z_i = 1000 m): every fit convective within 2 % at the hub, but the
+    records whose I_u(90 m) falls outside 20 % of Panofsky's move from the mixed-layer record
+    (its surface layer ends at 100 m = 0.1 z_i) at 0.2 to the strongest surface layers (theirs
+    reach 150 m = 7.5 (-L) at L = -20 m) at 0.12 and 0.1: no one depth fits both kinds, and the
+    package keeps the paper's 0.2 (docs/measurements.md#how-well-the-data-pin-the-turbulence)."""
+    speeds, directions, lengths, hub = published_thirteen()
+    panofsky = panofsky_intensity(90.0, lengths)
+    missed = {}
+    for fraction in (0.1, 0.12, 0.2):
+        abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either",
+                                   matching_fraction=fraction, **SITE)
+        fit = abl.profile_fit
+        assert list(fit.stability_class) == ["convective"] * 13 and np.all(fit.fits)
+        np.testing.assert_array_less(np.abs(fit.speed([90.0])[:, 0] / hub - 1.0), 0.02)
+        error = np.reshape(abl.turbulence_intensity(90.0), -1) / panofsky - 1.0
+        missed[fraction] = {round(float(L), 1): round(float(e), 2)
+                            for L, e in zip(lengths, error) if abs(e) > 0.2}
+        if fraction == 0.1:
+            assert error[12] == pytest.approx(-0.175, abs=0.005)  # the mixed-layer record
+    assert missed == {0.1: {-58.1: -0.23, -40.7: -0.28, -28.5: -0.34, -20.0: -0.4},
+                      0.12: {-28.5: -0.21, -20.0: -0.28}, 0.2: {-100.0: 0.32}}

@@ -250,8 +250,9 @@ def gdl_coefficients(
     ``rossby_number`` is the surface Rossby number u*/(|f_c| z0) = 1/xi0_hat. The paper
     prints 0.2 and 0.8 = 1 - 0.2; ``matching`` is that fraction. For mu < 0 the paper's
     5 mu (0.2 h_hat - xi0) is the Businger-Dyer `stability_term` at the matching height, the
-    same matching of the surface layer to the Ekman layer, so A = A_N + psi_m(0.2 h/L) - psi_m(z0/L)
-    (docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer).
+    same matching of the surface layer to the Ekman layer, so A = A_N + psi_m(0.2 h/L) - psi_m(z0/L):
+    the stability part of Brutsaert (1999)'s bulk similarity function B_w with its alpha_t the
+    matching fraction (docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer).
     """
     g_m, dg_m = stress_shape(matching, h_hat, c_g, decay)
     xi_m, xi0 = matching * h_hat, 1.0 / rossby_number
