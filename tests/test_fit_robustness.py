@@ -150,6 +150,21 @@ def test_unclear_inputs_get_messages_naming_them():
         fit_site(records, 0.01, **SITE)
 
 
+def test_shear_and_veer_refusal_of_many_conditions_names_the_first():
+    """Of 3,000 conditions, one veering 80 deg across the rotor: the message names that
+    condition by its index and its own inputs, counts no other, and stays short (it listed
+    every condition's hub speed, 15,782 characters, before)."""
+    speeds, veers = np.full(3000, 9.0), np.full(3000, 2.0)
+    veers[1234] = 80.0
+    with pytest.raises(ValueError) as error:
+        atmosphere_from_shear_and_veer(speeds, 90.0, 126.0, veer=veers, **SITE)
+    text = str(error.value)
+    assert text.startswith("atmosphere_from_shear_and_veer: condition 1234 (veer=80 [deg, from "
+                           "the bottom to the top of the rotor] at hub_speed 9 m/s) fits no "
+                           "atmosphere of the model")
+    assert "more record" not in text and len(text) < 800
+
+
 def test_shear_and_veer_inputs_are_vectorised():
     abl = atmosphere_from_shear_and_veer(np.array([6.0, 9.0]), 90.0, 126.0,
                                          np.array([0.2, 0.2]), **SITE)

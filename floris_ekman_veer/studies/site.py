@@ -411,10 +411,18 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
         text = str(error)
         if "fits no atmosphere of the model" not in text:
             raise
-        given = " and ".join(f"{k}={v!r}{unit}" for k, v, unit in (
+        # Of many conditions, name the first that fails by its index and values, not every
+        # condition's inputs (fit_profile counts and lists the others).
+        first = re.search(r"record (\d+) fits no atmosphere", text)
+        k = int(first[1]) if first and not single else None
+        pick = (lambda v: repr(float(np.ravel(v)[0]))) if k is None else (
+            lambda v: f"{float(np.broadcast_to(v, n)[k]):g}")
+        given = " and ".join(f"{name}={pick(v)}{unit}" for name, v, unit in (
             ("shear_exponent", shear_exponent, ""),
             ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
+        where = (f"{given} at hub_speed {hub_speed.tolist()} m/s" if k is None else
+                 f"condition {k} ({given} at hub_speed {pick(hub_speed)} m/s)")
         raise ValueError(
-            f"atmosphere_from_shear_and_veer: {given} at hub_speed {hub_speed.tolist()} m/s "
+            f"atmosphere_from_shear_and_veer: {where} "
             f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
             f"veer_tolerance={veer_tolerance:g} deg): {text.split('): ', 1)[-1]}") from None
