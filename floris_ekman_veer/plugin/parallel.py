@@ -97,17 +97,35 @@ _WORKER_FUNCTIONS = ("_parallel_run", "_parallel_run_powers_only",
                      "_parallel_sample_flow_at_points", "_parallel_sample_ti_at_points")
 
 
-def _recording_worker(function):
+class _RecordingWorker:
     """A worker's chunk: the package's warnings are recorded and travel back with the result,
     for the parent to report once at the user's line (floris_ekman_veer.warnings), instead of
-    being printed by each worker at the pool's frame with the worker's share of the counts."""
-    @functools.wraps(function)
-    def wrapper(*args, **kwargs):
+    being printed by each worker at the pool's frame with the worker's share of the counts.
+
+    The pool pickles the function it runs ahead of its arguments (the :class:`WorkerDict`). By
+    FLORIS's name, a ``spawn`` or ``forkserver`` worker that has not imported this package would
+    unpickle FLORIS's function unwrapped; so it is pickled as a call of :func:`_worker_function`,
+    which imports the package first (docs/coupling.md#parallel-workers)."""
+
+    def __init__(self, function):
+        functools.update_wrapper(self, function)
+
+    def __call__(self, *args, **kwargs):
         with package_warnings.collecting() as records:
-            result = function(*args, **kwargs)
+            result = self.__wrapped__(*args, **kwargs)
         return package_warnings.carrying(result, records)
 
-    return wrapper
+    def __reduce__(self):
+        return _worker_function, (self.__name__,)
+
+
+def _worker_function(name: str):
+    """Unpickle a :class:`_RecordingWorker`: prepare this process, then hand over FLORIS's worker
+    function ``name`` as this process has it wrapped."""
+    import floris.par_floris_model as par
+
+    prepare_worker()
+    return getattr(par, name)
 
 
 def _reporting_parent(method):
@@ -136,4 +154,4 @@ def install_parallel_hook() -> None:
     for name in ("run", "_sample_value_at_points"):
         _patch(ParFlorisModel, name, _reporting_parent)
     for name in _WORKER_FUNCTIONS:  # (a module has a __dict__ as a class has)
-        _patch(par, name, _recording_worker)
+        _patch(par, name, _RecordingWorker)
