@@ -64,6 +64,27 @@ SCRIPT = textwrap.dedent(
                       np.array([90.0, 60.0, 120.0]))
             out["points"] = np.max(np.abs(par.sample_flow_at_points(*points)
                                           - serial.sample_flow_at_points(*points))).item()
+            # The package's warnings raised on the workers (the thrust limit at light wind) are
+            # reported by the parent once, as the serial run reports them.
+            import warnings
+
+            from floris_ekman_veer import ThrustLimitWarning
+
+            rng = np.random.default_rng(1)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                light = FlorisModel(farm)
+                light.set(wind_directions=rng.uniform(0, 360, 8), wind_speeds=rng.uniform(3, 8, 8),
+                          turbulence_intensities=np.full(8, 0.06))
+            said = {}
+            for name, model in (("serial", light),
+                                ("dask", ParFlorisModel(light, interface="dask", client=client))):
+                with warnings.catch_warnings(record=True) as records:
+                    warnings.simplefilter("always")
+                    model.run()
+                said[name] = [str(w.message) for w in records
+                              if issubclass(w.category, ThrustLimitWarning)]
+            out["warnings"] = said
             # The package's models ran on the workers (a worker without them would have raised).
             out["worker_models"] = sorted(set(client.run(_velocity_models).values()))
 
@@ -216,6 +237,16 @@ def test_dask_model_is_the_serial_model(cluster_results):
     # Each condition is computed on its own, so the chunks give the serial numbers exactly.
     for key in ("run", "points", "powers_only", "per_condition"):
         assert cluster_results[key] == 0.0, key
+
+
+@pytest.mark.study
+def test_dask_worker_warnings_are_said_once_by_the_parent(cluster_results):
+    """The thrust-limit warnings of light-wind conditions run on the cluster's workers reach the
+    parent as one summary, the serial run's, counting all 8 conditions
+    (docs/coupling.md#parallel-workers)."""
+    said = cluster_results["warnings"]
+    assert len(said["serial"]) == 1 and "of 8 conditions" in said["serial"][0]
+    assert said["dask"] == said["serial"]
 
 
 @pytest.mark.study
