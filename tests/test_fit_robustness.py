@@ -162,7 +162,7 @@ def test_shear_and_veer_refusal_of_many_conditions_names_the_first():
     assert text.startswith("atmosphere_from_shear_and_veer: condition 1234 (veer=80 [deg, from "
                            "the bottom to the top of the rotor] at hub_speed 9 m/s) fits no "
                            "atmosphere of the model")
-    assert "more record" not in text and len(text) < 800
+    assert "more condition" not in text and len(text) < 800
 
 
 def test_shear_and_veer_inputs_are_vectorised():

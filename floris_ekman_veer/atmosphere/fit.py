@@ -195,13 +195,13 @@ class ProfileFit:
         x, sign = self._unknowns()
         z = float(height)
         ref = None if reference_height is None else float(reference_height)
-        centre = self._intensity_at(x, z, ref)
+        centre = self._intensity_at(x, sign, z, ref)
         p = x.shape[1]
         step = 1e-6
         # (the stability step on the fit's own side of neutral: the two sides are two models)
         trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
             np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
-        shifted = self._intensity_at(trial.reshape(-1, p), z, ref)
+        shifted = self._intensity_at(trial.reshape(-1, p), sign, z, ref)
         gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
         gradient[:, 1] *= sign
         cov = np.reshape(self.covariance, (-1, p, p))
@@ -222,36 +222,26 @@ class ProfileFit:
             columns.append(np.log(np.where(np.isfinite(z_i), z_i, 1000.0)))
         return np.stack(columns, axis=1), np.where(length < 0, -1.0, 1.0)
 
-    def _intensity_at(self, x, height, reference_height):
-        """I_u at ``height`` of the model states x (as :meth:`_unknowns`), one per row; rows are
-        the records repeated in blocks (x.shape[0] a multiple of the records)."""
+    def _intensity_at(self, x, sign, height, reference_height):
+        """I_u at ``height`` of the model states x and sides of neutral ``sign`` (as
+        :meth:`_unknowns`), one per row; rows are the records repeated in blocks (x.shape[0] a
+        multiple of the records); NaN where a state is no model state. The states are the
+        fit's own (`_ProfileModel.abl_at`)."""
         n = np.size(self.misfit)
-        repeat = x.shape[0] // n
-        per_row = lambda v: np.repeat(np.reshape(v, -1), repeat) if np.ndim(v) else v  # noqa: E731
-        fixed = {k: per_row(v) for k, v in self.fixed_inputs.items() if k != "roughness_length"}
-        z0 = (np.exp(x[:, 2]) if "roughness_length" in self.fitted
-              else per_row(np.broadcast_to(self.fixed_inputs["roughness_length"], (n,))))
-        if x.shape[1] > 2 + ("roughness_length" in self.fitted):
-            fixed["mixed_layer_height"] = np.exp(x[:, -1])
-        cls = type(self.abl)
-        template = cls.check_inputs(stability_parameter=np.zeros(x.shape[0]), roughness_length=z0,
-                                    **fixed)
-        params, _ = template._parameters(np.nan, (x.shape[0],))
-        log_u = x[:, 0]
-        u_star = np.exp(log_u)
-        with np.errstate(all="ignore"):
-            mu = u_star * np.where(np.isfinite(x[:, 1]), x[:, 1], 0.0) / (
-                _LENGTH_SCALE * template.von_karman * params["f"])
-            params["value"], params["z0"] = mu, z0
-            _, _, _, _, b, along = template._state(log_u, params)
-            g = u_star * np.hypot(along, b) / template.von_karman
-        ok = np.isfinite(g) & (along > 0)
-        abl = cls._solved_at(np.where(ok, log_u, np.log(0.3)), np.where(ok, g, 10.0),
-                             stability_parameter=np.where(ok, mu, 0.0), roughness_length=z0,
-                             **fixed)
+        rows = np.repeat(np.arange(n), x.shape[0] // n)
+        fit_roughness = "roughness_length" in self.fitted
+        z0 = np.broadcast_to(self.fixed_inputs.get("roughness_length", self.roughness_length),
+                             (n,))
+        fixed = {k: v for k, v in self.fixed_inputs.items() if k != "roughness_length"}
+        model = _ProfileModel(type(self.abl), np.ones((n, 1)), np.ones((n, 1)), None, fixed, z0,
+                              fit_roughness, 1.0, 1.0, sign,
+                              fit_mixed_layer=x.shape[1] > 2 + fit_roughness)
+        unsigned = x.copy()
+        unsigned[:, 1] *= sign[rows]
+        abl, valid = model.abl_at(unsigned, rows)
         ref = () if reference_height is None else (reference_height,)
         intensity = np.reshape(np.asarray(abl.turbulence_intensity(height, *ref), float), -1)
-        return np.where(ok, intensity, np.nan)
+        return np.where(valid, intensity, np.nan)
 
     def _fitted_depth(self):
         """{"mixed_layer_height": z_i per record} where some record's z_i was fitted (the
@@ -466,8 +456,9 @@ class _ProfileModel:
         # A measured turbulence intensity per record: (heights (n,), values (n,) NaN missing,
         # relative noise), or None (docs/measurements.md#measured-turbulence).
         self.turbulence = turbulence
-        # The sign of 1/L: the unknown lam >= 0 is 100 m/|L| (convective fits: sign -1).
-        self.sign = float(sign)
+        # The sign of 1/L: the unknown lam >= 0 is 100 m/|L| (convective fits: sign -1); one
+        # per record where the records' signs differ (ProfileFit's states of an "either" fit).
+        self.sign = np.asarray(sign, float) if np.ndim(sign) else float(sign)
         self.z, self.s, self.d = heights, speeds, directions
         self.sigma_s, self.sigma_d = speed_noise, direction_noise
         self.ms = np.isfinite(speeds)
@@ -495,7 +486,8 @@ class _ProfileModel:
         log_u = x[:, 0]
         u_star = np.exp(log_u)
         z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
-        mu = self.sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
+        mu = sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
         p = {k: v[index] for k, v in self.params.items()}
         p["value"], p["z0"] = mu, z0
         if self.fit_mixed_layer:
@@ -538,13 +530,18 @@ class _ProfileModel:
         return self.cls._solved_at(log_u, g, stability_parameter=mu, roughness_length=z0,
                                    **fixed)
 
-    def residuals(self, x, index):
-        """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
+    def abl_at(self, x, index):
+        """(the ABLs of unknowns x of records ``index``, valid (k,)): :meth:`state` and
+        :meth:`abl`, an invalid state evaluated at a harmless stand-in (to be discarded)."""
         g, mu, z0, valid, _ = self.state(x, index)
-        # Invalid trial states are evaluated at a harmless stand-in and discarded.
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
         abl = self.abl(x[:, 0], g, mu, z0, valid, index,
                        np.exp(x[:, -1]) if self.fit_mixed_layer else None)
+        return abl, valid
+
+    def residuals(self, x, index):
+        """(normalised residuals (k, n_obs), valid (k,), direction offset (k,))."""
+        abl, valid = self.abl_at(x, index)
         # One evaluation of the profile gives the speeds and the flow angles.
         u, v = abl._velocity(np.transpose(self.z[index]))
         speed = np.transpose(np.hypot(u, v))

@@ -401,28 +401,31 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     # The veer is met within veer_tolerance as stated: no model error of the directions is
     # added to it (docs/measurements.md#direction-model-error).
     fit_options_and_inputs.setdefault("direction_model_error", 0.0)
-    try:
-        return EkmanABL.fit_profile(
-            heights, speeds, directions,
-            speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
-            **fit_options_and_inputs,
-        )
-    except ValueError as error:
-        text = str(error)
-        if "fits no atmosphere of the model" not in text:
-            raise
-        # Of many conditions, name the first that fails by its index and values, not every
-        # condition's inputs (fit_profile counts and lists the others).
-        first = re.search(r"record (\d+) fits no atmosphere", text)
-        k = int(first[1]) if first and not single else None
-        pick = (lambda v: repr(float(np.ravel(v)[0]))) if k is None else (
-            lambda v: f"{float(np.broadcast_to(v, n)[k]):g}")
-        given = " and ".join(f"{name}={pick(v)}{unit}" for name, v, unit in (
-            ("shear_exponent", shear_exponent, ""),
-            ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
-        where = (f"{given} at hub_speed {hub_speed.tolist()} m/s" if k is None else
-                 f"condition {k} ({given} at hub_speed {pick(hub_speed)} m/s)")
-        raise ValueError(
-            f"atmosphere_from_shear_and_veer: {where} "
-            f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
-            f"veer_tolerance={veer_tolerance:g} deg): {text.split('): ', 1)[-1]}") from None
+    # The fit flags what it refuses; the refusal is said here, of this function's inputs.
+    on_misfit = fit_options_and_inputs.pop("on_misfit", "raise")
+    abl = EkmanABL.fit_profile(
+        heights, speeds, directions,
+        speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
+        on_misfit="flag" if on_misfit == "raise" else on_misfit, **fit_options_and_inputs,
+    )
+    failing = np.flatnonzero(~np.atleast_1d(abl.profile_fit.fits))
+    if on_misfit != "raise" or failing.size == 0:
+        return abl
+    k = int(failing[0])
+    value = (lambda v: repr(float(np.ravel(v)[0]))) if single else (
+        lambda v: f"{float(np.broadcast_to(v, n)[k]):g}")
+    given = " and ".join(f"{name}={value(v)}{unit}" for name, v, unit in (
+        ("shear_exponent", shear_exponent, ""),
+        ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
+    where = (f"{given} at hub_speed {hub_speed.tolist()} m/s" if single else
+             f"condition {k} ({given} at hub_speed {value(hub_speed)} m/s)")
+    more = ""
+    if failing.size > 1:
+        shown = ", ".join(str(j) for j in failing[1:6])
+        more = (f"; {failing.size - 1} more condition(s) fail ({shown}"
+                f"{', ...' if failing.size > 6 else ''})")
+    raise ValueError(
+        f"atmosphere_from_shear_and_veer: {where} "
+        f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
+        f"veer_tolerance={veer_tolerance:g} deg): {abl.profile_fit.reason(k)[1]}{more}. Give "
+        "on_misfit='flag' to keep the fits and read profile_fit.fits")
