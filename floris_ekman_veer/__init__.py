@@ -33,6 +33,7 @@ from floris_ekman_veer.warnings import (
     FlorisEkmanVeerWarning,
     HeterogeneousInflowWarning,
     ModelSettingsWarning,
+    ReferenceWindWarning,
     ShallowBoundaryLayerWarning,
     ThrustLimitWarning,
     TurbinePlacementWarning,
@@ -40,7 +41,8 @@ from floris_ekman_veer.warnings import (
 )
 
 __all__ = ["EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
-           "ModelSettingsWarning", "ParFlorisModel", "ShallowBoundaryLayerWarning",
+           "ModelSettingsWarning", "ParFlorisModel", "ReferenceWindWarning",
+           "ShallowBoundaryLayerWarning",
            "ThrustLimitWarning", "TurbinePlacementWarning", "__version__", "annual_energy",
            "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings",
            "validity_report"]

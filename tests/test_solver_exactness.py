@@ -4,6 +4,8 @@ condition gives the same bits alone as in a batch, whatever its stability input
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -72,3 +74,32 @@ def test_each_condition_is_bitwise_the_same_alone_as_in_a_batch(kind, driver):
         z = np.array([10.0, 90.0, 150.0])
         np.testing.assert_array_equal(one.speed(z), batch.speed(z[:, None])[:, j])
         assert float(one.wake_expansion_rate(90.0)) == batch.wake_expansion_rate(90.0)[j]
+
+
+def test_the_reference_wind_meets_its_tolerance_or_says_so():
+    """SBL-6's mu at 5.985205 m/s at 90 m: the speed lies in the step V takes onto V_g at
+    0.9973 h (h = 90.24 m), so no state meets it to 1e-13; the closest is taken (1.6e-12 in ln
+    speed) and a ReferenceWindWarning says so, with the residual kept per condition (before: taken
+    silently). Elsewhere the residual is within the tolerance, silently; a tolerance that is not one
+    number from 1e-15 to 1e-3 is refused, naming it."""
+    from floris_ekman_veer import ReferenceWindWarning
+
+    sbl6 = dict(coriolis_parameter=1e-4, roughness_length=0.1, stability_parameter=148.49)
+    with pytest.warns(ReferenceWindWarning, match=r"1 of 1 distinct conditions \(wind speeds "
+                      r"5.9852 m/s at 90 m\) meet their speed only to 1.6e-12 in ln speed, "
+                      r"above the tolerance 1e-13"):
+        step = EkmanABL.from_reference_wind(5.985205, 90.0, **sbl6)
+    assert 1e-13 < step.reference_wind_residual < 1e-11
+    assert abs(np.log(float(step.speed(90.0)) / 5.985205)) == pytest.approx(
+        step.reference_wind_residual, rel=1e-6)
+    speeds = np.linspace(4.0, 18.0, 57)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ReferenceWindWarning)
+        smooth = EkmanABL.from_reference_wind(speeds, 90.0, **sbl6)
+    assert np.all(smooth.reference_wind_residual <= 1e-13)
+    np.testing.assert_allclose(smooth.speed(90.0), speeds, rtol=2e-13)
+    for tolerance, shown in (("x", "'x' (str)"), (-1.0, "-1"), (1e-20, "1e-20"), (0.1, "0.1")):
+        with pytest.raises(ValueError, match=rf"tolerance must be .*one number from 1e-15 to 1e-3.*"
+                                             rf"got {re.escape(shown)}"):
+            EkmanABL.from_reference_wind(8.0, 90.0, tolerance=tolerance, **sbl6)

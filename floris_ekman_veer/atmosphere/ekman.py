@@ -30,8 +30,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import finite_real, real_array, require_at
 from floris_ekman_veer.atmosphere.turbulence import (
+    ALPHA_PRIME,
+    MERGE_EXPONENT,
+    MIXING_LAYER_FLOOR,
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
     convective_variance,
@@ -539,8 +543,12 @@ class EkmanABL:
 
     @staticmethod
     def valid_range(name):
-        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`)."""
-        return VALID_RANGES.get(name, "see EkmanABL")
+        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`);
+        ValueError naming the inputs for a name that is none of them."""
+        if not isinstance(name, str) or name not in VALID_RANGES:
+            raise ValueError(f"valid_range: name must be one of EkmanABL's inputs "
+                             f"{sorted(VALID_RANGES)}; got {name!r}")
+        return VALID_RANGES[name]
 
     # ----------------------------------------------------------------------------- inputs
     def _set_constants(self, kappa, c_g, decay, c_tn, c_cn, c_ns, matching):
@@ -971,6 +979,7 @@ class EkmanABL:
         (docs/atmosphere.md#shallow-boundary-layer).
         """
         z = self._log_layer_heights(z, "z")
+        A1, B1 = _turbulence_constants(A1=A1, B1=B1).values()
         if reference_height is None:
             reference_speed = np.hypot(*self._velocity(z))
         else:
@@ -990,6 +999,7 @@ class EkmanABL:
         h exp(B1/A1) up. Raises ValueError for a hub below the roughness length.
         """
         hub_height = self._log_layer_heights(hub_height, "hub_height")
+        constants = _turbulence_constants(**constants)
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,
             np.hypot(*self._velocity(hub_height)), convective=self.convective_variance,
@@ -1017,6 +1027,12 @@ class EkmanABL:
         if "geostrophic_wind" in inputs:
             raise ValueError("from_reference_wind takes speed and height instead of geostrophic_wind")
         speed = _checked("speed", speed, lambda s: s > 0, "> 0 m/s")
+        tolerance = float(_checked(
+            "tolerance", tolerance,
+            lambda t: (np.ndim(t) == 0) & (t >= MIN_REFERENCE_WIND_TOLERANCE) & (t <= 1e-3),
+            f"one number from {MIN_REFERENCE_WIND_TOLERANCE:g} to 1e-3, the tolerance on "
+            "ln(speed) at the height (default 1e-13)",
+        ))
         template = cls.check_inputs(**inputs)
         height = _checked("height", height, lambda h: h > 0, "> roughness_length z0")
         require_broadcastable({"speed": speed, "height": height, **{
@@ -1094,6 +1110,21 @@ class EkmanABL:
         ))
         abl._require_domain(lambda mask, reason: _reference_wind_refusal(
             abl, mask, speed, height, inputs, f"leaves the physical domain: {reason}"))
+        residual = np.abs(log_speed_error(log_u_star))
+        #: |ln(speed at height / speed asked)| of each condition's solution
+        abl.reference_wind_residual = residual[inverse.ravel()].reshape(shape)[()]
+        missed = residual > tolerance
+        if np.any(missed):
+            package_warnings.warn(
+                f"from_reference_wind: {np.count_nonzero(missed)} of {residual.size} distinct "
+                f"conditions (wind speeds {package_warnings.speeds_text(target[missed])} at "
+                f"{package_warnings.range_text(at[missed], 'm')}) meet their speed only to "
+                f"{residual[missed].max():.2g} in ln speed, above the tolerance {tolerance:g}: "
+                "the speed lies in the step of the profile where the top of the boundary layer "
+                "crosses the height (docs/atmosphere.md#reference-wind-solve); the closest state "
+                "is taken, its residual in reference_wind_residual",
+                package_warnings.ReferenceWindWarning,
+                items=tuple(zip(target[missed].round(6), at[missed].round(6))))
         return abl
 
     @classmethod
@@ -1115,6 +1146,28 @@ class EkmanABL:
         )
 
 
+#: The constants of Eqs. (Iu_model) and (kw_CNBL_SBL_model) the profile methods take, with the
+#: paper's values: each one positive number.
+TURBULENCE_CONSTANTS = {"A1": TOWNSEND_PERRY_A1, "B1": TOWNSEND_PERRY_B1,
+                        "alpha_prime": ALPHA_PRIME, "floor": MIXING_LAYER_FLOOR,
+                        "n": MERGE_EXPONENT}
+
+
+def _turbulence_constants(**constants):
+    """``constants`` checked: known names (`TURBULENCE_CONSTANTS`), each one positive number."""
+    unknown = sorted(set(constants) - set(TURBULENCE_CONSTANTS))
+    if unknown:
+        raise ValueError(f"unknown constant(s) {unknown}; the constants are "
+                         f"{sorted(TURBULENCE_CONSTANTS)}")
+    return {name: float(_checked(
+        name, value, lambda v: (np.ndim(v) == 0) & (v > 0),
+        f"one number > 0 (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
+        for name, value in constants.items()}
+
+
+#: The tightest tolerance of the reference-wind solve (in ln speed): a few times the spacing of
+#: doubles, below which no state is closer.
+MIN_REFERENCE_WIND_TOLERANCE = 1e-15
 #: Points of the scan in ln u* that brackets the largest root of the reference-wind solve.
 _SCAN_POINTS = 64
 #: Residual (in ln speed) accepted where round-off, not the method, stops the reference-wind solve.
