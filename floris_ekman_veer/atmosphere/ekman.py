@@ -1159,10 +1159,16 @@ def _turbulence_constants(**constants):
     if unknown:
         raise ValueError(f"unknown constant(s) {unknown}; the constants are "
                          f"{sorted(TURBULENCE_CONSTANTS)}")
-    return {name: float(_checked(
-        name, value, lambda v: (np.ndim(v) == 0) & (v > 0),
-        f"one number > 0 (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
-        for name, value in constants.items()}
+    # the model block's ranges (docs/user_guide.md#valid-input-ranges): B1 may be 0, n >= 1
+    lowest = {"B1": (0.0, ">="), "n": (1.0, ">=")}
+    checked = {}
+    for name, value in constants.items():
+        low, sign = lowest.get(name, (0.0, ">"))
+        checked[name] = float(_checked(
+            name, value,
+            lambda v: (np.ndim(v) == 0) & ((v >= low) if sign == ">=" else (v > low)),
+            f"one number {sign} {low:g} (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
+    return checked
 
 
 #: The tightest tolerance of the reference-wind solve (in ln speed): a few times the spacing of
