@@ -91,8 +91,8 @@ MIN_COOLING_RATE = -10.0
 #: would be 2 m deep); shallower solutions raise ValueError (docs/atmosphere.md#shallow-boundary-layer).
 MIN_BOUNDARY_LAYER_HEIGHT = 10.0
 #: The deepest convective mixed layer accepted [m]: afternoon layers over land reach 1-2 km, over
-#: deserts 4-5 km (Stull 1988, An Introduction to Boundary Layer Meteorology, Sect. 1.5; Garratt
-#: 1992, The Atmospheric Boundary Layer, Sect. 6.1); a z_i in feet or above the troposphere's
+#: deserts 4-5 km (Stull 1988, An Introduction to Boundary Layer Meteorology; Garratt
+#: 1992, The Atmospheric Boundary Layer); a z_i in feet or above the troposphere's
 #: lower half is refused (docs/atmosphere.md#physical-domain).
 MAX_MIXED_LAYER_HEIGHT = 5000.0
 #: The strongest geostrophic wind accepted [m/s]: above the 50-60 m/s of the deepest
