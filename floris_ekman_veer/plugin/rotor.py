@@ -38,8 +38,10 @@ s in z sampled at spacing h), which is what the sheared wakes need.
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextvars
 import functools
+import os
 import warnings
 
 import attrs
@@ -572,6 +574,35 @@ ROW_CHUNK = 4096
 MIN_BAND_PER_ROW = 0.4
 
 
+#: The thread pool of :func:`map_pieces`, per process (a forked worker makes its own: the
+#: parent's threads do not exist in it) and number of threads.
+_POOL: dict = {}
+
+
+def worker_threads() -> int:
+    """Threads a wake's pieces run on: numexpr's, i.e. the cores FLORIS's gauss runs its sums
+    on (``numexpr.set_num_threads`` or NUMEXPR_NUM_THREADS set both)."""
+    return ne.get_num_threads()
+
+
+def map_pieces(function, pieces) -> None:
+    """``function(piece)`` for every piece, on :func:`worker_threads` threads (numpy and numexpr
+    release the GIL). A piece's numbers do not depend on the thread that runs it or on what
+    runs beside it: the results are the same bit for bit with 1 or N threads."""
+    threads = min(worker_threads(), len(pieces))
+    if threads <= 1:
+        for piece in pieces:
+            function(piece)
+        return
+    key = (os.getpid(), threads)
+    if key not in _POOL:
+        _POOL.clear()  # (another process's or size's pool: not ours to use)
+        _POOL[key] = concurrent.futures.ThreadPoolExecutor(
+            threads, thread_name_prefix="floris_ekman_veer")
+    for _ in _POOL[key].map(function, pieces):
+        pass
+
+
 @attrs.define(frozen=True)
 class TurbineWake:
     """Turbine i's quantities at the points where its wake is evaluated (the grid's points, or
@@ -709,41 +740,46 @@ def rotor_cell_deficit(
     else:
         order = np.argsort(widths, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
-    for group in groups:
-        width = int(np.max(widths[group]))
-        for start in range(0, group.size, ROW_CHUNK):
-            chunk = group[start:start + ROW_CHUNK]
-            pe, re = p[chunk], r[chunk]
-            fe = f[pe]
-            pair = {k: v[pe][:, None] for k, v in per_pair.items()}
-            u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
-            v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
-            dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
-            wake = TurbineWake(
-                dx=x_pair[pe][:, None],
-                dy=dy,
-                dz=dz[pe, re][:, None],
-                yaw=pair["yaw"],
-                ct=pair["ct"],
-                radius=pair["radius"],
-                hub_speed=pair["hub_speed"],
-                k_w=pair["k_w"],
-                local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
-                local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
-                friction_velocity=pair["friction_velocity"],
-            )
-            # No flow (at and below z0): no wake.
-            ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-            du = model.sub_point_deficit(wake) * pair["hub_speed"]
-            stretches[chunk, :width // nodes] = wakes.superpose(
-                flat[pe], re, du, ambient_u, moment[pe][:, None],
-            ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
-            if track:
-                # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
-                # rotor laterally, here as the area of the disk where it holds.
-                inside = (du > WAKE_OVERLAP_VELOCITY) & (
-                    np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
-                row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+    pieces = [(group[start:start + ROW_CHUNK], int(np.max(widths[group])))
+              for group in groups for start in range(0, group.size, ROW_CHUNK)]
+
+    def integrate(piece):
+        """Superpose the wake on one piece of (pair, row) entries: pieces touch disjoint
+        entries and sub-points, so they run at once (:func:`map_pieces`)."""
+        chunk, width = piece
+        pe, re = p[chunk], r[chunk]
+        fe = f[pe]
+        pair = {k: v[pe][:, None] for k, v in per_pair.items()}
+        u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
+        v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
+        dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
+        wake = TurbineWake(
+            dx=x_pair[pe][:, None],
+            dy=dy,
+            dz=dz[pe, re][:, None],
+            yaw=pair["yaw"],
+            ct=pair["ct"],
+            radius=pair["radius"],
+            hub_speed=pair["hub_speed"],
+            k_w=pair["k_w"],
+            local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
+            local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
+            friction_velocity=pair["friction_velocity"],
+        )
+        # No flow (at and below z0): no wake.
+        ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
+        du = model.sub_point_deficit(wake) * pair["hub_speed"]
+        stretches[chunk, :width // nodes] = wakes.superpose(
+            flat[pe], re, du, ambient_u, moment[pe][:, None],
+        ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
+        if track:
+            # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
+            # rotor laterally, here as the area of the disk where it holds.
+            inside = (du > WAKE_OVERLAP_VELOCITY) & (
+                np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
+            row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+
+    map_pieces(integrate, pieces)
     removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
                           weights=stretches.ravel(), minlength=f.size * n2)
     overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None
