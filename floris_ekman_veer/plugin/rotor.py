@@ -585,22 +585,19 @@ def worker_threads() -> int:
     return ne.get_num_threads()
 
 
-def map_pieces(function, pieces) -> None:
-    """``function(piece)`` for every piece, on :func:`worker_threads` threads (numpy and numexpr
-    release the GIL). A piece's numbers do not depend on the thread that runs it or on what
-    runs beside it: the results are the same bit for bit with 1 or N threads."""
+def map_pieces(function, pieces) -> list:
+    """``[function(piece) for piece in pieces]``, on :func:`worker_threads` threads (numpy and
+    numexpr release the GIL). A piece's numbers do not depend on the thread that runs it or on
+    what runs beside it: the results are the same bit for bit with 1 or N threads."""
     threads = min(worker_threads(), len(pieces))
     if threads <= 1:
-        for piece in pieces:
-            function(piece)
-        return
+        return [function(piece) for piece in pieces]
     key = (os.getpid(), threads)
     if key not in _POOL:
         _POOL.clear()  # (another process's or size's pool: not ours to use)
         _POOL[key] = concurrent.futures.ThreadPoolExecutor(
             threads, thread_name_prefix="floris_ekman_veer")
-    for _ in _POOL[key].map(function, pieces):
-        pass
+    return list(_POOL[key].map(function, pieces))
 
 
 @attrs.define(frozen=True)
@@ -708,8 +705,9 @@ def rotor_cell_deficit(
                         * row_interpolation(cells.n, cells.row_z), axis=1)
     else:
         # In chunks of rotors, so that the deflection's temporaries stay small.
-        centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
-                                 for k in range(0, f.size, PAIR_CHUNK)])
+        centre = np.concatenate(map_pieces(
+            lambda k: rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK]),
+            range(0, f.size, PAIR_CHUNK)))
     lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
     dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
     kind = rotor.kind[f, j]
@@ -740,6 +738,9 @@ def rotor_cell_deficit(
     else:
         order = np.argsort(widths, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
+    # The deficit's factors that depend on the wake only, once per rotor reached.
+    wake_parameters = model.wake_parameters(x_pair, *(per_pair[k] for k in (
+        "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
     pieces = [(group[start:start + ROW_CHUNK], int(np.max(widths[group])))
               for group in groups for start in range(0, group.size, ROW_CHUNK)]
 
@@ -768,7 +769,8 @@ def rotor_cell_deficit(
         )
         # No flow (at and below z0): no wake.
         ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-        du = model.sub_point_deficit(wake) * pair["hub_speed"]
+        du = model.sub_point_deficit(
+            wake, {k: v[pe][:, None] for k, v in wake_parameters.items()}) * pair["hub_speed"]
         stretches[chunk, :width // nodes] = wakes.superpose(
             flat[pe], re, du, ambient_u, moment[pe][:, None],
         ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
