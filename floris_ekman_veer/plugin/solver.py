@@ -9,7 +9,8 @@ of every rotor of the farm, upstream ones included. On a turbine grid the ``ekma
 ``width_bound`` and ``amplitude_bound`` give) and return 0 elsewhere; this solver makes the rest of
 each step, FLORIS's part, follow them: the combination, the wake-added turbulence and the
 velocity update are evaluated on the rotors (condition, turbine) where turbine i's wake is not
-zero, gathered from and scattered back into the farm's arrays, vectorised over conditions.
+zero (the turbulence where it overlaps a rotor, as FLORIS counts the overlap), gathered from and
+scattered back into the farm's arrays, vectorised over conditions.
 
 Each step calls the same functions as FLORIS's ``sequential_solver``, in its order, with the same
 arguments on those rotors: FLORIS's thrust and induction of turbine i (the veer-aware rotor,
@@ -135,6 +136,15 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         deficit = velocity_deficit[f, j] * u_initial[f, j]  # (pairs, n, n)
         wake_field[f, j] = model_manager.combination_model.function(wake_field[f, j], deficit)
 
+        flow_field.u_sorted[f, j] = u_initial[f, j] - wake_field[f, j]
+
+        # Wake-added turbulence where the wake overlaps a rotor (elsewhere FLORIS adds 0).
+        area_overlap = (np.sum(deficit > 0.05, axis=(1, 2))
+                        / (grid.grid_resolution * grid.grid_resolution))
+        hit = np.flatnonzero(area_overlap)
+        if hit.size == 0:
+            continue
+        f, j, area_overlap = f[hit], j[hit], area_overlap[hit, None, None]
         x = grid.x_sorted[f, j]
         per_pair = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0]  # noqa: E731
         x_source, diameter = per_pair(x_i), per_pair(rotor_diameter_i)
@@ -142,8 +152,6 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         wake_added_turbulence_intensity = model_manager.turbulence_model.function(
             ambient, x, x_source, diameter, per_pair(axial_induction_i),
         )
-        area_overlap = (np.sum(deficit > 0.05, axis=(1, 2))
-                        / (grid.grid_resolution * grid.grid_resolution))[:, None, None]
         ti_added = (
             area_overlap
             * np.nan_to_num(wake_added_turbulence_intensity, posinf=0.0)
@@ -153,7 +161,6 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         )
         turbine_turbulence_intensity[f, j] = np.maximum(
             np.sqrt(ti_added**2 + ambient**2), turbine_turbulence_intensity[f, j])
-        flow_field.u_sorted[f, j] = u_initial[f, j] - wake_field[f, j]
 
     flow_field.turbulence_intensity_field_sorted = turbine_turbulence_intensity
     if model_manager.enable_turbine_turbulence_grid:
