@@ -25,11 +25,11 @@ profile). PyWake's power and thrust curves are FLORIS's NREL 5 MW table.
 Timed: one run of each contender (``FlorisModel.run()``; PyWake's call with ``time=True`` and
 the turbines' power read), wall (perf_counter) and CPU (process_time: all threads) per run,
 the contenders interleaved (each repeat runs every contender once, in turn) so that a load on
-the shared machine weighs on all alike, best of ``--repeats`` after a warm-up; ratios to
-FLORIS gauss of the same farm. Peak memory: tracemalloc's peak above the level before one run,
+the shared machine weighs on all alike, best of ``--repeats`` after a warm-up (farms up to
+10 x 10); ratios to FLORIS gauss of the same farm. Peak memory: tracemalloc's peak above the level before one run,
 measured in a separate run. Scaling: the exponent b of a least-squares fit of
 CPU time = a n_turbines^b over the farms. ``--profile`` adds a cProfile of M-1 on the 10 x 10
-farm (top functions by internal time). ``--threads`` sets numexpr's threads (FLORIS's gauss sums
+farm on one thread (top functions by internal time). ``--threads`` sets numexpr's threads (FLORIS's gauss sums
 and the package's superposition run on them; default: numexpr's, all cores).
 """
 
@@ -54,6 +54,9 @@ from floris.utilities import load_yaml  # noqa: E402
 
 FLORIS_CONTENDERS = ("gauss", "M-1", "empirical_gauss", "GCH")
 PYWAKE_CONTENDERS = ("PyWake 3x3", "PyWake centre")
+#: Farms up to this side get an untimed warm-up run of every contender (larger farms come after
+#: them in the process and find the caches warm).
+WARM_UP_SIDE = 10
 
 
 def floris_model(name: str, directions, speeds, yaw):
@@ -142,8 +145,9 @@ def farm_table(side: int, n: int, seed: int, repeats: int, contenders):
             runs[name] = floris_model(name, directions, speeds, yaw).run
         else:
             runs[name] = pywake_model(name, directions, speeds, yaw)
-    for run in runs.values():
-        run()  # warm-up (first-call caches)
+    if side <= WARM_UP_SIDE:
+        for run in runs.values():
+            run()  # warm-up (first-call caches: the same in every farm of the process)
     best = {name: (np.inf, np.inf) for name in runs}
     for repeat in range(repeats):
         for name, run in runs.items():
@@ -210,6 +214,8 @@ def main(argv=None) -> None:
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end")
 
     if args.profile:
+        # On one thread: cProfile sees the main thread only.
+        numexpr.set_num_threads(1)
         directions, speeds, yaw = bench_models.conditions(args.conditions, args.seed, 10)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
