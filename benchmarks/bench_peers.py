@@ -136,7 +136,7 @@ def peak_memory(run) -> float:
     return (peak - before) / 1e6
 
 
-def farm_table(side: int, n: int, seed: int, repeats: int, contenders):
+def farm_table(side: int, n: int, seed: int, repeats: int, contenders, with_memory=True):
     """Best-of wall and CPU times and peak memory of every contender on one farm."""
     directions, speeds, yaw = bench_models.conditions(n, seed, side)
     runs = {}
@@ -155,7 +155,7 @@ def farm_table(side: int, n: int, seed: int, repeats: int, contenders):
             best[name] = (min(best[name][0], wall), min(best[name][1], cpu))
             print(f"  {side} x {side}, repeat {repeat + 1}/{repeats}: {name} {wall:.2f} s "
                   f"wall, {cpu:.2f} s CPU", file=sys.stderr, flush=True)
-    memory = {name: peak_memory(run) for name, run in runs.items()}
+    memory = {name: peak_memory(run) if with_memory else np.nan for name, run in runs.items()}
     return best, memory
 
 
@@ -173,6 +173,7 @@ def main(argv=None) -> None:
     parser.add_argument("--threads", type=int, default=None)
     parser.add_argument("--contenders", default=",".join(FLORIS_CONTENDERS + PYWAKE_CONTENDERS))
     parser.add_argument("--profile", action="store_true")
+    parser.add_argument("--no-memory", action="store_true", help="skip the peak-memory runs")
     args = parser.parse_args(argv)
     if args.threads:
         numexpr.set_num_threads(args.threads)
@@ -191,18 +192,18 @@ def main(argv=None) -> None:
           f"{numexpr.get_num_threads()} of {os.cpu_count()} CPUs; load average "
           f"{load[0]:.1f} at the start\n")
     results = {}
+    print("| farm | contender | wall [s] | / gauss | CPU [s] | / gauss | peak memory [MB] |")
+    print("|---|---|---:|---:|---:|---:|---:|", flush=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the SBL-6 night's shallow-layer summary
         for side in sides:
-            results[side] = farm_table(side, args.conditions, args.seed, args.repeats,
-                                       contenders)
-    print("| farm | contender | wall [s] | / gauss | CPU [s] | / gauss | peak memory [MB] |")
-    print("|---|---|---:|---:|---:|---:|---:|")
-    for side, (best, memory) in results.items():
-        for name in contenders:
-            wall, cpu = best[name]
-            print(f"| {side} x {side} | {name} | {wall:.3f} | {wall / best['gauss'][0]:.2f} | "
-                  f"{cpu:.3f} | {cpu / best['gauss'][1]:.2f} | {memory[name]:.1f} |")
+            best, memory = results[side] = farm_table(
+                side, args.conditions, args.seed, args.repeats, contenders, not args.no_memory)
+            for name in contenders:  # each farm's rows as soon as it is done
+                wall, cpu = best[name]
+                print(f"| {side} x {side} | {name} | {wall:.3f} | {wall / best['gauss'][0]:.2f}"
+                      f" | {cpu:.3f} | {cpu / best['gauss'][1]:.2f} | {memory[name]:.1f} |",
+                      flush=True)
     if len(sides) > 1:
         turbines = np.array(sides) ** 2
         print("\n| contender | exponent b, wall | exponent b, CPU |")
