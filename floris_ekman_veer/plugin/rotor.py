@@ -42,6 +42,7 @@ import concurrent.futures
 import contextvars
 import functools
 import os
+import threading
 import warnings
 
 import attrs
@@ -577,6 +578,7 @@ MIN_BAND_PER_ROW = 0.4
 #: The thread pool of :func:`map_pieces`, per process (a forked worker makes its own: the
 #: parent's threads do not exist in it) and number of threads.
 _POOL: dict = {}
+_POOL_LOCK = threading.Lock()
 
 
 def worker_threads() -> int:
@@ -593,11 +595,13 @@ def map_pieces(function, pieces) -> list:
     if threads <= 1:
         return [function(piece) for piece in pieces]
     key = (os.getpid(), threads)
-    if key not in _POOL:
-        _POOL.clear()  # (another process's or size's pool: not ours to use)
-        _POOL[key] = concurrent.futures.ThreadPoolExecutor(
-            threads, thread_name_prefix="floris_ekman_veer")
-    return list(_POOL[key].map(function, pieces))
+    with _POOL_LOCK:  # (solves in several threads of a process share the pool)
+        pool = _POOL.get(key)
+        if pool is None:
+            _POOL.clear()  # (another process's or size's pool: not ours to use)
+            pool = _POOL[key] = concurrent.futures.ThreadPoolExecutor(
+                threads, thread_name_prefix="floris_ekman_veer")
+    return list(pool.map(function, pieces))
 
 
 @attrs.define(frozen=True)
