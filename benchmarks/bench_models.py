@@ -57,10 +57,10 @@ SIDE, SPACING = 10, 7 * 126.0
 MODELS = ("gauss", "GCH", "M-1", "M-2")
 
 
-def configuration(model: str) -> dict:
-    """FLORIS input of one benchmarked model on the 10 x 10 farm (Ekman inflow for all)."""
+def configuration(model: str, side: int = SIDE) -> dict:
+    """FLORIS input of one benchmarked model on the side x side farm (Ekman inflow for all)."""
     config = load_yaml(FARM_INPUT)
-    x, y = np.meshgrid(np.arange(SIDE) * SPACING, np.arange(SIDE) * SPACING)
+    x, y = np.meshgrid(np.arange(side) * SPACING, np.arange(side) * SPACING)
     config["farm"]["layout_x"] = x.ravel().tolist()
     config["farm"]["layout_y"] = y.ravel().tolist()
     wake = config["wake"]
@@ -75,16 +75,17 @@ def configuration(model: str) -> dict:
     return config
 
 
-def conditions(n: int, seed: int):
+def conditions(n: int, seed: int, side: int = SIDE):
     rng = np.random.default_rng(seed)
     directions = rng.uniform(0.0, 360.0, n)
     speeds = rng.uniform(7.0, 12.0, n)
-    yaw = rng.uniform(-20.0, 20.0, (n, SIDE * SIDE))
+    yaw = rng.uniform(-20.0, 20.0, (n, side * side))
     return directions, speeds, yaw
 
 
 def build(model: str, directions, speeds, yaw) -> FlorisModel:
-    fmodel = FlorisModel(copy.deepcopy(configuration(model)))
+    side = int(round(np.sqrt(np.shape(yaw)[1])))
+    fmodel = FlorisModel(copy.deepcopy(configuration(model, side)))
     fmodel.set(wind_directions=directions, wind_speeds=speeds,
                turbulence_intensities=np.full(len(directions), 0.06), yaw_angles=yaw)
     return fmodel
@@ -140,17 +141,21 @@ def main(argv=None) -> None:
               f"{memory[model] / memory['GCH']:.2f} | {farm[model]:.2f} |")
 
     if args.profile:
-        fmodel = build("M-1", directions, speeds, yaw)
-        fmodel.run()
-        profiler = cProfile.Profile()
-        profiler.enable()
-        fmodel.run()
-        profiler.disable()
-        stream = io.StringIO()
-        pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(25)
-        print("\ncProfile of M-1, one run(), by internal time:")
-        print(stream.getvalue())
+        print_profile(build("M-1", directions, speeds, yaw), 25)
 
+
+def print_profile(fmodel: FlorisModel, top: int) -> None:
+    """cProfile of one ``run()`` after a warm-up, the ``top`` functions by internal time."""
+    fmodel.run()
+    profiler = cProfile.Profile()
+    profiler.enable()
+    fmodel.run()
+    profiler.disable()
+    stream = io.StringIO()
+    pstats.Stats(profiler, stream=stream).sort_stats("tottime").print_stats(top)
+    print(f"\ncProfile of one run() ({fmodel.core.farm.n_turbines} turbines, "
+          f"{fmodel.core.flow_field.n_findex} conditions), by internal time:")
+    print(stream.getvalue())
 
 if __name__ == "__main__":
     main()

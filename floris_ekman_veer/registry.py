@@ -102,8 +102,8 @@ def register_operation_model() -> type:
 
 
 def register() -> None:
-    """Register the wake models and the actuator-disk turbine, install the inflow hook and the
-    ParFlorisModel support."""
+    """Register the wake models and the actuator-disk turbine, install the inflow hook, the
+    ParFlorisModel support and the models' solver (plugin/solver.py)."""
     from floris.core.wake import MODEL_MAP
 
     from floris_ekman_veer.plugin.inflow import install_inflow_hook
@@ -114,6 +114,7 @@ def register() -> None:
     )
     from floris_ekman_veer.studies.optimization import install_optimizer_hook
     from floris_ekman_veer.plugin.parallel import install_parallel_hook
+    from floris_ekman_veer.plugin.solver import install_solver_hook
     from floris_ekman_veer.studies.uncertain import install_uncertain_hook
     from floris_ekman_veer.plugin.wake_settings import install_wake_settings_hook
     from floris_ekman_veer.plugin.yawed_rotor import install_yawed_rotor_hook
@@ -132,3 +133,4 @@ def register() -> None:
     install_optimizer_hook()
     install_wake_settings_hook()
     install_yawed_rotor_hook()
+    install_solver_hook()

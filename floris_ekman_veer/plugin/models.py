@@ -77,7 +77,11 @@ from floris_ekman_veer.wake.deficit import (
     stream_tube_area_ratio,
 )
 from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
-from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
+from floris_ekman_veer.wake.fused import (
+    deficit_on_rows,
+    rows_deficit_parameters,
+    wake_deficit_parameters,
+)
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
 #: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
@@ -267,8 +271,14 @@ class _EkmanWakeModel(BaseModel):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
-    def sub_point_deficit(self, wake: TurbineWake) -> np.ndarray:
-        """Delta u / U_h of the wake at the sub-points (each model's normalised deficit)."""
+    def wake_parameters(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
+        """The factors of :meth:`sub_point_deficit` that depend on the wake only, evaluated once
+        per wake (1-D arrays, one per wake and rotor reached): none here."""
+        return {}
+
+    def sub_point_deficit(self, wake: TurbineWake, parameters: dict | None = None) -> np.ndarray:
+        """Delta u / U_h of the wake at the sub-points (each model's normalised deficit);
+        ``parameters``: :meth:`wake_parameters` gathered to the sub-point rows."""
         return self.normalised_deficit(wake)
 
     def amplitude_bound(self, x, k_w, radius, ct, yaw):
@@ -336,13 +346,20 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
-    def sub_point_deficit(self, wake: TurbineWake) -> np.ndarray:
+    def wake_parameters(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
+        if self.polar_angle_centre != "wake_centre":
+            return {}
+        return wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
+                                       curl=self.curl)
+
+    def sub_point_deficit(self, wake: TurbineWake, parameters: dict | None = None) -> np.ndarray:
         if self.polar_angle_centre != "wake_centre":
             return super().sub_point_deficit(wake)
         # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
         parameters = rows_deficit_parameters(
             wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw, wake.friction_velocity,
             wake.hub_speed, np.where(wake.local_u > 0, wake.local_u, 1.0), curl=self.curl,
+            wake=parameters or None,
         )
         return deficit_on_rows(wake.dy, wake.dz, parameters)
 

@@ -38,8 +38,11 @@ s in z sampled at spacing h), which is what the sheared wakes need.
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextvars
 import functools
+import os
+import threading
 import warnings
 
 import attrs
@@ -572,6 +575,35 @@ ROW_CHUNK = 4096
 MIN_BAND_PER_ROW = 0.4
 
 
+#: The thread pool of :func:`map_pieces`, per process (a forked worker makes its own: the
+#: parent's threads do not exist in it) and number of threads.
+_POOL: dict = {}
+_POOL_LOCK = threading.Lock()
+
+
+def worker_threads() -> int:
+    """Threads a wake's pieces run on: numexpr's, i.e. the cores FLORIS's gauss runs its sums
+    on (``numexpr.set_num_threads`` or NUMEXPR_NUM_THREADS set both)."""
+    return ne.get_num_threads()
+
+
+def map_pieces(function, pieces) -> list:
+    """``[function(piece) for piece in pieces]``, on :func:`worker_threads` threads (numpy and
+    numexpr release the GIL). A piece's numbers do not depend on the thread that runs it or on
+    what runs beside it: the results are the same bit for bit with 1 or N threads."""
+    threads = min(worker_threads(), len(pieces))
+    if threads <= 1:
+        return [function(piece) for piece in pieces]
+    key = (os.getpid(), threads)
+    with _POOL_LOCK:  # (solves in several threads of a process share the pool)
+        pool = _POOL.get(key)
+        if pool is None:
+            _POOL.clear()  # (another process's or size's pool: not ours to use)
+            pool = _POOL[key] = concurrent.futures.ThreadPoolExecutor(
+                threads, thread_name_prefix="floris_ekman_veer")
+    return list(pool.map(function, pieces))
+
+
 @attrs.define(frozen=True)
 class TurbineWake:
     """Turbine i's quantities at the points where its wake is evaluated (the grid's points, or
@@ -655,12 +687,13 @@ def rotor_cell_deficit(
         # widened by its spread plus R/4 on either side (the centre at the rows beyond
         # +-R/2, twice the linear extrapolation, and between them) are not integrated and
         # their rows not evaluated.
-        points = deflection_field_i[f, j, 0, :]
-        spread = np.max(points, axis=1) - np.min(points, axis=1)
-        margin = spread + 0.25 * rotor.radius[f, j]
+        # (the n point heights' extremes column by column: numpy's reductions along a short
+        # axis cost more than the comparisons)
+        points = deflection_field_i[f, j, 0, :].T
+        top, bottom = functools.reduce(np.maximum, points), functools.reduce(np.minimum, points)
+        margin = top - bottom + 0.25 * rotor.radius[f, j]
         offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
-        lateral_gap = np.maximum(np.maximum(offset - np.max(points, axis=1),
-                                            np.min(points, axis=1) - offset)
+        lateral_gap = np.maximum(np.maximum(offset - top, bottom - offset)
                                  - margin - rotor.radius[f, j], 0.0)
         vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
                                   - rotor.radius[f, j], 0.0)
@@ -677,8 +710,9 @@ def rotor_cell_deficit(
                         * row_interpolation(cells.n, cells.row_z), axis=1)
     else:
         # In chunks of rotors, so that the deflection's temporaries stay small.
-        centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
-                                 for k in range(0, f.size, PAIR_CHUNK)])
+        centre = np.concatenate(map_pieces(
+            lambda k: rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK]),
+            range(0, f.size, PAIR_CHUNK)))
     lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
     dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
     kind = rotor.kind[f, j]
@@ -709,41 +743,54 @@ def rotor_cell_deficit(
     else:
         order = np.argsort(widths, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
-    for group in groups:
-        width = int(np.max(widths[group]))
-        for start in range(0, group.size, ROW_CHUNK):
-            chunk = group[start:start + ROW_CHUNK]
-            pe, re = p[chunk], r[chunk]
-            fe = f[pe]
-            pair = {k: v[pe][:, None] for k, v in per_pair.items()}
-            u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
-            v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
-            dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
-            wake = TurbineWake(
-                dx=x_pair[pe][:, None],
-                dy=dy,
-                dz=dz[pe, re][:, None],
-                yaw=pair["yaw"],
-                ct=pair["ct"],
-                radius=pair["radius"],
-                hub_speed=pair["hub_speed"],
-                k_w=pair["k_w"],
-                local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
-                local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
-                friction_velocity=pair["friction_velocity"],
-            )
-            # No flow (at and below z0): no wake.
-            ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-            du = model.sub_point_deficit(wake) * pair["hub_speed"]
-            stretches[chunk, :width // nodes] = wakes.superpose(
-                flat[pe], re, du, ambient_u, moment[pe][:, None],
-            ).reshape(chunk.size, width // nodes, nodes).sum(axis=2)
-            if track:
-                # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
-                # rotor laterally, here as the area of the disk where it holds.
-                inside = (du > WAKE_OVERLAP_VELOCITY) & (
-                    np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
-                row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+    # The deficit's factors that depend on the wake only, once per rotor reached.
+    wake_parameters = model.wake_parameters(x_pair, *(per_pair[k] for k in (
+        "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
+    pieces = [(group[start:start + ROW_CHUNK], int(np.max(widths[group])))
+              for group in groups for start in range(0, group.size, ROW_CHUNK)]
+
+    def integrate(piece):
+        """Superpose the wake on one piece of (pair, row) entries: pieces touch disjoint
+        entries and sub-points, so they run at once (:func:`map_pieces`)."""
+        chunk, width = piece
+        pe, re = p[chunk], r[chunk]
+        fe = f[pe]
+        pair = {k: v[pe][:, None] for k, v in per_pair.items()}
+        u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
+        v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
+        dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
+        wake = TurbineWake(
+            dx=x_pair[pe][:, None],
+            dy=dy,
+            dz=dz[pe, re][:, None],
+            yaw=pair["yaw"],
+            ct=pair["ct"],
+            radius=pair["radius"],
+            hub_speed=pair["hub_speed"],
+            k_w=pair["k_w"],
+            local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
+            local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
+            friction_velocity=pair["friction_velocity"],
+        )
+        # No flow (at and below z0): no wake.
+        ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
+        du = model.sub_point_deficit(
+            wake, {k: v[pe][:, None] for k, v in wake_parameters.items()}) * pair["hub_speed"]
+        removed = wakes.superpose(flat[pe], re, du, ambient_u, moment[pe][:, None])
+        # Each stretch's nodes added in turn: numpy's sum of fewer than 8 numbers, at less
+        # cost than a reduction along a short axis.
+        stretch = removed[:, ::nodes]
+        for node in range(1, nodes):
+            stretch = stretch + removed[:, node::nodes]
+        stretches[chunk, :width // nodes] = stretch
+        if track:
+            # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
+            # rotor laterally, here as the area of the disk where it holds.
+            inside = (du > WAKE_OVERLAP_VELOCITY) & (
+                np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
+            row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+
+    map_pieces(integrate, pieces)
     removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
                           weights=stretches.ravel(), minlength=f.size * n2)
     overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None

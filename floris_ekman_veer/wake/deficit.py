@@ -247,16 +247,28 @@ def time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct,
     finite and > 0: U(z) <= 0 (at or below the roughness height) carries nothing downstream.
     1 - exp(-y) is evaluated as -expm1(-y) to keep precision close to the rotor.
     """
-    x = np.asarray(x, dtype=float)
+    return time_like_strength(friction_velocity, hub_speed, ct, yaw) * time_like_growth(
+        x, friction_velocity, local_speed, radius)
+
+
+def time_like_strength(friction_velocity, hub_speed, ct, yaw):
+    """The prefactor of t_hat, Eq. (that): -1.44 (U_h/u*) C_T cos^2 beta sin beta / sqrt(A*),
+    one per wake (:func:`time_like_variable`)."""
     u_star = positive(friction_velocity, "friction_velocity")
     u_hub = positive(hub_speed, "hub_speed")
-    u_local = positive(local_speed, "local_speed")
-    radius = positive(radius, "radius")
     sqrt_area = np.sqrt(stream_tube_area_ratio(ct, yaw))
     yaw_thrust = np.asarray(ct) * np.cos(yaw) ** 2 * np.sin(yaw)
-    strength = -1.44 * (u_hub / u_star) / sqrt_area * yaw_thrust
-    growth = -np.expm1(-0.35 * (u_star / u_local) * np.maximum(x, 0.0) / radius)
-    return strength * growth
+    return -1.44 * (u_hub / u_star) / sqrt_area * yaw_thrust
+
+
+def time_like_growth(x, friction_velocity, local_speed, radius):
+    """The advection factor of t_hat, Eq. (that): 1 - exp(-0.35 (u*/U(z)) x/R), 0 for x <= 0
+    (:func:`time_like_variable`)."""
+    x = np.asarray(x, dtype=float)
+    u_star = positive(friction_velocity, "friction_velocity")
+    u_local = positive(local_speed, "local_speed")
+    radius = positive(radius, "radius")
+    return -np.expm1(-0.35 * (u_star / u_local) * np.maximum(x, 0.0) / radius)
 
 
 def wake_width(x, k_w, xi):

@@ -18,7 +18,8 @@ from .deficit import (
     WIDTH_FACTOR,
     _initial_radius,
     max_deficit,
-    time_like_variable,
+    time_like_growth,
+    time_like_strength,
 )
 
 
@@ -48,25 +49,41 @@ _SIGMA = f"(kx + xi0 / sqrt(1 - sin2b * (1 - c**2)) * {_CURL})"
 _DEFICIT = f"amplitude * exp(-(dy**2 + dz**2) / (2 * {_SIGMA}**2))"
 
 
+def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True):
+    """The per-wake factors of Eq. (du_model) (see :func:`rows_deficit_parameters`), evaluated
+    once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor."""
+    r_tube = _initial_radius(radius, ct, yaw)
+    parameters = {
+        "amplitude": max_deficit(x, k_w, radius, ct, yaw),
+        "kx": np.asarray(k_w) * np.asarray(x),
+        "xi0": WIDTH_FACTOR * r_tube * np.abs(np.cos(yaw)),
+        "sin2b": np.sin(yaw) ** 2,
+    }
+    if curl:
+        parameters["strength"] = time_like_strength(friction_velocity, hub_speed, ct, yaw)
+    return parameters
+
+
 def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, local_speed,
-                            curl=True):
+                            curl=True, wake=None):
     """The per-wake and per-height factors of Eq. (du_model) (see :func:`deficit_on_rows`).
 
     ``x`` (> 0), ``k_w``, ``radius``, ``ct``, ``yaw``, ``friction_velocity``, ``hub_speed``
-    broadcast per wake; ``local_speed`` U(z) per height (> 0). Returns a dict of arrays.
+    broadcast per wake; ``local_speed`` U(z) per height (> 0). ``wake``: the per-wake factors
+    of :func:`wake_deficit_parameters` at the same points, if already evaluated (once per wake,
+    then gathered to its heights). Returns a dict of arrays.
     """
-    r_tube = _initial_radius(radius, ct, yaw)
+    if wake is None:
+        wake = wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
+                                       curl)
     if curl:
-        t_hat = time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct, yaw)
+        t_hat = wake["strength"] * time_like_growth(x, friction_velocity, local_speed, radius)
         a2, a3, a4 = curl_coefficients(t_hat)
     else:
         a2 = a3 = a4 = np.zeros(1)
     # xi_hat = 1 - (a2 (2c^2 - 1) + a3 (4c^3 - 3c) + a4 (8c^4 - 8c^2 + 1)) = sum_k q_k c^k.
     return {
-        "amplitude": max_deficit(x, k_w, radius, ct, yaw),
-        "kx": np.asarray(k_w) * np.asarray(x),
-        "xi0": WIDTH_FACTOR * r_tube * np.abs(np.cos(yaw)),
-        "sin2b": np.sin(yaw) ** 2,
+        **{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b")},
         "q0": 1.0 + a2 - a4, "q1": 3.0 * a3, "q2": 8.0 * a4 - 2.0 * a2, "q3": -4.0 * a3,
         "q4": -8.0 * a4,
     }
