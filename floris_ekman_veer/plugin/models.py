@@ -62,7 +62,9 @@ from floris_ekman_veer.plugin.names import (
     VELOCITY_MODEL_NAME,
 )
 from floris_ekman_veer.plugin.rotor import (
+    DEFICIT_VELOCITIES,
     ROTOR_PLANE_MARGIN,
+    WAKE_EXPANSIONS,
     WAKE_MODELS,
     RotorWakes,
     TurbineWake,
@@ -138,8 +140,17 @@ class _EkmanWakeModel(BaseModel):
     k_w_exponent: float = number_field(MERGE_EXPONENT, *_MERGE_EXPONENT_RANGE)
     #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
     #: "local_turbulence": the same with FLORIS's wake-added turbulence at the turbine (from its
-    #: turbulence model) added in quadrature to I_u(z_h), for farms (see expansion_rate).
-    wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
+    #: turbulence model, the largest of the upstream wakes' as FLORIS combines it) added in
+    #: quadrature to I_u(z_h) (see expansion_rate). "array_turbulence" (the default): the
+    #: upstream wakes' added turbulence intensities summed in quadrature, their variances
+    #: adding (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor gets the paper's k_w
+    #: with each.
+    wake_expansion: str = choice_field("array_turbulence", WAKE_EXPANSIONS)
+    #: The velocity a waked rotor's wake deficit C(x) scales with: "incoming" (the default,
+    #: Niayifar & Porte-Agel 2016) its rotor-averaged incoming speed, with the deficits summed
+    #: (FLORIS's combination ``fls``); "free_stream" the ambient U_h, as FLORIS's gauss
+    #: (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor's wake is the paper's with each.
+    deficit_velocity: str = choice_field("incoming", DEFICIT_VELOCITIES)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/shallow.py).
