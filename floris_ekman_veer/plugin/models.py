@@ -162,13 +162,15 @@ class _EkmanWakeModel(BaseModel):
 
     def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity,
                        floris_turbulence):
-        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant.
+        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its wake-added-turbulence variants.
 
-        ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
-        waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
-        plugin/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
-        ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
-        so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
+        ``turbulence_intensity`` is the turbulence at the turbine, TI_0 plus the upstream wakes'
+        added turbulence (on a turbine grid the rotor cells' own, the wakes' overlaps as areas,
+        the largest wake's for "local_turbulence" and all of them in quadrature for
+        "array_turbulence": plugin/rotor.py ``RotorWakes``; elsewhere FLORIS's), with
+        ``floris_turbulence`` its ambient TI_0. Both keep the paper's ambient I_u(z_h) and add
+        the wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0), so an unwaked turbine gets the
+        paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
         """
         if self.wake_expansion == "ambient":
