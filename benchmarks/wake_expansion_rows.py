@@ -1,19 +1,23 @@
-"""Which ``wake_expansion`` the farm inputs use: power by row of a 10 x 10 farm (hand-run script).
+"""How the farm couplings of M-1 change a farm's rows: power by row of a 10 x 10 farm (hand-run script).
 
     python benchmarks/wake_expansion_rows.py [--speed 8] [--direction 270]
 
 Farm: 10 x 10 NREL 5 MW at 7 D (882 m), the wake settings of ``inputs/farm_sbl6.yaml``
-(ekman_veer velocity and deflection, M-1; sosfs combination; crespo_hernandez added turbulence;
-3 x 3 rotor points), wind along the rows (270 deg), one speed at 90 m. Atmospheres: neutral (the
-farm input's with mu = 0) and SBL-6 (the farm input's, mu = 148.49). Variants:
+(ekman_veer velocity and deflection, M-1; crespo_hernandez added turbulence; 3 x 3 rotor
+points), wind along the rows (270 deg), one speed at 90 m. Atmospheres: neutral (the farm input's
+with mu = 0) and SBL-6 (the farm input's, mu = 148.49); FLORIS's ambient TI set to the ABL's
+I_u(z_h) (studies/comparison.py). Variants:
 
     ambient           k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper;
-    local_turbulence  alpha' times FLORIS's turbulence intensity at each turbine (ambient plus
-                      crespo_hernandez wake-added) in the same smooth maximum; FLORIS's ambient
-                      TI set to the ABL's I_u(z_h) (studies/comparison.py), so that the two
-                      variants differ only by the wake-added turbulence;
-    gauss             FLORIS's gauss velocity and deflection on the same inflow and TI, for
-                      reference (FLORIS's wake expansion grows with the local TI).
+                      the wakes scaled with the free stream, their squares summed (sosfs);
+    local_turbulence  alpha' times the ambient plus the largest upstream wake's added
+                      turbulence at each turbine in the same smooth maximum (as FLORIS combines
+                      it), otherwise as ``ambient``;
+    array             the farm input's defaults: the upstream wakes' added turbulence summed in
+                      quadrature, each waked rotor's wake scaled with its incoming speed, the
+                      wakes summed (fls) (docs/coupling.md#wakes-deep-in-an-array);
+    gauss             FLORIS's gauss velocity and deflection on the same inflow and TI (sosfs),
+                      for reference (FLORIS's wake expansion grows with the local TI).
 
 Prints, per atmosphere, the mean power of each row (row 1 faces the wind) relative to row 1, and
 the farm's total relative to 100 unwaked turbines. The README's "Wake expansion in farms" table
@@ -46,7 +50,9 @@ from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 SIDE, SPACING = 10, 7 * 126.0
 HUB_HEIGHT, ROTOR_DIAMETER = 90.0, 125.88
-VARIANTS = ("ambient", "local_turbulence", "gauss")
+VARIANTS = ("ambient", "local_turbulence", "array", "gauss")
+#: The free-stream couplings (FLORIS's gauss has the same).
+FREE_STREAM = {"combination_model": "sosfs"}
 
 
 def configuration(stability_parameter: float, variant: str, speed: float, direction: float):
@@ -61,11 +67,13 @@ def configuration(stability_parameter: float, variant: str, speed: float, direct
     config["flow_field"].update(wind_speeds=[speed], wind_directions=[direction],
                                 turbulence_intensities=turbulence.tolist())
     if variant == "gauss":
-        wake["model_strings"].update(velocity_model="gauss", deflection_model="gauss")
+        wake["model_strings"].update(velocity_model="gauss", deflection_model="gauss",
+                                     **FREE_STREAM)
         wake["wake_velocity_parameters"].setdefault(
             "gauss", dict(alpha=0.58, beta=0.077, ka=0.38, kb=0.004))
-    else:
-        block["wake_expansion"] = variant
+    elif variant != "array":  # "array": the farm input as it ships
+        wake["model_strings"].update(**FREE_STREAM)
+        block.update(wake_expansion=variant, deficit_velocity="free_stream")
     return config, float(turbulence[0])
 
 

@@ -67,7 +67,8 @@ def farm_powers(name: str, speeds=SPEEDS) -> dict[str, np.ndarray]:
         fmodel = farm(name, speeds)
         if model == "gauss":
             config = fmodel.core.as_dict()
-            config["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss")
+            config["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss",
+                                                   combination_model="sosfs")  # FLORIS's own
             fmodel = FlorisModel(config)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)

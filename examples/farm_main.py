@@ -9,12 +9,14 @@ It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 st
 
 * M-1    ``ekman_veer`` velocity + deflection (yaw and veer deflection: the wake is sheared),
 * M-2    the same with the veer deflection off (``wake_deflection_parameters.ekman_veer.veer``),
-* gauss  FLORIS's own Gaussian velocity + deflection models; only the model names change, so
-         FLORIS's inflow stays the Ekman U(z) (and ``wind_veer`` stays 0, see below).
+* gauss  FLORIS's own Gaussian velocity + deflection models with FLORIS's superposition (sosfs);
+         only the model names change, so FLORIS's inflow stays the Ekman U(z) (and
+         ``wind_veer`` stays 0, see below).
 
 Every model gets the atmosphere's I_u(z_h) as turbulence intensity (the ekman_veer models take
-their wake expansion k_w from the ABL itself, plus FLORIS's wake-added turbulence: the input's
-wake_expansion: local_turbulence; gauss reads the TI). ``--gauss-wind-veer`` also
+their wake expansion k_w from the ABL itself, plus the upstream wakes' added turbulence, and
+scale a waked rotor's wake with its incoming speed: the input's array coupling,
+docs/coupling.md#wakes-deep-in-an-array; gauss reads the TI). ``--gauss-wind-veer`` also
 gives gauss the rotor-layer veer as FLORIS's ``wind_veer`` (as
 ``floris_ekman_veer.studies.comparison.builtin_inflow_settings`` suggests). It is off by default:
 FLORIS's gauss narrows its initial width by cos(wind_veer) and tilts its ellipse, and with this
@@ -81,8 +83,8 @@ def build_models(config: dict) -> dict[str, FlorisModel]:
     m2 = copy.deepcopy(config)
     m2["wake"]["wake_deflection_parameters"]["ekman_veer"]["veer"] = False
     gauss = copy.deepcopy(config)
-    gauss["wake"]["model_strings"]["velocity_model"] = "gauss"
-    gauss["wake"]["model_strings"]["deflection_model"] = "gauss"
+    gauss["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss",
+                                          combination_model="sosfs")
     return {"M-1": FlorisModel(config), "M-2": FlorisModel(m2), "gauss": FlorisModel(gauss)}
 
 

@@ -97,13 +97,13 @@ def beta_tag(beta: float) -> str:
 # ----------------------------------------------------------------------------------- set-up
 def builtin_model_config(config: dict, velocity_model: str) -> dict:
     """``config`` with FLORIS's ``velocity_model`` (gauss or cc) in its GCH set-up (gauss
-    deflection, secondary steering, yaw-added recovery, Crespo-Hernandez turbulence), the
+    deflection, secondary steering, yaw-added recovery, Crespo-Hernandez turbulence, sosfs), the
     atmosphere block kept, so the inflow stays the Ekman profile."""
     config = copy.deepcopy(config)
     blocks = load_yaml(BUILTIN_BLOCKS)["wake"]
     wake = config["wake"]
     wake["model_strings"].update(velocity_model=velocity_model, deflection_model="gauss",
-                                 turbulence_model="crespo_hernandez")
+                                 turbulence_model="crespo_hernandez", combination_model="sosfs")
     wake.update(enable_secondary_steering=True, enable_yaw_added_recovery=True,
                 enable_transverse_velocities=True)
     for kind, name in (("wake_deflection_parameters", "gauss"),

@@ -1,7 +1,8 @@
 """Quick start: your FLORIS input with veer (docs/user_guide.md#your-floris-input-with-veer).
 
 FLORIS's own default input (GCH on the NREL 5 MW) turned into an ``ekman_veer`` input: the two
-model names, the atmosphere once, GCH's switches off. Then what veer changes (the same run with
+model names, the wakes summed (``combination_model: fls``), the atmosphere once, GCH's switches
+off. Then what veer changes (the same run with
 the veer offset switched off: the paper's M-2) and what GCH's switches would add behind a yawed
 rotor if left on (FLORIS's own vortex model on top of the ekman_veer wake).
 
@@ -30,7 +31,7 @@ def veer_input(gch: bool = False, veer: bool = True) -> dict:
     """FLORIS's default input with the ekman_veer models and the atmosphere."""
     config = FlorisModel.get_defaults()
     config["wake"]["model_strings"].update(velocity_model="ekman_veer",
-                                           deflection_model="ekman_veer")
+                                           deflection_model="ekman_veer", combination_model="fls")
     config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {"atmosphere": ATMOSPHERE}
     if not veer:
         config["wake"]["wake_deflection_parameters"]["ekman_veer"] = {"veer": False}

@@ -2,21 +2,25 @@
 
     python examples/validate.py [--output DIR] [--gallery DIR]
 
-Runs every case of ``floris_ekman_veer.studies.validation`` (six single wakes and Horns Rev 1, data
-shipped in floris_ekman_veer/studies/validation/data/, DTU PyWake's validation data, MIT licence) with the
-paper's M-1, M-2, M-3 and FLORIS's gauss, GCH, cc, TurbOPark-Gauss and empirical Gauss on the same
-Ekman inflow, for two atmospheres per case: the paper's pure ABL with the site's roughness
-("site") and the neutral ABL whose I_u(z_h) is the measured turbulence intensity ("matched",
-docs/validation.md#the-atmosphere-of-a-case). Horns Rev's rows are averaged over the measured
-direction bin (267-273 deg) and, in the "averaged" columns, over the wind-direction uncertainty
-with FLORIS's UncertainFlorisModel (per-turbine sigma of van der Laan et al.).
+Runs every case of ``floris_ekman_veer.studies.validation`` (six single wakes, Horns Rev 1 and
+Lillgrund's rows B and D, data shipped in floris_ekman_veer/studies/validation/data/, DTU PyWake's
+validation data, MIT licence) through its public API with the paper's M-1 (and two farm
+couplings of it for comparison), M-2, M-3 and FLORIS's gauss, GCH, cc, TurbOPark-Gauss and
+empirical Gauss on the same Ekman inflow, for two atmospheres per case: the paper's pure ABL
+with the site's roughness ("site") and the neutral ABL whose I_u(z_h) is the measured turbulence
+intensity ("matched", docs/validation.md#the-atmosphere-of-a-case). A farm's rows are averaged
+over the measured direction bin (+-3 deg) and, in the "averaged" columns, over the
+wind-direction uncertainty with FLORIS's UncertainFlorisModel (Horns Rev: per-turbine sigma of
+van der Laan et al.; Lillgrund: 3.3 deg).
 
 Writes to DIR (default ./output) the error tables (markdown: ``validation_tables.md``; RMSE and
-bias per case and model, single wakes by downstream distance, Horns Rev by row, the farm
-efficiency against the LES) and the figures ``validation_arcs_<case>.png`` (U/U0 on the arcs with
-the measurements' standard errors, the LES's band and the RANS), ``validation_horns_rev_rows.png``
-and ``validation_horns_rev_efficiency.png``. With ``--gallery docs`` also the small PNGs of
-docs/validation.md. Prints the tables. Takes 4 to 6 minutes on two (loaded) cores.
+bias per case and model, single wakes by downstream distance, each farm's rows by position, the
+farm efficiency against the LES), the tidy tables as CSV (``validation_rows.csv``,
+``validation_efficiency.csv``) and the figures ``validation_arcs_<case>.png`` (U/U0 on the arcs
+with the measurements' standard errors, the LES's band and the RANS),
+``validation_horns_rev_rows.png``, ``validation_lillgrund_rows.png`` and
+``validation_horns_rev_efficiency.png``. With ``--gallery docs`` also the small PNGs of
+docs/validation.md. Prints the tables. Takes 6 to 10 minutes on two (loaded) cores.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -41,13 +46,19 @@ from floris_ekman_veer.studies.validation.atmospheres import (  # noqa: E402
     hub_turbulence,
     wake_scales,
 )
-from floris_ekman_veer.studies.validation.cases import HORNS_REV, SINGLE_WAKE_CASES  # noqa: E402
+from floris_ekman_veer.studies.validation.cases import (  # noqa: E402
+    FARM_CASES,
+    HORNS_REV,
+    LILLGRUND,
+    SINGLE_WAKE_CASES,
+)
 from floris_ekman_veer.studies.validation.metrics import (  # noqa: E402
     arc_errors,
     efficiency_errors,
     markdown,
     pooled,
     reference_arc_errors,
+    reference_row_errors,
     row_errors,
 )
 from floris_ekman_veer.studies.validation.models import (  # noqa: E402
@@ -55,8 +66,8 @@ from floris_ekman_veer.studies.validation.models import (  # noqa: E402
     WAKE_MODELS,
     arc_directions,
     arc_profiles,
-    horns_rev_efficiency,
-    horns_rev_rows,
+    farm_efficiency,
+    row_ratios,
 )
 
 LABEL = {"measured": "measured", "les": "LES"}
@@ -66,6 +77,7 @@ SAMPLE_STEP = 1.0
 ARC_STEP = 0.5
 STYLE = {
     "M-1": dict(color="C3", lw=2.0), "M-1, ambient k_w": dict(color="C3", lw=1.2, ls=":"),
+    "M-1, FLORIS-style": dict(color="C3", lw=1.0, ls="--"),
     "M-2": dict(color="C1", lw=1.2, ls="--"), "M-3": dict(color="C5", lw=1.2, ls="-."),
     "gauss": dict(color="C0", lw=1.0, ls="--"), "GCH": dict(color="C0", lw=2.0),
     "cc": dict(color="C2", lw=1.2), "TurbOPark": dict(color="C4", lw=1.2),
@@ -88,20 +100,19 @@ def single_wake_errors(profiles, step=ARC_STEP):
             for key, profile in profiles.items()}
 
 
-def horns_rev(models=tuple(WAKE_MODELS), readings=ATMOSPHERES, sample_step=SAMPLE_STEP,
-              directions=None):
-    """{(reading, model): {"raw": P_i/P_1, "averaged": P_i/P_1}} (models.horns_rev_rows)."""
-    jobs = [(r, m) for r in readings for m in models]
-    return {(r, m): horns_rev_rows(m, r, sample_step, directions)
-            for r, m in tqdm(jobs, desc="Horns Rev rows", leave=False)}
+def farm_rows(cases=tuple(FARM_CASES), models=tuple(WAKE_MODELS), readings=ATMOSPHERES,
+              sample_step=SAMPLE_STEP, offsets=None):
+    """The tidy P_i/P_1 table of every farm case's rows (models.row_ratios)."""
+    jobs = [(c, m) for c in cases for m in models]
+    return pd.concat([row_ratios(FARM_CASES[c], [m], readings, sample_step, offsets)
+                      for c, m in tqdm(jobs, desc="farm rows", leave=False)], ignore_index=True)
 
 
 def efficiency(models=tuple(WAKE_MODELS), readings=ATMOSPHERES, directions=None):
-    """{(reading, model): farm efficiency at the LES's wind directions}."""
-    directions = HORNS_REV.les_efficiency[:, 0] if directions is None else directions
-    jobs = [(r, m) for r in readings for m in models]
-    return {(r, m): horns_rev_efficiency(m, r, directions)
-            for r, m in tqdm(jobs, desc="Horns Rev efficiency", leave=False)}
+    """The tidy farm-efficiency table of Horns Rev at the LES's directions."""
+    return pd.concat([farm_efficiency(HORNS_REV, [m], readings, directions)
+                      for m in tqdm(models, desc="Horns Rev efficiency", leave=False)],
+                     ignore_index=True)
 
 
 # ------------------------------------------------------------------------------------ tables
@@ -148,45 +159,70 @@ def distance_table(errors, reading):
     return markdown(["case", "x/D", "against"] + models, rows)
 
 
-def rows_error_table(rows):
-    """Rows: model; columns: RMSE (bias) over rows 2-10, raw and averaged, per atmosphere."""
-    readings = list(dict.fromkeys(k[0] for k in rows))
-    models = list(dict.fromkeys(k[1] for k in rows))
-    table = [[model] + [_cell(*row_errors(rows[(r, model)][kind]))
-                        for r in readings for kind in ("averaged", "raw")] for model in models]
-    rans = HORNS_REV.rans_rows
-    table.append(["EllipSys3D RANS (published)"]
-                 + [_cell(*row_errors(rans[:, col])) for _ in readings for col in (2, 1)])
+def rows_error_table(rows, case):
+    """Rows: model; columns: RMSE (bias) over the waked positions, averaged and raw, per
+    atmosphere; the measurements' standard error and the published RANS below."""
+    errors = row_errors(rows[rows["case"] == case])
+    readings = list(dict.fromkeys(errors["reading"]))
+    table = []
+    for model in dict.fromkeys(errors["model"]):
+        cells = []
+        for reading in readings:
+            for kind in ("averaged", "raw"):
+                (e,) = errors[(errors["model"] == model) & (errors["reading"] == reading)
+                              & (errors["kind"] == kind)].itertuples()
+                cells.append(_cell(e.rmse, e.bias))
+        table.append([model] + cells)
+    rans = reference_row_errors(rows[rows["case"] == case])
+    if rans["n"].gt(0).all():
+        by_kind = {e.kind: _cell(e.rmse, e.bias) for e in rans.itertuples()}
+        table.append(["EllipSys3D RANS (published)"]
+                     + [by_kind[kind] for _ in readings for kind in ("averaged", "raw")])
+    error = {e.kind: e.standard_error for e in rans.itertuples()}
+    table.append(["measurements' standard error (RMS)"]
+                 + [f"{error[kind]:.3f}" for _ in readings for kind in ("averaged", "raw")])
     header = ["model"] + [f"{r}, {kind}" for r in readings for kind in ("averaged", "raw")]
     return markdown(header, table)
 
 
-def rows_table(rows, reading, kind="averaged"):
-    """P_i/P_1 by row i: measured, RANS and every model."""
-    models = list(dict.fromkeys(k[1] for k in rows if k[0] == reading))
-    measured = HORNS_REV.measured_rows
-    rans = HORNS_REV.rans_rows[:, 2 if kind == "averaged" else 1]
-    table = [[int(measured[i, 0]), f"{measured[i, 1]:.3f} +- {measured[i, 2]:.3f}", float(rans[i])]
-             + [float(rows[(reading, m)][kind][i]) for m in models] for i in range(len(measured))]
-    return markdown(["row", "measured", "RANS"] + models, table)
+def rows_table(rows, case, reading, kind="averaged"):
+    """P_i/P_1 by row and position: measured, RANS and every model."""
+    chosen = rows[(rows["case"] == case) & (rows["reading"] == reading) & (rows["kind"] == kind)]
+    models = list(dict.fromkeys(chosen["model"]))
+    first = chosen[chosen["model"] == models[0]]
+    several = first["row"].nunique() > 1 or first["wind_direction"].nunique() > 1
+    table = []
+    for index, point in enumerate(first.itertuples()):
+        if np.isnan(point.measured):
+            continue
+        label = ([f"{point.row}, {point.wind_direction:g} deg"] if several else []) + [point.position]
+        values = [float(chosen[chosen["model"] == m]["ratio"].iloc[index]) for m in models]
+        rans = [] if np.isnan(point.rans) else [float(point.rans)]
+        table.append(label + [f"{point.measured:.3f} +- {point.standard_error:.3f}"]
+                     + (rans if not np.isnan(first["rans"]).all() else []) + values)
+    header = (["row"] if several else []) + ["position", "measured"]
+    header += [] if np.isnan(first["rans"]).all() else ["RANS"]
+    return markdown(header + models, table)
 
 
 def efficiency_table(effs):
-    readings = list(dict.fromkeys(k[0] for k in effs))
-    models = list(dict.fromkeys(k[1] for k in effs))
-    directions = HORNS_REV.les_efficiency[:, 0]
-    table = [[m] + [_cell(*efficiency_errors(directions, effs[(r, m)])) for r in readings]
-             for m in models]
-    return markdown(["model"] + list(readings), table)
+    errors = efficiency_errors(effs)
+    readings = list(dict.fromkeys(errors["reading"]))
+    table = []
+    for model in dict.fromkeys(errors["model"]):
+        row = [model]
+        for reading in readings:
+            (e,) = errors[(errors["model"] == model) & (errors["reading"] == reading)].itertuples()
+            row.append(_cell(e.rmse, e.bias))
+        table.append(row)
+    return markdown(["model"] + readings, table)
 
 
 def atmosphere_table():
     """Per case: the measured I_u, and for each atmosphere z0, I_u(z_h), k_w and x0/D."""
     rows = []
-    for case in list(SINGLE_WAKE_CASES.values()) + [HORNS_REV]:
-        ct = getattr(case, "thrust_coefficient", None)
-        if ct is None:  # Horns Rev: the V80's C_T at its wind speed
-            ct = float(np.interp(case.wind_speed, *HORNS_REV.v80_table[:, [0, 2]].T))
+    for case in list(SINGLE_WAKE_CASES.values()) + list(FARM_CASES.values()):
+        ct = case.thrust_coefficient  # a farm's: its turbine's at the case's wind speed
         row = [case.name, f"{case.streamwise_turbulence:.3f}"]
         for reading in ATMOSPHERES:
             z0 = atmosphere(case, reading)["roughness_length"]
@@ -209,10 +245,12 @@ def tables(errors, rows, effs) -> str:
     for reading in ATMOSPHERES:
         parts += [f"## Single wakes by downstream distance, {reading} atmosphere", "",
                   distance_table(errors, reading), ""]
-    parts += ["## Horns Rev 1, P_i/P_1 over rows 2-10: RMSE (bias)", "", rows_error_table(rows), ""]
-    for reading in ATMOSPHERES:
-        parts += [f"## Horns Rev 1 by row, {reading} atmosphere, direction-averaged", "",
-                  rows_table(rows, reading), ""]
+    for case in dict.fromkeys(rows["case"]):
+        parts += [f"## {case}, P_i/P_1 over the waked positions: RMSE (bias)", "",
+                  rows_error_table(rows, case), ""]
+        for reading in ATMOSPHERES:
+            parts += [f"## {case} by position, {reading} atmosphere, direction-averaged", "",
+                      rows_table(rows, case, reading), ""]
     parts += ["## Horns Rev 1 farm efficiency against the LES: RMSE (bias)", "",
               efficiency_table(effs), ""]
     return "\n".join(parts)
@@ -263,23 +301,32 @@ def arcs_figure(profiles, case_name, output, distances=None, dpi=100, models=Non
     return path
 
 
+def _row_panel(ax, rows, row, direction, kind, models):
+    chosen = rows[(rows["row"] == row) & (rows["wind_direction"] == direction)
+                  & (rows["kind"] == kind)]
+    first = chosen[(chosen["model"] == models[0]) & (chosen["reading"] == "matched")]
+    ax.errorbar(first["position"], first["measured"], yerr=first["standard_error"], fmt="ko",
+                ms=4, capsize=3, label="measured")
+    if not first["rans"].isna().all():
+        ax.plot(first["position"], first["rans"], "k-.", lw=1.0, label="RANS")
+    for model in models:
+        line = chosen[(chosen["model"] == model) & (chosen["reading"] == "matched")]
+        ax.plot(line["position"], line["ratio"], label=model, **STYLE[model])
+    ax.set_xticks(first["position"])
+    ax.grid(alpha=0.3)
+
+
 def rows_figure(rows, output, dpi=100):
+    rows = rows[rows["case"] == HORNS_REV.name]
+    models = list(dict.fromkeys(rows["model"]))
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
-    measured, rans = HORNS_REV.measured_rows, HORNS_REV.rans_rows
-    models = [k[1] for k in rows if k[0] == "matched"]
-    for ax, kind, col in zip(axes, ("raw", "averaged"), (1, 2)):
-        ax.errorbar(measured[:, 0], measured[:, 1], yerr=measured[:, 2], fmt="ko", ms=4,
-                    capsize=3, label="measured")
-        ax.plot(rans[:, 0], rans[:, col], "k-.", lw=1.0, label="RANS")
-        for model in models:
-            ax.plot(measured[:, 0], rows[("matched", model)][kind], label=model, **STYLE[model])
-        ax.plot(measured[:, 0], rows[("site", "M-1")][kind], color="C3", lw=1.0, ls="--",
-                label="M-1, site ABL")
+    for ax, kind in zip(axes, ("raw", "averaged")):
+        _row_panel(ax, rows, "inner rows", 270.0, kind, models)
+        site = rows[(rows["model"] == "M-1") & (rows["reading"] == "site") & (rows["kind"] == kind)]
+        ax.plot(site["position"], site["ratio"], color="C3", lw=1.0, ls="-.", label="M-1, site ABL")
         ax.set_title(f"Horns Rev 1, 270 +- 2.5 deg, 8 m/s: {kind}"
                      + (" (direction uncertainty)" if kind == "averaged" else ""), fontsize=9)
         ax.set_xlabel("turbine along the row")
-        ax.set_xticks(measured[:, 0])
-        ax.grid(alpha=0.3)
     axes[0].set_ylabel("P_i/P_1, inner-row mean")
     axes[1].legend(fontsize=7, ncol=2)
     fig.tight_layout()
@@ -289,13 +336,34 @@ def rows_figure(rows, output, dpi=100):
     return path
 
 
+def lillgrund_figure(rows, output, dpi=100):
+    """Lillgrund's rows B and D at 222 and 207 deg, direction-averaged, matched atmosphere."""
+    rows = rows[rows["case"] == LILLGRUND.name]
+    models = list(dict.fromkeys(rows["model"]))
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharey=True)
+    for ax, reference in zip(axes.ravel(), LILLGRUND.rows):
+        direction, row = reference.wind_direction, reference.label
+        _row_panel(ax, rows, row, direction, "averaged", models)
+        ax.set_title(f"Lillgrund {row}, {direction:g} +- 2.5 deg, 9 m/s, sigma 3.3 deg", fontsize=9)
+        ax.set_xlabel("position along the row (gap in row D: no turbine)")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("P_i/P_1")
+    axes[0, 1].legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    path = Path(output) / "validation_lillgrund_rows.png"
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
 def efficiency_figure(effs, output, dpi=100):
-    les = HORNS_REV.les_efficiency
+    les = HORNS_REV.efficiency
     fig, ax = plt.subplots(figsize=(10, 3.6))
-    ax.plot(les[:, 0], les[:, 1], "ko-", ms=3, lw=1.0, label="LES (Zong & Porte-Agel 2020)")
-    for (reading, model), eff in effs.items():
-        if reading == "matched":
-            ax.plot(les[:, 0], eff, label=model, **STYLE[model])
+    ax.plot(les.directions, les.efficiency, "ko-", ms=3, lw=1.0, label=les.source)
+    matched = effs[effs["reading"] == "matched"]
+    for model in dict.fromkeys(matched["model"]):
+        line = matched[matched["model"] == model]
+        ax.plot(line["wind_direction"], line["efficiency"], label=model, **STYLE[model])
     ax.set_xlabel("wind direction [deg]")
     ax.set_ylabel("farm power / 80 unwaked")
     ax.set_title("Horns Rev 1 farm efficiency, 8 m/s (matched atmosphere)", fontsize=9)
@@ -313,20 +381,25 @@ def main(argv=None) -> None:
     start = time.perf_counter()
     profiles = single_wakes()
     errors = single_wake_errors(profiles)
-    rows = horns_rev()
+    rows = farm_rows()
     effs = efficiency()
     text = tables(errors, rows, effs)
     print(text)
     (args.output / "validation_tables.md").write_text(text + "\n")
+    rows.to_csv(args.output / "validation_rows.csv", index=False)
+    effs.to_csv(args.output / "validation_efficiency.csv", index=False)
     written = [arcs_figure(profiles, name, args.output) for name in SINGLE_WAKE_CASES]
-    written += [rows_figure(rows, args.output), efficiency_figure(effs, args.output)]
+    written += [rows_figure(rows, args.output), lillgrund_figure(rows, args.output),
+                efficiency_figure(effs, args.output)]
     if args.gallery is not None:
         main_models = ["M-1", "M-3", "GCH", "cc", "TurbOPark"]
         for name in SINGLE_WAKE_CASES:
             distances = (2.0, 3.0, 5.0) if name == "Nordtank-500" else None
             written.append(arcs_figure(profiles, name, args.gallery, distances, dpi=80,
                                        models=main_models))
-        written += [rows_figure(rows, args.gallery, dpi=70), efficiency_figure(effs, args.gallery, dpi=70)]
+        written += [rows_figure(rows, args.gallery, dpi=70),
+                    lillgrund_figure(rows, args.gallery, dpi=70),
+                    efficiency_figure(effs, args.gallery, dpi=70)]
     report(written, start)
 
 

@@ -51,7 +51,8 @@ def line_of(text: str) -> int:
 def defaults_with_veer(**wake_switches) -> dict:
     """FLORIS's default input (GCH on the NREL 5 MW) turned to ekman_veer as the user guide says."""
     config = FlorisModel.get_defaults()
-    config["wake"]["model_strings"].update(velocity_model="ekman_veer", deflection_model="ekman_veer")
+    config["wake"]["model_strings"].update(velocity_model="ekman_veer", deflection_model="ekman_veer",
+                                           combination_model="fls")
     config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {"atmosphere": dict(STABLE_ATMOSPHERE)}
     config["wake"].update(wake_switches)
     config["farm"].update(layout_x=[0.0, 630.0, 1260.0], layout_y=[0.0, 0.0, 0.0])

@@ -26,7 +26,8 @@ ATMOSPHERE = {"latitude": 52.0, "roughness_length": 0.1, "cooling_rate": -0.25}
 
 def defaults(velocity="ekman_veer", deflection="ekman_veer", **flow_field):
     config = FlorisModel.get_defaults()
-    config["wake"]["model_strings"].update(velocity_model=velocity, deflection_model=deflection)
+    config["wake"]["model_strings"].update(velocity_model=velocity, deflection_model=deflection,
+                                           combination_model="fls")
     config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {"atmosphere": ATMOSPHERE}
     config["wake"].update(enable_secondary_steering=False, enable_yaw_added_recovery=False,
                           enable_transverse_velocities=False)

@@ -801,9 +801,11 @@ def farm(layout, wind_directions=WIND_DIRECTIONS, wind_speeds=WIND_SPEEDS, yaw=N
                  wind_speeds=list(wind_speeds),
                  turbulence_intensities=[0.06] * len(wind_speeds))
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = list(layout[0]), list(layout[1])
-    # The baselines pin the paper's k_w (the farm input takes local_turbulence, pinned by
-    # test_local_turbulence_adds_only_the_wake_added_turbulence).
-    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_expansion"] = "ambient"
+    # The baselines pin the paper's k_w with FLORIS's free-stream sum of squares (the farm
+    # input's array coupling is pinned by test_array_coupling_*).
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        wake_expansion="ambient", deficit_velocity="free_stream")
+    cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
     fmodel = FlorisModel(cfg)
     if yaw is not None:
         fmodel.set(yaw_angles=np.tile(yaw, (len(wind_speeds), 1)))
@@ -990,8 +992,8 @@ def test_local_turbulence_adds_only_the_wake_added_turbulence():
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 882.0, 1764.0], [0.0] * 3
     abl = atmosphere_of(cfg)
     speed = abl.speed(HUB_5MW)
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_expansion"] = "local_turbulence"
     model = FlorisModel(cfg).core.wake.velocity_model
-    assert model.wake_expansion == "local_turbulence"  # what the farm input uses
     ambient = float(abl.wake_expansion_rate(HUB_5MW))
     i_u = float(abl.turbulence_intensity(HUB_5MW, reference_height=HUB_5MW))
     for floris_ti in (0.03, 0.06, 0.11):  # unwaked: the paper's k_w, whatever FLORIS's TI
@@ -1010,3 +1012,76 @@ def test_local_turbulence_adds_only_the_wake_added_turbulence():
         powers[mode] = fmodel.get_turbine_powers()[0]
     assert powers["local_turbulence"][0] == powers["ambient"][0]
     assert np.all(powers["local_turbulence"][2:] > 1.05 * powers["ambient"][2:])
+
+
+def test_array_coupling_is_the_default_and_adds_what_a_second_wake_brings():
+    """The farm input's defaults (docs/coupling.md#wakes-deep-in-an-array): array_turbulence,
+    incoming, the wakes summed. A row of four NREL 5 MW at 7 D, neutral, 8 m/s: turbine 2 stands
+    in one wake from an unwaked rotor, so every coupling gives it the same power (fraction 1,
+    and one wake's added turbulence is the same summed or maximal); turbine 3's wake source,
+    turbine 2, is waked: scaled with its incoming speed, turbine 3 gets more power than with the
+    free stream; turbine 4 mixes the added turbulence of two wakes, so its power rises when
+    their variances are summed rather than the larger kept."""
+    cfg = config("farm_sbl6", atmosphere={"stability_parameter": 0.0}, wind_speeds=[8.0],
+                 turbulence_intensities=[0.06])
+    cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 882.0, 1764.0, 2646.0], [0.0] * 4
+    default = FlorisModel(cfg).core.wake.velocity_model
+    assert (default.wake_expansion, default.deficit_velocity) == ("array_turbulence", "incoming")
+    assert cfg["wake"]["model_strings"]["combination_model"] == "fls"
+    powers = {}
+    for expansion in ("local_turbulence", "array_turbulence"):
+        for scale in ("free_stream", "incoming"):
+            cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+                wake_expansion=expansion, deficit_velocity=scale)
+            fmodel = FlorisModel(cfg)
+            fmodel.run()
+            powers[expansion, scale] = fmodel.get_turbine_powers()[0]
+    for variant in powers.values():
+        np.testing.assert_array_equal(variant[:2], powers["array_turbulence", "incoming"][:2])
+    for expansion in ("local_turbulence", "array_turbulence"):
+        assert powers[expansion, "incoming"][2] > 1.02 * powers[expansion, "free_stream"][2]
+    for scale in ("free_stream", "incoming"):
+        assert powers["array_turbulence", scale][2] == powers["local_turbulence", scale][2]
+        assert powers["array_turbulence", scale][3] > 1.01 * powers["local_turbulence", scale][3]
+
+
+def test_added_turbulence_and_incoming_speed_by_hand():
+    """RotorWakes: ``quadrature`` adds each wake's variance, TI^2 = TI_0^2 + sum added^2,
+    ``max`` keeps FLORIS's max(TI, sqrt(added^2 + TI_0^2)); the incoming fraction is the
+    cells' mean waked over ambient speed, 1 without a wake."""
+    from types import SimpleNamespace
+
+    from floris_ekman_veer.plugin.rotor import RotorWakes
+
+    for rule, expected in (("quadrature", math.sqrt(0.05**2 + 0.1**2 + 0.08**2)),
+                           ("max", math.hypot(0.1, 0.05))):
+        wakes = SimpleNamespace(turbulence=np.full((1, 2), 0.05))
+        for added in (0.1, 0.08):
+            RotorWakes.add_turbulence(wakes, np.array([0]), np.array([1]), np.array([added]),
+                                      np.array([0.05]), rule)
+        assert wakes.turbulence[0, 1] == pytest.approx(expected, rel=1e-15)
+        assert wakes.turbulence[0, 0] == 0.05
+    wakes = SimpleNamespace(wake=np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]]))
+    u = np.array([[8.0, 9.0, 10.0], [8.0, 9.0, 10.0]])
+    np.testing.assert_allclose(RotorWakes.incoming_fraction(wakes, np.array([0, 1]), u),
+                               [1.0, 1.0 - 6.0 / 27.0], rtol=1e-15)
+
+
+def test_summed_wakes_are_asked_for_with_incoming_deficits():
+    """deficit_velocity: incoming with FLORIS's sosfs (its default) or max gives one
+    ModelSettingsWarning naming both settings; fls, or free_stream, is silent."""
+    cfg = config("farm_sbl6")
+    for combination, scale, warned in (("sosfs", "incoming", True), ("max", "incoming", True),
+                                       ("fls", "incoming", False), ("sosfs", "free_stream", False)):
+        cfg["wake"]["model_strings"]["combination_model"] = combination
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["deficit_velocity"] = scale
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            FlorisModel(cfg)
+        messages = [str(w.message) for w in caught
+                    if issubclass(w.category, floris_ekman_veer.ModelSettingsWarning)]
+        assert len(messages) == int(warned), (combination, scale)
+        if warned:
+            assert f"combination_model = '{combination}'" in messages[0]
+            assert "deficit_velocity = 'incoming'" in messages[0]
+

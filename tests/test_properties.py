@@ -182,7 +182,9 @@ def cases(draw) -> dict:
             "yaw_deflection": draw(st.booleans()),
             "ground_image": draw(st.booleans()),
             "polar_angle_centre": draw(st.sampled_from(["wake_centre", "yaw_centre"])),
-            "wake_expansion": draw(st.sampled_from(["ambient", "local_turbulence"])),
+            "wake_expansion": draw(st.sampled_from(["ambient", "local_turbulence",
+                                                    "array_turbulence"])),
+            "deficit_velocity": draw(st.sampled_from(["incoming", "free_stream"])),
             "gch": draw(st.booleans()),
         },
         "points": draw(st.lists(
@@ -211,8 +213,10 @@ def floris_model(case) -> FlorisModel:
             switches["polar_angle_centre"] if case["wake"] == "M-1/M-2" else "wake_centre"
         ),
         "wake_expansion": switches["wake_expansion"],
+        "deficit_velocity": switches["deficit_velocity"],
     }
-    velocity["bastankhah2014"] = {"wake_expansion": switches["wake_expansion"]}
+    velocity["bastankhah2014"] = {"wake_expansion": switches["wake_expansion"],
+                                  "deficit_velocity": switches["deficit_velocity"]}
     wake["wake_deflection_parameters"]["ekman_veer"] = {
         k: switches[k] for k in ("veer", "yaw_deflection", "ground_image")
     }

@@ -89,10 +89,12 @@ def test_solver_equals_floris_sequential_solver(farm, model, combination, expans
 
 
 def test_solver_equals_floris_on_the_shipped_farms_and_a_large_batch():
-    """The shipped inputs as they are, 40 conditions, every rotor yawed."""
+    """The shipped inputs as they are, 40 conditions, every rotor yawed; speeds up to 19 m/s,
+    where the stable inputs' fixed stability stays inside the physical domain
+    (docs/atmosphere.md#physical-domain)."""
     rng = np.random.default_rng(3)
     n = 40
-    speeds, directions = rng.uniform(3.0, 25.0, n), rng.uniform(0.0, 360.0, n)
+    speeds, directions = rng.uniform(3.0, 19.0, n), rng.uniform(0.0, 360.0, n)
     for farm in FARMS:
         config = load_yaml(INPUTS / f"{farm}.yaml")
         yaw = rng.uniform(-30.0, 30.0, (n, len(config["farm"]["layout_x"])))

@@ -148,3 +148,26 @@ def test_without_atmosphere_raises():
     config["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss")
     with pytest.raises(ValueError, match="validity_report: the model has no atmosphere"):
         floris_ekman_veer.validity_report(FlorisModel(config))
+
+
+def test_farm_coupling_is_flagged_beyond_the_paper():
+    """A farm with the array coupling (the shipped default) is flagged beyond the paper's
+    single-wake validation, every condition alike, without changing inside_envelope; a single
+    turbine, or the paper's ambient k_w with free-stream deficits, is not."""
+    config = load_yaml(floris_ekman_veer.example_input("farm_night"))
+    conditions = dict(wind_directions=[270.0, 270.0], wind_speeds=[10.0, 11.0],
+                      turbulence_intensities=[0.06, 0.06])
+    farm = FlorisModel(config)
+    farm.set(**conditions)
+    report = floris_ekman_veer.validity_report(farm)
+    assert report.farm_coupling_beyond_paper.tolist() == [True, True]
+    assert report.inside_envelope.tolist() == [True, True]
+    single = FlorisModel(config)
+    single.set(layout_x=[0.0], layout_y=[0.0], **conditions)
+    assert not floris_ekman_veer.validity_report(single).farm_coupling_beyond_paper.any()
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        wake_expansion="ambient", deficit_velocity="free_stream")
+    config["wake"]["model_strings"]["combination_model"] = "sosfs"
+    paper = FlorisModel(config)
+    paper.set(**conditions)
+    assert not floris_ekman_veer.validity_report(paper).farm_coupling_beyond_paper.any()

@@ -36,6 +36,13 @@ def uses_wake_models(core) -> bool:
     )
 
 
+def reads_wind_shear(core) -> bool:
+    """Whether FLORIS's GCH terms that read ``flow_field.wind_shear`` are on (secondary steering
+    and the transverse velocities take the vortex strength from the power law's shear)."""
+    wake = core.wake
+    return bool(wake.enable_secondary_steering or wake.enable_transverse_velocities)
+
+
 def uses_package(core, atmosphere) -> bool:
     """Whether the Core uses an atmosphere, a wake model or a turbine of this package."""
     return (
@@ -66,11 +73,13 @@ def check_core(core, atmosphere=None) -> None:
     _check_conditions(core.flow_field)
     _check_turbines(core.farm)
     warn_ignored_flow_inputs(core, atmosphere)
+    warn_deficit_superposition(core)
 
 
 def warn_ignored_flow_inputs(core, atmosphere) -> None:
-    """With an atmosphere, FLORIS's ``flow_field.wind_shear`` is not used (the atmosphere gives
-    the inflow's shear), and ``flow_field.wind_veer`` is not used by the ekman_veer models
+    """With an atmosphere, FLORIS's ``flow_field.wind_shear`` is not used for the inflow (the
+    atmosphere gives the inflow's shear; only FLORIS's GCH terms read it, :func:`reads_wind_shear`),
+    and ``flow_field.wind_veer`` is not used by the ekman_veer models
     (the atmosphere gives the veer; FLORIS's gauss models still read it as they do without the
     package, docs/user_guide.md#floris-inputs-the-atmosphere-replaces): one
     :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per value per study, so that a
@@ -80,7 +89,7 @@ def warn_ignored_flow_inputs(core, atmosphere) -> None:
         return
     flow_field = core.flow_field
     shear, veer = float(flow_field.wind_shear), float(flow_field.wind_veer)
-    if shear != 0.0:
+    if shear != 0.0 and not reads_wind_shear(core):
         package_warnings.warn(
             f"flow_field.wind_shear = {shear:g} is not used: the atmosphere ({ATMOSPHERE_PATH}) "
             "gives the inflow's shear; set wind_shear: 0.0 to say so "
@@ -124,6 +133,27 @@ def notice_unused_turbulence(core, abl, atmosphere) -> None:
             "on the same inflow give them the atmosphere's I_u "
             "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
             package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
+
+
+def warn_deficit_superposition(core) -> None:
+    """``deficit_velocity: incoming`` (the package's default) scales each waked rotor's wake with
+    its incoming speed, as Niayifar & Porte-Agel (2016) do with the deficits summed (FLORIS's
+    combination ``fls``); squares summed (``sosfs``) or the largest (``max``) of such deficits
+    would let deep-array wakes recover too fast: one
+    :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per combination per study
+    (docs/coupling.md#wakes-deep-in-an-array). Silent with ``fls`` or ``free_stream``."""
+    velocity = getattr(core.wake, "velocity_model", None)
+    if getattr(velocity, "deficit_velocity", None) != "incoming":
+        return
+    combination = str(core.wake.model_strings.get("combination_model", "")).lower()
+    if combination != "fls":
+        package_warnings.warn(
+            f"wake.model_strings.combination_model = {combination!r} with "
+            f"{velocity.input_path}.deficit_velocity = 'incoming': the wakes of waked rotors "
+            "scale with their incoming speed and are meant to be summed; set combination_model: "
+            "fls, or deficit_velocity: free_stream to scale them with the free stream "
+            "(docs/coupling.md#wakes-deep-in-an-array)",
+            package_warnings.ModelSettingsWarning, items=(("combination_model", combination),))
 
 
 def _check_layout(farm) -> None:

@@ -62,7 +62,9 @@ from floris_ekman_veer.plugin.names import (
     VELOCITY_MODEL_NAME,
 )
 from floris_ekman_veer.plugin.rotor import (
+    DEFICIT_VELOCITIES,
     ROTOR_PLANE_MARGIN,
+    WAKE_EXPANSIONS,
     WAKE_MODELS,
     RotorWakes,
     TurbineWake,
@@ -142,8 +144,17 @@ class _EkmanWakeModel(BaseModel):
     k_w_exponent: float = number_field(MERGE_EXPONENT, *_MERGE_EXPONENT_RANGE)
     #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
     #: "local_turbulence": the same with FLORIS's wake-added turbulence at the turbine (from its
-    #: turbulence model) added in quadrature to I_u(z_h), for farms (see expansion_rate).
-    wake_expansion: str = choice_field("ambient", ("ambient", "local_turbulence"))
+    #: turbulence model, the largest of the upstream wakes' as FLORIS combines it) added in
+    #: quadrature to I_u(z_h) (see expansion_rate). "array_turbulence" (the default): the
+    #: upstream wakes' added turbulence intensities summed in quadrature, their variances
+    #: adding (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor gets the paper's k_w
+    #: with each.
+    wake_expansion: str = choice_field("array_turbulence", WAKE_EXPANSIONS)
+    #: The velocity a waked rotor's wake deficit C(x) scales with: "incoming" (the default,
+    #: Niayifar & Porte-Agel 2016) its rotor-averaged incoming speed, with the deficits summed
+    #: (FLORIS's combination ``fls``); "free_stream" the ambient U_h, as FLORIS's gauss
+    #: (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor's wake is the paper's with each.
+    deficit_velocity: str = choice_field("incoming", DEFICIT_VELOCITIES)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/shallow.py).
@@ -155,13 +166,15 @@ class _EkmanWakeModel(BaseModel):
 
     def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity,
                        floris_turbulence):
-        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its local-turbulence variant.
+        """k_w of the wake, Eq. (kw_CNBL_SBL_model) or its wake-added-turbulence variants.
 
-        ``turbulence_intensity`` is FLORIS's at the turbine, sqrt(TI_0^2 + TI_added^2) once
-        waked (on a turbine grid the rotor cells' own, with the wake overlap as an area:
-        plugin/rotor.py ``RotorWakes``), with ``floris_turbulence`` its ambient TI_0. "local_turbulence" keeps the paper's
-        ambient I_u(z_h) and adds FLORIS's wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0),
-        so an unwaked turbine gets the paper's k_w exactly, whatever TI_0 FLORIS was given
+        ``turbulence_intensity`` is the turbulence at the turbine, TI_0 plus the upstream wakes'
+        added turbulence (on a turbine grid the rotor cells' own, the wakes' overlaps as areas,
+        the largest wake's for "local_turbulence" and all of them in quadrature for
+        "array_turbulence": plugin/rotor.py ``RotorWakes``; elsewhere FLORIS's), with
+        ``floris_turbulence`` its ambient TI_0. Both keep the paper's ambient I_u(z_h) and add
+        the wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0), so an unwaked turbine gets the
+        paper's k_w exactly, whatever TI_0 FLORIS was given
         (docs/coupling.md#wake-expansion-in-farms).
         """
         if self.wake_expansion == "ambient":

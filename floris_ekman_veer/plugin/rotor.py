@@ -439,10 +439,23 @@ class RotorWakes:
         flowing = u_cell > 0.0
         return np.where(flowing, increment / np.where(flowing, u_cell, 1.0), 0.0)
 
-    def add_turbulence(self, f, j, added, ambient) -> None:
-        """FLORIS's combination of wake-added turbulence at rotors (f, j):
-        TI = max(TI, sqrt(added^2 + TI_0^2))."""
-        self.turbulence[f, j] = np.maximum(self.turbulence[f, j], np.hypot(added, ambient))
+    def add_turbulence(self, f, j, added, ambient, rule="max") -> None:
+        """One wake's added turbulence at rotors (f, j) (each once): ``max`` is FLORIS's
+        combination, TI = max(TI, sqrt(added^2 + TI_0^2)); ``quadrature`` adds its variance,
+        TI = sqrt(TI^2 + added^2), so that TI^2 = TI_0^2 + the sum over the upstream wakes
+        (docs/coupling.md#wakes-deep-in-an-array)."""
+        if rule == "quadrature":
+            self.turbulence[f, j] = np.hypot(self.turbulence[f, j], added)
+        else:
+            self.turbulence[f, j] = np.maximum(self.turbulence[f, j], np.hypot(added, ambient))
+
+    def incoming_fraction(self, pair, u_cell) -> np.ndarray:
+        """U_i / U_i,0 of rotors ``pair`` (flat indices): the mean over their cells of the
+        velocity in the wakes superposed so far, U_k - U_k d_k, over that of the inflow U_k
+        (``u_cell``, (pairs, n^2)); 1 for a rotor no wake has reached."""
+        ambient = u_cell.sum(axis=1)
+        waked = self.wake[pair].sum(axis=1)
+        return 1.0 - waked / np.where(ambient > 0.0, ambient, 1.0)
 
 
 #: Sub-quadrature of the wake cells per point of FLORIS's n x n grid: ROWS_PER_POINT n strips
@@ -566,6 +579,15 @@ NEGLIGIBLE_DEFICIT = 1e-5
 #: Rotors whose wake centre is evaluated at their sub-point rows at once.
 PAIR_CHUNK = 1024
 
+#: The velocity models' ``wake_expansion`` choices (plugin/models.py): the paper's ambient k_w,
+#: and the two that add the upstream wakes' turbulence at a rotor (its largest, as FLORIS
+#: combines it; all of them, their variances summed), tracked here on a turbine grid.
+WAKE_EXPANSIONS = ("ambient", "local_turbulence", "array_turbulence")
+ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
+
+#: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
+DEFICIT_VELOCITIES = ("incoming", "free_stream")
+
 #: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
 #: about 0.3 MB each.
 ROW_CHUNK = 4096
@@ -638,7 +660,9 @@ def rotor_cell_deficit(
 
     ``model`` is the velocity model (plugin/models.py): its ``expansion_rate`` (k_w),
     ``width_bound`` and ``amplitude_bound`` (how far its wake reaches), ``sub_point_deficit``
-    (Delta u / U_h of a :class:`TurbineWake`) and ``wake_expansion``. ``ambient`` is the grid's
+    (Delta u / U_h of a :class:`TurbineWake`), ``wake_expansion`` and ``deficit_velocity``
+    (with "incoming" the wake's velocity is scaled by turbine i's U_i / U_i,0 of the wakes
+    superposed so far, docs/coupling.md#wakes-deep-in-an-array). ``ambient`` is the grid's
     :class:`~floris_ekman_veer.plugin.ambient.Ambient` with its ``rotor``, ``wakes`` the solve's
     :class:`RotorWakes`; yaw in radians, ct the model's thrust coefficient.
     """
@@ -652,12 +676,25 @@ def rotor_cell_deficit(
         return result.reshape(u_initial.shape)
     abl = ambient.abl
     hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
-    track = (model.wake_expansion == "local_turbulence" and wakes.rule is not None
+    added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
+    track = (added_rule is not None and wakes.rule is not None
              and wakes.turbulence_model is not None)
-    if track:
-        # The turbulence at turbine i with the overlaps as areas (RotorWakes).
+    incoming = model.deficit_velocity == "incoming" and wakes.rule is not None
+    if track or incoming:
+        # Turbine i among the rotors, per condition.
         source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
                            axis=1)
+    # U_i / U_i,0 of turbine i: its wake's C(x) scales with the speed it stands in
+    # (docs/coupling.md#wakes-deep-in-an-array); 1 for an unwaked rotor.
+    speed_fraction = 1.0
+    if incoming:
+        conditions = np.arange(n_findex)
+        speed_fraction = wakes.incoming_fraction(
+            conditions * n_turbines + source,
+            u_initial.reshape(n_findex, n_turbines, -1)[conditions, source],
+        )[:, None, None, None]
+    if track:
+        # The turbulence at turbine i with the overlaps as areas (RotorWakes).
         turbulence = wakes.turbulence[np.arange(n_findex), source][:, None, None, None]
     else:
         # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added
@@ -670,6 +707,7 @@ def rotor_cell_deficit(
     per_pair = {
         "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
         "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
+        "speed_fraction": speed_fraction,
     }
     per_pair = {k: pick(v) for k, v in per_pair.items()}
     x_pair = dx[f, j]
@@ -775,7 +813,8 @@ def rotor_cell_deficit(
         # No flow (at and below z0): no wake.
         ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
         du = model.sub_point_deficit(
-            wake, {k: v[pe][:, None] for k, v in wake_parameters.items()}) * pair["hub_speed"]
+            wake, {k: v[pe][:, None] for k, v in wake_parameters.items()},
+        ) * (pair["hub_speed"] * pair["speed_fraction"])
         removed = wakes.superpose(flat[pe], re, du, ambient_u, moment[pe][:, None])
         # Each stretch's nodes added in turn: numpy's sum of fewer than 8 numbers, at less
         # cost than a reduction along a short axis.
@@ -800,13 +839,14 @@ def rotor_cell_deficit(
         moment[reached][:, None])
     if track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
-                        axial_induction_i, overlap[reached], ambient)
+                        axial_induction_i, overlap[reached], ambient, added_rule)
     return result.reshape(u_initial.shape)
 
 
-def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient):
+def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):
     """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
-    the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it."""
+    the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it,
+    combined by ``rule`` (RotorWakes.add_turbulence)."""
     column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
     x_j, x_source = ambient.rotor.x[f, j], column(x_i)
     diameter = 2.0 * column(radius_i)
@@ -815,7 +855,7 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
         ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
     added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
         x_j <= x_source + 15.0 * diameter)
-    wakes.add_turbulence(f, j, added, ambient_turbulence)
+    wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
 
 
 def _check_resolution(x, per_pair, reached, centre, radius_j, cells, warned):

@@ -222,12 +222,15 @@ def native_inflow_set_kwargs(fmodel, z=None, x_bounds=None, y_bounds=None) -> di
 
 
 #: Wake set-ups of FLORIS 4.7's example inputs (gch.yaml, gauss.yaml and cc.yaml in its
-#: examples folder): model names and the three GCH switches. Their parameter blocks are those
+#: examples folder): model names, their combination (sosfs) and the three GCH switches. Their parameter blocks are those
 #: of the input they are applied to (FLORIS's defaults where it has none).
 BUILTIN_WAKES = {
-    "gch": ({"velocity_model": "gauss", "deflection_model": "gauss"}, True),
-    "gauss": ({"velocity_model": "gauss", "deflection_model": "gauss"}, False),
-    "cc": ({"velocity_model": "cc", "deflection_model": "gauss"}, True),
+    "gch": ({"velocity_model": "gauss", "deflection_model": "gauss", "combination_model": "sosfs"},
+            True),
+    "gauss": ({"velocity_model": "gauss", "deflection_model": "gauss",
+               "combination_model": "sosfs"}, False),
+    "cc": ({"velocity_model": "cc", "deflection_model": "gauss", "combination_model": "sosfs"},
+           True),
 }
 GCH_SWITCHES = ("enable_secondary_steering", "enable_yaw_added_recovery",
                 "enable_transverse_velocities")

@@ -16,6 +16,12 @@ only where all three hold, each with the paper's own cases inside it as the mode
 - Ro within the LES's range widened to the model's u* of the paper's cases (3.39e4 to 6.27e4),
   or a ``rossby_range`` the caller documents.
 
+Farms add physics the paper's single wakes do not test: where a rotor stands in another's wake,
+the package's farm coupling (the upstream wakes' added turbulence in k_w, the wakes scaled with
+their rotors' incoming speed and summed, docs/coupling.md#wakes-deep-in-an-array) is beyond the
+paper's validation, which the report's ``farm_coupling_beyond_paper`` column says (it leaves
+``inside_envelope``, a property of the atmosphere, unchanged).
+
 Outside it the wake model is extrapolated (a shallow night, h below the rotor top, sees the
 geostrophic wind above h: docs/atmosphere.md#shallow-boundary-layer): its numbers, and any gain
 computed from them, are not validated.
@@ -153,7 +159,9 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     ``wake_validated_stability`` (:func:`wake_validated_stability`), ``deep_enough``
     (h / rotor top >= :data:`MIN_H_OVER_ROTOR_TOP`), ``rossby_in_range`` (within
     ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three), and
-    ``at_rest`` (a calm condition: no boundary layer, its columns NaN).
+    ``at_rest`` (a calm condition: no boundary layer, its columns NaN), and
+    ``farm_coupling_beyond_paper`` (:func:`farm_coupling_beyond_paper`: the same for every
+    condition).
 
     Raises:
         ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
@@ -211,7 +219,19 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         "deep_enough": deep,
         "rossby_in_range": in_range,
         "inside_envelope": validated & deep & in_range,
+        "farm_coupling_beyond_paper": farm_coupling_beyond_paper(core),
     }), rest)
+
+
+def farm_coupling_beyond_paper(core) -> bool:
+    """Whether the farm's waked rotors go through the package's farm coupling, beyond the
+    paper's single-wake validation: more than one turbine and the ekman_veer or bastankhah2014
+    velocity model with the upstream wakes' added turbulence in k_w (``wake_expansion`` other
+    than ``ambient``) or the incoming-speed deficits (docs/coupling.md#wakes-deep-in-an-array)."""
+    velocity = getattr(core.wake, "velocity_model", None)
+    if core.farm.n_turbines < 2 or not hasattr(velocity, "deficit_velocity"):
+        return False
+    return velocity.wake_expansion != "ambient" or velocity.deficit_velocity == "incoming"
 
 
 def validity_summary(report: pd.DataFrame, label: str = "") -> str:

@@ -16,6 +16,9 @@ wind speed:
     the k_w floor) are left as they are; k_w then follows from the matched I_u through
     Eq. (kw_CNBL_SBL_model).
 
+``given``
+    A case's own ``atmosphere`` block (e.g. a stable one), as a user's FLORIS input has it.
+
 FLORIS's own models run on the same inflow (the atmosphere's U(z)) with FLORIS's ambient
 turbulence intensity = I_u(z_h) of the same atmosphere, so every model sees one turbulence level.
 """
@@ -28,8 +31,10 @@ from scipy.optimize import brentq
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.wake.deficit import potential_core_length
 
-#: The two atmospheres of a case (see the module docstring).
+#: The two atmospheres of a case from its measured TI (see the module docstring).
 ATMOSPHERES = ("site", "matched")
+#: ...and the reading of a case's own atmosphere block.
+GIVEN = "given"
 #: Search range of the matched roughness length [m].
 ROUGHNESS_RANGE = (1.0e-6, 5.0)
 
@@ -39,10 +44,13 @@ def _abl(case, roughness_length: float) -> EkmanABL:
                                         roughness_length=roughness_length)
 
 
-def hub_turbulence(case, roughness_length: float) -> float:
-    """I_u(z_h) (Eq. Iu_model) of the neutral ABL with ``roughness_length`` and the case's
-    hub-height speed and latitude."""
-    abl = _abl(case, roughness_length)
+def hub_turbulence(case, roughness_length) -> float:
+    """I_u(z_h) (Eq. Iu_model) of the case's atmosphere at its hub-height speed and latitude:
+    the neutral ABL with ``roughness_length`` [m], or an ``atmosphere`` block (dict)."""
+    if isinstance(roughness_length, dict):
+        abl = EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, **roughness_length)
+    else:
+        abl = _abl(case, roughness_length)
     return float(abl.turbulence_intensity(case.hub_height, reference_height=case.hub_height))
 
 
@@ -72,9 +80,13 @@ def matched_roughness(case) -> float:
 
 
 def atmosphere(case, reading: str) -> dict:
-    """The ``ekman_veer.atmosphere`` input block of ``case`` for ``reading`` (``site`` or
-    ``matched``)."""
+    """The ``ekman_veer.atmosphere`` input block of ``case`` for ``reading`` (``site``,
+    ``matched`` or, for a case with its own atmosphere, ``given``)."""
+    if reading == GIVEN:
+        if getattr(case, "atmosphere", None) is None:
+            raise ValueError(f"{case.name}: reading {GIVEN!r} needs the case's atmosphere block")
+        return dict(case.atmosphere)
     if reading not in ATMOSPHERES:
-        raise ValueError(f"reading must be one of {ATMOSPHERES}, got {reading!r}")
+        raise ValueError(f"reading must be one of {ATMOSPHERES + (GIVEN,)}, got {reading!r}")
     z0 = case.site_roughness if reading == "site" else matched_roughness(case)
     return {"latitude": float(case.latitude), "roughness_length": float(z0)}

@@ -1,9 +1,18 @@
-"""The validation cases and their reference data (measured, LES, RANS).
+"""Validation cases and their reference data (measured, LES, RANS): the public door for any farm.
 
-The data ship in ``floris_ekman_veer/studies/validation/data/`` (DTU PyWake's validation data, MIT
-licence; attribution and the original studies in that folder's README.md and in
-docs/validation.md#measured-wakes-and-farms). This module only reads them: each single-wake case
-is a :class:`SingleWakeCase` with its arcs, Horns Rev 1 a :class:`HornsRevCase`.
+A farm is a :class:`FarmCase`: a layout (any projected coordinates in metres), a FLORIS turbine
+(or one built from a power/C_T table by :func:`turbine_from_table`), the conditions (hub-height
+speed, hub-height streamwise TI or an atmosphere, the wind-direction uncertainty
+:class:`DirectionUncertainty`) and its measured references: :class:`RowReference` (power ratios
+along rows named by turbine indices, gaps allowed) and :class:`EfficiencyReference` (farm
+efficiency against wind direction). An isolated wake is a :class:`SingleWakeCase` with its
+:class:`Arc` s. ``validation.models`` runs any set of FLORIS models on them and
+``validation.metrics`` gives the tidy error tables (docs/validation.md#your-own-farm).
+
+The shipped cases (Horns Rev 1, Lillgrund rows B and D, six single wakes) are built here through
+the same classes from the data in ``floris_ekman_veer/studies/validation/data/`` (DTU PyWake's
+validation data, MIT licence; attribution and the original studies in that folder's README.md and
+in docs/validation.md#measured-wakes-and-farms).
 """
 
 from __future__ import annotations
@@ -58,6 +67,8 @@ class SingleWakeCase:
     latitude: float            # [deg]
     offshore: bool
     distances: tuple = field(converter=tuple)  # x/D of the arcs with any reference
+    #: The arcs' references; default: read from the shipped data by the case's name.
+    reference_arcs: tuple | None = field(default=None)
 
     @property
     def streamwise_turbulence(self) -> float:
@@ -91,8 +102,18 @@ class SingleWakeCase:
 
     @cached_property
     def arcs(self) -> tuple[Arc, ...]:
+        if self.reference_arcs is not None:
+            return tuple(self.reference_arcs)
         return tuple(Arc(x, self._measured(x), self._simulated("LES", x), self._simulated("RANS", x))
                      for x in self.distances)
+
+    @property
+    def turbine(self) -> dict:
+        return constant_thrust_turbine(self)
+
+    @property
+    def layout(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros(1), np.zeros(1)
 
 
 SINGLE_WAKE_CASES = {
@@ -108,23 +129,166 @@ SINGLE_WAKE_CASES = {
 }
 
 
-@define(frozen=True)
-class HornsRevCase:
-    """Horns Rev 1: 80 V80 turbines, wind from 270 +- 2.5 deg at 8 m/s, near neutral
-    (docs/validation.md#horns-rev-1)."""
+def turbine_from_table(name: str, rotor_diameter: float, hub_height: float, wind_speed,
+                       power, thrust_coefficient) -> dict:
+    """A FLORIS turbine definition from a power [kW] and thrust-coefficient table against wind
+    speed [m/s] (cosine-loss operation model, FLORIS's defaults for the rest), zero power and
+    thrust from 0 m/s to 0.1 m/s below the table's first speed and from 0.1 m/s above its last
+    to 50 m/s (cut-in and cut-out)."""
+    speed = np.asarray(wind_speed, dtype=float)
+    power = np.asarray(power, dtype=float)
+    thrust = np.asarray(thrust_coefficient, dtype=float)
+    if speed.ndim != 1 or speed.size < 2 or power.shape != speed.shape or thrust.shape != speed.shape:
+        raise ValueError("turbine_from_table: wind_speed, power and thrust_coefficient must be 1-D "
+                         f"tables of one length >= 2; got shapes {speed.shape}, {power.shape}, "
+                         f"{thrust.shape}")
+    if np.any(np.diff(speed) <= 0) or speed[0] <= 0.1 or speed[-1] >= 49.9:
+        raise ValueError("turbine_from_table: wind_speed must increase strictly within (0.1, 49.9) "
+                         f"m/s; got {speed.tolist()}")
+    zeros = [0.0, 0.0]
+    return _turbine(name, rotor_diameter, hub_height,
+                    np.concatenate([[0.0, speed[0] - 0.1], speed, [speed[-1] + 0.1, 50.0]]),
+                    np.concatenate([zeros, power, zeros]), np.concatenate([zeros, thrust, zeros]))
 
-    name: str = "Hornsrev1"
-    wind_speed: float = 8.0
-    wind_direction: float = 270.0
-    #: Direction bin of the measurements: the model is averaged over these integer directions.
-    direction_bin: tuple = (267.0, 268.0, 269.0, 270.0, 271.0, 272.0, 273.0)
-    turbulence: float = 0.056   # measured hub-height TI in this sector and speed bin
-    rotor_diameter: float = 80.0
-    hub_height: float = 70.0
-    latitude: float = 55.5
+
+def read_turbine_table(path) -> np.ndarray:
+    """(wind speed [m/s], power [kW], C_T) rows of a CSV table with a header line (comment lines
+    starting with # are skipped)."""
+    return _read_csv(path)
+
+
+def _read_csv(path) -> np.ndarray:
+    lines = [line for line in Path(path).read_text().splitlines() if not line.startswith("#")]
+    return np.loadtxt(lines[1:], delimiter=",", ndmin=2)
+
+
+def read_layout(path) -> tuple[np.ndarray, np.ndarray]:
+    """x (east), y (north) [m] of a CSV layout (turbine index, easting, northing; one header
+    line, # comments skipped), relative to the layout's south-west corner."""
+    data = _read_csv(path)
+    return data[:, 1] - data[:, 1].min(), data[:, 2] - data[:, 2].min()
+
+
+def read_row_measurements(path) -> np.ndarray:
+    """(position, P_i/P_1, standard error of P_i/P_1) of a measured row file (columns:
+    position, mean power (ratio), standard deviation, number of 10-min samples; NaN at a gap):
+    the mean normalised by its first turbine, the error bar std/sqrt(n) normalised alike."""
+    data = _read(path)
+    first = data[0, 1]
+    return np.column_stack([data[:, 0], data[:, 1] / first, data[:, 2] / np.sqrt(data[:, 3]) / first])
+
+
+@define(frozen=True)
+class DirectionUncertainty:
+    """Standard deviation of the wind direction at each turbine [deg]:
+    sigma = sqrt(constant^2 + (offset + growth d)^2), d the distance [m] to ``reference_turbine``
+    (growth = offset = 0: one sigma for every turbine). The measured direction is the reference
+    turbine's; van der Laan et al. (doi:10.1002/we.1804) use constant 2.5, offset 2.1,
+    growth 0.00035 1/m at Horns Rev."""
+
+    constant: float
+    growth: float = 0.0
+    offset: float = 0.0
+    reference_turbine: int = 0
+
+    def __attrs_post_init__(self):
+        for name in ("constant", "growth", "offset"):
+            value = getattr(self, name)
+            if not np.isfinite(value) or value < 0:
+                raise ValueError(f"DirectionUncertainty.{name} must be finite and >= 0; got {value!r}")
+        if self.constant == 0 and self.offset == 0:
+            raise ValueError("DirectionUncertainty: constant or offset must be > 0 (a zero sigma "
+                             "at the reference turbine); got both 0")
+
+    def sigma(self, x, y) -> np.ndarray:
+        d = np.hypot(x - x[self.reference_turbine], y - y[self.reference_turbine])
+        return np.sqrt((self.growth * d + self.offset) ** 2 + self.constant**2)
+
+
+@define(frozen=True)
+class RowReference:
+    """Measured power ratios P_i/P_1 along a row for the wind from ``wind_direction`` [deg].
+
+    ``turbines``: the turbine indices (of the case's layout) at each position of the row, first
+    the upstream one; -1 marks a gap (a position without a turbine, NaN in the tables); a 2-D
+    array (positions, rows) is a mean over parallel rows (Horns Rev's inner-row mean).
+    ``measured``: (position, P_i/P_1, standard error) per position
+    (:func:`read_row_measurements`); ``rans``: optional (position, raw, direction-averaged)."""
+
+    label: str
+    wind_direction: float
+    turbines: np.ndarray = field(converter=lambda a: np.atleast_2d(np.asarray(a, dtype=int).T).T)
+    measured: np.ndarray = field(converter=lambda a: np.asarray(a, dtype=float))
+    rans: np.ndarray | None = None
+
+    def __attrs_post_init__(self):
+        if self.measured.shape != (len(self.turbines), 3):
+            raise ValueError(f"RowReference {self.label!r}: measured must have one (position, "
+                             f"ratio, standard error) row per position ({len(self.turbines)}); "
+                             f"got shape {self.measured.shape}")
+        if self.turbines[0].min() < 0:
+            raise ValueError(f"RowReference {self.label!r}: the first position must be a turbine")
+
+    @property
+    def gaps(self) -> np.ndarray:
+        return self.turbines[:, 0] < 0
+
+
+@define(frozen=True)
+class EfficiencyReference:
+    """Farm power over n unwaked turbines' power against wind direction [deg] (``source``
+    names the reference, e.g. an LES or SCADA)."""
+
+    directions: np.ndarray = field(converter=lambda a: np.asarray(a, dtype=float))
+    efficiency: np.ndarray = field(converter=lambda a: np.asarray(a, dtype=float))
+    source: str = "reference"
+
+
+@define(frozen=True)
+class FarmCase:
+    """A farm, its conditions and its measured references (docs/validation.md#your-own-farm).
+
+    ``turbulence`` is the hub-height streamwise TI (the "matched" atmosphere reaches it, the
+    "site" one takes the roughness ``site_roughness``); or give ``atmosphere`` (an
+    ``ekman_veer.atmosphere`` block, the "given" reading). The model is averaged over the
+    wind directions ``row direction + direction_offsets`` (the measurements' bin) and, in the
+    "averaged" results, over the direction uncertainty."""
+
+    name: str
+    layout: tuple = field(converter=lambda xy: tuple(np.asarray(v, dtype=float) for v in xy))
+    turbine: dict
+    wind_speed: float
+    latitude: float
+    turbulence: float | None = None
+    direction_uncertainty: DirectionUncertainty | None = None
+    rows: tuple = field(default=(), converter=tuple)
+    efficiency: EfficiencyReference | None = None
     offshore: bool = True
-    reference_turbine: int = 6  # G2, whose direction and power the measurements refer to
-    n_rows: int = 8             # turbines per column (the rows the wind at 270 deg runs along)
+    direction_offsets: tuple = field(default=(-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0), converter=tuple)
+    atmosphere: dict | None = None
+    roughness_length: float | None = None
+
+    def __attrs_post_init__(self):
+        x, y = self.layout
+        if x.ndim != 1 or x.shape != y.shape or x.size == 0:
+            raise ValueError(f"FarmCase {self.name!r}: layout must be two 1-D arrays of one length; "
+                             f"got shapes {x.shape}, {y.shape}")
+        if self.turbulence is None and self.atmosphere is None:
+            raise ValueError(f"FarmCase {self.name!r}: give turbulence (hub-height I_u) or atmosphere")
+        if self.turbulence is not None and not 0.0 < self.turbulence < 1.0:
+            raise ValueError(f"FarmCase {self.name!r}: turbulence must be in (0, 1); got {self.turbulence!r}")
+        for row in self.rows:
+            if row.turbines.max() >= x.size:
+                raise ValueError(f"FarmCase {self.name!r}, row {row.label!r}: turbine index "
+                                 f"{row.turbines.max()} beyond the layout's {x.size} turbines")
+
+    @property
+    def rotor_diameter(self) -> float:
+        return float(self.turbine["rotor_diameter"])
+
+    @property
+    def hub_height(self) -> float:
+        return float(self.turbine["hub_height"])
 
     @property
     def streamwise_turbulence(self) -> float:
@@ -132,63 +296,66 @@ class HornsRevCase:
 
     @property
     def site_roughness(self) -> float:
-        return SEA_ROUGHNESS
-
-    @cached_property
-    def layout(self) -> tuple[np.ndarray, np.ndarray]:
-        """x (east), y (north) [m] relative to the south-west corner of the layout."""
-        data = np.loadtxt(DATA / "Hornsrev1_layout.csv", delimiter=",", skiprows=2)
-        x, y = data[:, 1], data[:, 2]
-        return x - x.min(), y - y.min()
-
-    @property
-    def inner_rows(self) -> np.ndarray:
-        """Turbine indices (n_columns, 6): the 6 inner rows of each column (index = 8 col + row)."""
-        n_columns = len(self.layout[0]) // self.n_rows
-        return np.arange(n_columns * self.n_rows).reshape(n_columns, self.n_rows)[:, 1:-1]
+        if self.roughness_length is not None:
+            return self.roughness_length
+        return SEA_ROUGHNESS if self.offshore else LAND_ROUGHNESS
 
     def direction_sigma(self) -> np.ndarray:
-        """Per-turbine standard deviation of the wind direction [deg], van der Laan et al.
-        (doi:10.1002/we.1804): sqrt((0.00035 d + 2.1)^2 + 2.5^2), d the distance to G2 [m]."""
-        x, y = self.layout
-        d = np.hypot(x - x[self.reference_turbine], y - y[self.reference_turbine])
-        return np.sqrt((0.00035 * d + 2.1) ** 2 + 2.5**2)
+        """Per-turbine standard deviation of the wind direction [deg]."""
+        return self.direction_uncertainty.sigma(*self.layout)
 
-    @cached_property
-    def measured_rows(self) -> np.ndarray:
-        """(row number, P_i/P_1, standard error of P_i/P_1): the inner-row mean normalised by its
-        first turbine, the error bar std/sqrt(n) normalised alike (as PyWake plots them)."""
-        data = _read(DATA / "Hornsrev1_WFdata_wd270_InnerRowMean.dat")
-        first = data[0, 1]
-        return np.column_stack([data[:, 0], data[:, 1] / first, data[:, 2] / np.sqrt(data[:, 3]) / first])
-
-    @cached_property
-    def rans_rows(self) -> np.ndarray:
-        """(row number, P_i/P_1 raw, P_i/P_1 direction-averaged) of EllipSys3D RANS."""
-        return _read(DATA / "Hornsrev1_RANS_wd270_InnerRowMean.dat")
-
-    @cached_property
-    def les_efficiency(self) -> np.ndarray:
-        """(wind direction [deg], farm power / (80 x unwaked power)) of the LES."""
-        return _read(DATA / "Hornsrev1_LES_WFeff.dat")
-
-    @cached_property
-    def v80_table(self) -> np.ndarray:
-        """(wind speed [m/s], power [kW], C_T) of the V80."""
-        return np.loadtxt(DATA / "V80_power_ct.csv", delimiter=",", skiprows=2)
+    @property
+    def thrust_coefficient(self) -> float:
+        """The turbine's C_T at the case's wind speed."""
+        table = self.turbine["power_thrust_table"]
+        return float(np.interp(self.wind_speed, table["wind_speed"], table["thrust_coefficient"]))
 
 
-HORNS_REV = HornsRevCase()
+
+def horns_rev() -> FarmCase:
+    """Horns Rev 1: 80 V80s, the wind from 270 +- 2.5 deg along rows 7 D apart, 8 m/s, hub TI
+    0.056, direction uncertainty of van der Laan et al. about G2 (turbine 6); the measured
+    inner-row mean with the RANS, and the LES's farm efficiency (docs/validation.md#horns-rev-1)."""
+    table = read_turbine_table(DATA / "V80_power_ct.csv")
+    columns = np.arange(80).reshape(10, 8)
+    rans = _read(DATA / "Hornsrev1_RANS_wd270_InnerRowMean.dat")
+    les = _read(DATA / "Hornsrev1_LES_WFeff.dat")
+    return FarmCase(
+        name="Hornsrev1", layout=read_layout(DATA / "Hornsrev1_layout.csv"),
+        turbine=turbine_from_table("V80", 80.0, 70.0, *table.T), wind_speed=8.0, latitude=55.5,
+        turbulence=0.056,
+        direction_uncertainty=DirectionUncertainty(2.5, growth=0.00035, offset=2.1, reference_turbine=6),
+        rows=(RowReference("inner rows", 270.0, columns[:, 1:-1],
+                           read_row_measurements(DATA / "Hornsrev1_WFdata_wd270_InnerRowMean.dat"),
+                           rans),),
+        efficiency=EfficiencyReference(les[:, 0], les[:, 1], "LES (Zong & Porte-Agel 2020)"),
+    )
 
 
-def v80_turbine() -> dict:
-    """FLORIS turbine definition of the Vestas V80 from ``V80_power_ct.csv`` (cosine-loss
-    operation model, FLORIS's defaults for the rest), zero below cut-in and above the table."""
-    table = HORNS_REV.v80_table
-    speed = np.concatenate([[0.0, 2.9], table[:, 0], [table[-1, 0] + 0.1, 50.0]])
-    power = np.concatenate([[0.0, 0.0], table[:, 1], [0.0, 0.0]])
-    thrust = np.concatenate([[0.0, 0.0], table[:, 2], [0.0, 0.0]])
-    return _turbine("V80", HORNS_REV.rotor_diameter, HORNS_REV.hub_height, speed, power, thrust)
+#: Lillgrund's rows as the measurements name them (turbine indices of Lillgrund_layout.csv,
+#: upstream first for the wind from the south-west; -1: the gap in row D).
+LILLGRUND_ROWS = {"B": (14, 13, 12, 11, 10, 9, 8, 7), "D": (29, 28, 27, -1, 26, 25, 24, 23)}
+
+
+def lillgrund() -> FarmCase:
+    """Lillgrund: 48 SWT-2.3-93s, rows B and D for the wind from 222 deg (along the rows, 4.3 D
+    apart) and 207 deg, 9 m/s, hub TI 0.048, a constant 3.3-deg direction uncertainty (the
+    published comparisons'); measured and RANS (docs/validation.md#lillgrund)."""
+    table = read_turbine_table(DATA / "SWT-2.3-93_power_ct.csv")
+    rows = []
+    for direction in (222, 207):
+        for label, turbines in LILLGRUND_ROWS.items():
+            stem = f"wd{direction}_Row{label}.dat"
+            rows.append(RowReference(
+                f"row {label}", float(direction), turbines,
+                read_row_measurements(DATA / f"Lillgrund_WFdata_{stem}"),
+                _read(DATA / f"Lillgrund_RANS_{stem}")))
+    return FarmCase(
+        name="Lillgrund", layout=read_layout(DATA / "Lillgrund_layout.csv"),
+        turbine=turbine_from_table("SWT-2.3-93", 92.6, 65.0, *table.T), wind_speed=9.0,
+        latitude=55.5, turbulence=0.048, direction_uncertainty=DirectionUncertainty(3.3),
+        rows=tuple(rows),
+    )
 
 
 def constant_thrust_turbine(case: SingleWakeCase) -> dict:
@@ -220,3 +387,9 @@ def _turbine(name, diameter, hub_height, speed, power, thrust) -> dict:
             "thrust_coefficient": [float(v) for v in thrust],
         },
     }
+
+
+HORNS_REV = horns_rev()
+LILLGRUND = lillgrund()
+#: The shipped farm cases.
+FARM_CASES = {case.name: case for case in (HORNS_REV, LILLGRUND)}

@@ -1,14 +1,15 @@
 """Error measures and tables of the validation (docs/validation.md#measured-wakes-and-farms).
 
-RMSE and bias (model minus reference) of U/U0 on the single-wake arcs, of P_i/P_1 over Horns
-Rev's rows 2-10, and of the farm efficiency against wind direction.
+RMSE and bias (model minus reference) of U/U0 on the single-wake arcs, of P_i/P_1 along a farm's
+reference rows (every position but the first and the gaps), and of the farm efficiency against
+wind direction; the tidy tables of ``validation.models`` in, tidy tables out.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
-from floris_ekman_veer.studies.validation.cases import HORNS_REV
 from floris_ekman_veer.studies.validation.models import arc_directions
 
 #: Reference kinds of a single-wake arc, in the order the tables give them.
@@ -67,16 +68,42 @@ def pooled(rows: list[dict]) -> tuple[float, float, int]:
     return float(np.sqrt(np.sum(n * rmse**2) / n.sum())), float(np.sum(n * bias) / n.sum()), int(n.sum())
 
 
-def row_errors(ratios: np.ndarray) -> tuple[float, float]:
-    """RMSE and bias of P_i/P_1 over rows 2-10 against the measured inner-row mean."""
-    return rmse_bias(ratios[1:], HORNS_REV.measured_rows[1:, 1])
+def _errors(group, value, reference, spread=None) -> pd.Series:
+    inside = group[[value, reference]].notna().all(axis=1)
+    chosen = group[inside]
+    rmse, bias = rmse_bias(chosen[value], chosen[reference])
+    result = {"n": int(inside.sum()), "rmse": rmse, "bias": bias}
+    if spread is not None:
+        # The measured means' own standard error, as an RMS over the same points: an RMSE near
+        # it is within what the measurements can tell apart.
+        result["standard_error"] = float(np.sqrt(np.mean(chosen[spread] ** 2)))
+    return pd.Series(result)
 
 
-def efficiency_errors(directions, efficiency) -> tuple[float, float]:
-    """RMSE and bias of the farm efficiency against the LES at the LES's directions."""
-    les = HORNS_REV.les_efficiency
-    model = np.interp(les[:, 0], np.asarray(directions, dtype=float), efficiency)
-    return rmse_bias(model, les[:, 1])
+def row_errors(ratios: pd.DataFrame, by=("case", "reading", "model", "kind"),
+               reference: str = "measured") -> pd.DataFrame:
+    """RMSE, bias and the measurements' standard error of P_i/P_1 (``models.row_ratios``)
+    against ``reference`` ("measured" or "rans"), over every position but each row's first and
+    its gaps, per group ``by`` (add "row" and "wind_direction" for each row alone)."""
+    waked = ratios[ratios["position"] > 1]
+    spread = "standard_error" if reference == "measured" else None
+    return (waked.groupby(list(by), sort=False)
+            .apply(_errors, "ratio", reference, spread, include_groups=False).reset_index())
+
+
+def reference_row_errors(ratios: pd.DataFrame, by=("case", "kind")) -> pd.DataFrame:
+    """The published RANS against the measurements, as :func:`row_errors` (one model's rows
+    carry them)."""
+    first = ratios[(ratios["model"] == ratios["model"].iloc[0])
+                   & (ratios["reading"] == ratios["reading"].iloc[0])]
+    return row_errors(first.assign(ratio=first["rans"]), by=by)
+
+
+def efficiency_errors(efficiency: pd.DataFrame, by=("case", "reading", "model")) -> pd.DataFrame:
+    """RMSE and bias of the farm efficiency (``models.farm_efficiency``) against its reference
+    at the reference's directions, per group ``by``."""
+    return (efficiency.groupby(list(by), sort=False)
+            .apply(_errors, "efficiency", "reference", include_groups=False).reset_index())
 
 
 def markdown(header: list[str], rows: list[list]) -> str:
