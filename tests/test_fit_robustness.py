@@ -22,8 +22,12 @@ def model_record(speed=9.0, obukhov_length=150.0):
 def test_a_light_wind_record_is_flagged_not_fatal():
     s, d = model_record()
     fit = EkmanABL.fit_profile(Z, np.vstack([s, s * 0.0056]), np.vstack([d, d]),
-                               on_misfit="flag", **SITE).profile_fit
+                               on_misfit="flag", stability="stable", **SITE).profile_fit
     assert list(fit.fits) == [True, False] and fit.misfit[1] == np.inf
+    # Of either sign (the default) a calm record is refused too, whatever its fit.
+    either = EkmanABL.fit_profile(Z, np.vstack([s, s * 0.0056]), np.vstack([d, d]),
+                                  on_misfit="flag", **SITE).profile_fit
+    assert list(either.fits) == [True, False] and either.reason(1)[0] == "calm"
     assert fit.obukhov_length[0] == pytest.approx(150.0, rel=1e-6)
     assert fit.reason(1)[0] == "calm"
     with pytest.raises(ValueError, match=r"record 1 fits no atmosphere .*calm: every speed below"):

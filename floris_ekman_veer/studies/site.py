@@ -274,7 +274,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
 #: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
 EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "missing data",
                    "calm", "falling speeds", "convective", "backing", "no top", "misfit",
-                   "two states")
+                   "physical bound", "two states")
 
 
 def _screen(records, labels, heights, speeds, directions, unknowns):
