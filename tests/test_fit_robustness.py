@@ -130,6 +130,24 @@ def test_directions_in_radians_are_refused():
                                 **SITE).profile_fit.fits.all()
 
 
+def test_one_record_in_radians_is_fitted_with_a_warning():
+    """One record cannot be refused as radians (a northerly wind veering a few degrees looks
+    alike), but its fitted veer in "degrees" is a few hundredths: DirectionUnitsWarning, once,
+    at the user's line, naming the record; the same record in degrees fits without one."""
+    import warnings
+
+    from floris_ekman_veer import DirectionUnitsWarning
+
+    s, d = model_record()
+    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(0\) all lie "
+                                                   r"within 0 to 2 pi .* veer is only 0\.\d+ deg") as seen:
+        EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
+    assert len(seen) == 1 and seen[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert EkmanABL.fit_profile(Z, s, d, **SITE).profile_fit.fits
+
+
 def test_unclear_inputs_get_messages_naming_them():
     s, d = model_record()
     with pytest.raises(ValueError, match=r"speeds hold no records"):

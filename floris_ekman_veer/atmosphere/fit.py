@@ -59,6 +59,7 @@ import attrs
 import numpy as np
 
 from floris_ekman_veer._validation import real_array, require_at
+from floris_ekman_veer.warnings import DirectionUnitsWarning, warn
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
@@ -769,6 +770,45 @@ def _check_option_names(abl_class, fixed_inputs):
             f"{valid[len(FIT_OPTIONS):]}")
 
 
+#: [deg] A fitted veer between a record's lowest and highest vane below this, with every one
+#: of its directions within 0 to 2 pi, is what directions in radians look like: a warning.
+RADIANS_VEER = 0.5
+
+
+def _warn_if_radians(fit):
+    """:class:`DirectionUnitsWarning`, once, naming the records whose directions all lie within
+    0 to 2 pi and whose fitted veer between their lowest and highest vane is below
+    :data:`RADIANS_VEER` (a real veer of a few degrees given in radians is a few hundredths
+    of a "degree"). Two records or more all in radians are refused (`_check_degrees`)."""
+    if fit.directions is None:
+        return
+    d = np.atleast_2d(fit.directions)
+    z = np.where(np.isfinite(d), np.atleast_2d(fit.heights), np.nan)
+    measured = np.sum(np.isfinite(d), axis=1) >= 2
+    within = np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1) & measured
+    if not np.any(within):
+        return
+    rows = np.flatnonzero(within)
+    low = np.nanmin(z[rows], axis=1)
+    high = np.nanmax(z[rows], axis=1)
+    direction = np.reshape(fit.direction(np.stack([low, high], axis=1)
+                                         if not fit.single else np.array([low[0], high[0]])),
+                           (-1, 2))
+    if not fit.single:
+        direction = direction[rows]
+    veer = np.abs(_wrap(direction[:, 1] - direction[:, 0]))
+    small = veer < RADIANS_VEER
+    if not np.any(small):
+        return
+    labels = [fit.labels[i] for i in rows[small]]
+    shown = ", ".join(str(k) for k in labels[:5]) + (", ..." if len(labels) > 5 else "")
+    warn(f"fit_profile: the directions of {len(labels)} record(s) ({shown}) all lie within 0 to "
+         f"2 pi and their fitted veer is only {float(veer[small][0]):.2g} deg between "
+         f"{low[small][0]:.4g} and {high[small][0]:.4g} m, as directions in radians would: "
+         "give degrees (np.degrees); a northerly wind in degrees can be given as 360 + "
+         "direction", DirectionUnitsWarning, items=[str(k) for k in labels])
+
+
 def _check_degrees(directions):
     """Directions given in radians are refused: all of them within +-2 pi in two records or
     more (a table of winds all within 6.3 deg of north). One record cannot tell: a northerly
@@ -1179,6 +1219,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         stability=stability, bound=shape(bound),
     )
     abl.profile_fit = fit
+    _warn_if_radians(fit)
     return abl
 
 
@@ -1376,7 +1417,10 @@ def _covariance(model, x, valid, fitted_depth=None):
     jtj = np.einsum("kpm,kqm->kpq", jac, jac)
     if fitted_depth is not None:
         jtj[~fitted_depth, -1, -1] = 1.0
-    cov = np.linalg.pinv(jtj)
+    # (a record whose Jacobian is not finite has no covariance: NaN, the others unaffected)
+    finite = np.all(np.isfinite(jtj), axis=(1, 2))
+    valid = valid & finite
+    cov = np.linalg.pinv(np.where(finite[:, None, None], jtj, np.eye(jtj.shape[-1])))
     if fitted_depth is not None:
         cov[~fitted_depth, -1, :] = 0.0
         cov[~fitted_depth, :, -1] = 0.0
