@@ -850,13 +850,11 @@ def _warn_if_radians(fit):
     if not np.any(within):
         return
     rows = np.flatnonzero(within)
-    low = np.nanmin(z[rows], axis=1)
-    high = np.nanmax(z[rows], axis=1)
-    direction = np.reshape(fit.direction(np.stack([low, high], axis=1)
-                                         if not fit.single else np.array([low[0], high[0]])),
-                           (-1, 2))
-    if not fit.single:
-        direction = direction[rows]
+    # (every record's lowest and highest vane: the fit's profiles are evaluated all at once)
+    anywhere = np.where(measured[:, None], z, np.atleast_2d(fit.heights)[:, :1])
+    ends = np.stack([np.nanmin(anywhere, axis=1), np.nanmax(anywhere, axis=1)], axis=1)
+    direction = np.reshape(fit.direction(ends[0] if fit.single else ends), (-1, 2))[rows]
+    low, high = ends[rows, 0], ends[rows, 1]
     veer = np.abs(_wrap(direction[:, 1] - direction[:, 0]))
     small = veer < RADIANS_VEER
     if not np.any(small):
