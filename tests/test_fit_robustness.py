@@ -132,16 +132,17 @@ def test_directions_in_radians_are_refused():
 
 def test_one_record_in_radians_is_fitted_with_a_warning():
     """One record cannot be refused as radians (a northerly wind veering a few degrees looks
-    alike), but its fitted veer in "degrees" is a few hundredths: DirectionUnitsWarning, once,
-    at the user's line, naming the record; the same record in degrees fits without one."""
+    alike), but its turning in "degrees" is a few tenths (12 deg of veer is 0.21 rad):
+    DirectionUnitsWarning, once (an either-sign fit is two fits), at the user's line, naming the
+    record; the same record in degrees fits without one."""
     import warnings
 
     from floris_ekman_veer import DirectionUnitsWarning
 
     s, d = model_record()
     with pytest.warns(DirectionUnitsWarning,
-                      match=r"directions of 1 record\(s\) \(0\) all lie within 0 to 2 pi .* "
-                            r"veer is only 0\.\d+ deg") as seen:
+                      match=r"directions of 1 record\(s\) \(0\) all lie within 0 to 2 pi and "
+                            r"turn by only 0\.21 deg between their vanes") as seen:
         EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
     assert len(seen) == 1 and seen[0].filename == __file__
     # among records in degrees, the one in radians is named
