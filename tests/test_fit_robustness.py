@@ -6,6 +6,8 @@ directions in radians, vectorised simple inputs."""
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, fit_site
 from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
@@ -223,13 +225,12 @@ def test_chunks_do_not_change_the_fits():
 MAST = (40.0, 60.0, 80.0)
 
 
+@st.composite
 def _mast_record(draw):
     """One real-looking 10-minute record of a 40-60-80 m mast: a power-law speed profile
     (shear exponent -0.1..0.6) from calm to 30 m/s at 80 m, veering or backing up to 20 deg
     per 40 m, with cup and vane noise, and perhaps a spike, a kinked cup, a stuck vane, NaN
     or a zero reading."""
-    from hypothesis import strategies as st
-
     z = np.asarray(MAST)
     hub = draw(st.one_of(st.floats(0.2, 2.0), st.floats(2.0, 30.0)))
     shear = draw(st.floats(-0.1, 0.6))
@@ -256,11 +257,10 @@ def _mast_record(draw):
     return list(speeds) + list(np.mod(directions, 360.0))
 
 
-def _records(draw):
-    from hypothesis import strategies as st
-
-    rows = draw(st.lists(st.builds(lambda: None).flatmap(lambda _: st.composite(
-        lambda d: _mast_record(d))()), min_size=1, max_size=8))
+@st.composite
+def _physical_records(draw):
+    """A batch of 1-5 drawn records after the anchor, as fit_site's table."""
+    rows = draw(st.lists(_mast_record(), min_size=1, max_size=5))
     anchor = list(8.0 * (np.asarray(MAST) / 80.0) ** 0.14) + [265.0, 266.0, 267.0]
     table = np.array([anchor] + rows)
     columns = ([f"speed_{h:.0f}m" for h in MAST] + [f"direction_{h:.0f}m" for h in MAST])
@@ -268,12 +268,6 @@ def _records(draw):
     frame.insert(0, "time", pd.date_range("2026-01-01", periods=len(frame), freq="10min")
                  .strftime("%Y-%m-%d %H:%M"))
     return frame
-
-
-def _physical_records():
-    from hypothesis import strategies as st
-
-    return st.composite(lambda draw: _records(draw))()
 
 
 def _check_site(records):
@@ -347,6 +341,4 @@ def test_random_real_looking_records_never_abort_a_site_and_stay_physical():
     kinks, stuck vanes, NaN, zero readings) through fit_site(..., stability="either",
     on_misfit="drop"): it returns, every record is fitted or named with a reason, every
     fitted state lies inside the physical domain and is accepted as the atmosphere's input."""
-    from hypothesis import given
-
     given(_physical_records())(lambda records: _check_site(records) and None)()
