@@ -416,8 +416,14 @@ class ProfileFit:
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
                                 depth, _record_sigma(self.speeds[i : i + 1], self.speed_noise),
                                 np.hypot(self.direction_noise, self.direction_model_error))[0]):
-            return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
-                                                depth[0], None, self.direction_noise)
+            kind, text = "no top", _hidden_top_reason(self.heights[i], self.speeds[i],
+                                                      directions, depth[0], None,
+                                                      self.direction_noise)
+            if self.stability == "either":
+                # (the convective fit was tried too, and missed as well)
+                text = text.replace('stability="either" fits convective layers too',
+                                    "its convective fit misses the data too")
+            return kind, text
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
                              _record_sigma(self.speeds[i], self.speed_noise),
