@@ -743,6 +743,11 @@ def _stacked_solve(a, rhs):
     finite = np.all(np.isfinite(a), axis=(1, 2)) & np.all(np.isfinite(rhs), axis=1)
     a = np.where(finite[:, None, None], a, np.eye(a.shape[-1]))
     rhs = np.where(finite[:, None], rhs, 0.0)
+    try:
+        # (the stack at once where no system is singular: the usual case, and the cheapest)
+        return np.linalg.solve(a, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        pass
     singular_values = np.linalg.svd(a, compute_uv=False)
     regular = singular_values[:, -1] > 1e-13 * singular_values[:, 0]
     x = np.zeros_like(rhs)
