@@ -74,6 +74,11 @@ class HeterogeneousInflowWarning(FlorisEkmanVeerWarning):
     docs/user_guide.md#heterogeneous-inflow)."""
 
 
+class DirectionUnitsWarning(FlorisEkmanVeerWarning):
+    """A fitted record's directions all lie within 0 to 2 pi and its fitted veer is
+    implausibly small: directions given in radians would look like this."""
+
+
 class ReferenceWindWarning(FlorisEkmanVeerWarning):
     """The reference-wind solve met some speeds only to more than its tolerance (the speed lies
     in the profile's step where the boundary-layer top crosses the reference height); the
@@ -85,7 +90,7 @@ CLASSES = {
     cls.__name__: cls
     for cls in (FlorisEkmanVeerWarning, ShallowBoundaryLayerWarning, ThrustLimitWarning,
                 ModelSettingsWarning, TurbinePlacementWarning, HeterogeneousInflowWarning,
-                ReferenceWindWarning)
+                DirectionUnitsWarning, ReferenceWindWarning)
 }
 
 

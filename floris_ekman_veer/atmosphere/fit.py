@@ -51,6 +51,7 @@ class in (imports point one way, docs/coupling.md#registry).
 
 from __future__ import annotations
 
+import contextvars
 import difflib
 import importlib
 import inspect
@@ -59,12 +60,13 @@ import attrs
 import numpy as np
 
 from floris_ekman_veer._validation import real_array, require_at
+from floris_ekman_veer.warnings import DirectionUnitsWarning, warn
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
                "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
                "turbulence_intensity", "turbulence_noise", "direction_model_error",
-               "fit_mixed_layer_height")
+               "fit_mixed_layer_height", "direction_heights")
 #: Default noise of a measured turbulence intensity, relative to its value: the order of the
 #: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
 DEFAULT_TURBULENCE_NOISE = 0.1
@@ -76,8 +78,18 @@ STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", 
 #: The signs of 1/L a fit may take (``stability``): 1/L >= 0 (stable or neutral), 1/L <= 0
 #: (convective or neutral), or either, chosen per record by the smaller misfit.
 STABILITY_CHOICES = ("stable", "convective", "either")
-#: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
-DEFAULT_SPEED_NOISE = 0.2
+#: Default noise of a 10-minute mean speed (docs/measurements.md#noise-model): (absolute [m/s],
+#: relative to the speed), sigma_U = sqrt(0.1^2 + (0.02 U)^2): the cup's calibration (about
+#: 0.05 m/s + 0.5 %) and operational class (1.7/sqrt(3) = 1.0 %, IEC 61400-12-1 class 1.7A),
+#: its mounting on a boom (0.5-1 %, IEC 61400-12-1 Annex G), the part of the 10-minute mean's
+#: sampling error not shared by the heights (about 1.3 %), and the model's own error in a
+#: profile's shape (1 %), in quadrature; 0.1 m/s of resolution and starting threshold below.
+DEFAULT_SPEED_NOISE = (0.1, 0.02)
+#: Default noise of a 10-minute mean direction [deg]: the vane's resolution (1.4 deg steps,
+#: sigma 0.4 deg), its alignment after a boom survey or the offsets estimated from the records
+#: (about 0.7 deg), the 10-minute mean's sampling (about 0.5 deg), in quadrature about 1 deg
+#: (docs/measurements.md#noise-model). A vane offset not removed is a few degrees: remove it
+#: first or state it here.
 DEFAULT_DIRECTION_NOISE = 1.0
 #: Default model error of the directions [deg], added in variance to ``direction_noise`` in the
 #: chi-square refusal only (docs/measurements.md#direction-model-error): a neutral layer with 5 deg
@@ -102,6 +114,9 @@ CONFIDENCE_CHI_SQUARE = 4.0
 DEFAULT_ROUGHNESS_START = 0.05
 #: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
 _LENGTH_SCALE = 100.0
+#: The relative slack a fitted state keeps inside the physical domain's bounds
+#: (`DomainCheck.margin`): far above the round-off of the ABL re-solved from its G.
+_DOMAIN_MARGIN = 1e-9
 _JACOBIAN_STEP = 1e-7
 _STEP_TOLERANCE = 1e-10
 
@@ -185,6 +200,12 @@ class ProfileFit:
     #: noise, not the misfit); z_i's row and column 0 where not fitted; NaN where no state
     #: (docs/measurements.md#how-well-the-data-pin-the-turbulence).
     covariance: np.ndarray | None = None
+    #: The sign of 1/L fitted: "either" (the default), "stable" or "convective".
+    stability: str = "stable"
+    #: Per record, the bound of the physical domain on which its best fit lies, where that
+    #: fit is refused ("" elsewhere): the data ask for a state beyond it
+    #: (docs/measurements.md#physical-domain).
+    bound: np.ndarray | str | None = None
 
     def turbulence_intensity_interval(self, height, reference_height=None):
         """(low, high): the fitted I_u at ``height`` (`EkmanABL.turbulence_intensity`) minus and
@@ -201,8 +222,12 @@ class ProfileFit:
         # (the stability step on the fit's own side of neutral: the two sides are two models)
         trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
             np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
-        shifted = self._intensity_at(trial.reshape(-1, p), sign, z, ref)
-        gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
+        shifted = self._intensity_at(trial.reshape(-1, p), sign, z, ref).reshape(-1, p)
+        gradient = (shifted - centre[:, None]) / step
+        # (a fit on a bound of the physical domain: the backward step, inside it)
+        backward = 2.0 * x[:, None, :] - trial
+        behind = self._intensity_at(backward.reshape(-1, p), sign, z, ref).reshape(-1, p)
+        gradient = np.where(np.isfinite(shifted), gradient, (centre[:, None] - behind) / step)
         gradient[:, 1] *= sign
         cov = np.reshape(self.covariance, (-1, p, p))
         sigma = np.sqrt(np.einsum("kp,kpq,kq->k", gradient, cov, gradient))
@@ -358,7 +383,8 @@ class ProfileFit:
             speed = np.transpose(abl.speed(z))[index]
             angle = np.transpose(abl.wind_angle(z))[index]
         r, observations, _ = _normalised_residuals(speed, angle, speeds, directions,
-                                                self.speed_noise, self.direction_noise)
+                                                _speed_sigma(speeds, self.speed_noise),
+                                                self.direction_noise)
         depth = np.reshape(np.asarray(self.mixed_layer_height_fitted, int), -1)
         depth = np.broadcast_to(depth, np.shape(self.misfit) or (1,))[index]
         return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted) - depth, 1)
@@ -366,6 +392,20 @@ class ProfileFit:
     def reason(self, i):
         """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
         for a record that fits, its kind is whatever its data look like)."""
+        reason = self._data_reason(i)
+        bound = "" if self.bound is None else str(np.reshape(self.bound, -1)[i])
+        if bound and reason[0] == "misfit":
+            # (what the data show comes first: calm, falling speeds, backing...)
+            return "physical bound", (
+                f"its best fit inside the model's physical domain lies on the bound of the "
+                f"{bound} and misses the data (misfit "
+                f"{np.reshape(self.refusal_misfit, -1)[i]:.3g}, refused above "
+                f"{np.reshape(self.misfit_tolerance, -1)[i]:.3g}): the data ask for a state "
+                "beyond it, one the atmosphere refuses as input "
+                "(docs/measurements.md#physical-domain)")
+        return reason
+
+    def _data_reason(self, i):
         hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
                                                         np.shape(self.misfit)), -1)[i])
         depth = np.reshape(self.boundary_layer_height, -1)[i : i + 1]
@@ -374,14 +414,21 @@ class ProfileFit:
                 and np.reshape(self.refusal_misfit, -1)[i]
                 <= np.reshape(self.misfit_tolerance, -1)[i]
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
-                                depth, self.speed_noise,
+                                depth, _record_sigma(self.speeds[i : i + 1], self.speed_noise),
                                 np.hypot(self.direction_noise, self.direction_model_error))[0]):
-            return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
-                                                depth[0], self.speed_noise, self.direction_noise)
+            kind, text = "no top", _hidden_top_reason(self.heights[i], self.speeds[i],
+                                                      directions, depth[0], None,
+                                                      self.direction_noise)
+            if self.stability == "either":
+                # (the convective fit was tried too, and missed as well)
+                text = text.replace('stability="either" fits convective layers too',
+                                    "its convective fit misses the data too")
+            return kind, text
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
-                             self.speed_noise, self.direction_noise, hemisphere,
-                             np.reshape(self.roughness_length, -1)[i])
+                             _record_sigma(self.speeds[i], self.speed_noise),
+                             self.direction_noise, hemisphere,
+                             np.reshape(self.roughness_length, -1)[i], self.stability)
 
     def subset(self, index):
         """The fitted EkmanABL of records ``index`` only (shape (len(index),)), with its
@@ -443,6 +490,35 @@ def _wrap(angle):
     return angle - 360.0 * np.round(angle / 360.0)
 
 
+def _noise_pair(speed_noise):
+    """(absolute [m/s], relative) of ``speed_noise``: a number is absolute alone."""
+    if np.ndim(speed_noise) == 0:
+        return float(speed_noise), 0.0
+    absolute, relative = speed_noise
+    return float(absolute), float(relative)
+
+
+def _speed_sigma(speeds, speed_noise):
+    """[m/s] the noise of each measured speed, sqrt(a^2 + (r U)^2) (a where missing)."""
+    absolute, relative = _noise_pair(speed_noise)
+    return np.hypot(absolute, relative * np.where(np.isfinite(speeds), speeds, 0.0))
+
+
+def _record_sigma(speeds, speed_noise):
+    """[m/s] per record (rows of ``speeds``), the noise at its largest speed: the scale of the
+    tests on what its data show (a speed maximum, a fall, a shear deficit)."""
+    absolute, relative = _noise_pair(speed_noise)
+    largest = np.max(np.where(np.isfinite(speeds), speeds, 0.0), axis=-1)
+    return np.hypot(absolute, relative * largest)
+
+
+def _noise_text(speed_noise):
+    absolute, relative = _noise_pair(speed_noise)
+    return (f"{absolute:g} m/s" if relative == 0 else
+            f"({absolute:g} m/s, {relative:g}): {absolute:g} m/s and {100 * relative:g} % of the "
+            "speed in quadrature")
+
+
 class _ProfileModel:
     """The model's speeds and direction changes at the data heights for unknowns
     x = (ln u*, lam = 100 m/L, [ln z0], [ln z_i]) per record, and the normalised residuals
@@ -460,7 +536,11 @@ class _ProfileModel:
         # per record where the records' signs differ (ProfileFit's states of an "either" fit).
         self.sign = np.asarray(sign, float) if np.ndim(sign) else float(sign)
         self.z, self.s, self.d = heights, speeds, directions
-        self.sigma_s, self.sigma_d = speed_noise, direction_noise
+        # the noise of each speed ((n, m), docs/measurements.md#noise-model) and per record
+        self.noise = speed_noise
+        self.sigma_s = _speed_sigma(speeds, speed_noise)
+        self.sigma_record = _record_sigma(speeds, speed_noise)
+        self.sigma_d = direction_noise
         self.ms = np.isfinite(speeds)
         self.md = None if directions is None else np.isfinite(directions)
         n = speeds.shape[0]
@@ -475,24 +555,40 @@ class _ProfileModel:
         self.f = params["f"]
         self.kappa = self.template.von_karman
         # The shallowest boundary layer the ABL class accepts (a state below it is no model state).
-        self.min_depth = float(getattr(importlib.import_module(abl_class.__module__),
-                                       "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
+        physics = importlib.import_module(abl_class.__module__)
+        self.min_depth = float(getattr(physics, "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
+        self.max_mixed_layer_height = float(getattr(physics, "MAX_MIXED_LAYER_HEIGHT", np.inf))
+        # The physical domain of the ABL's solved states (its module's `physical_domain`, the
+        # bounds `PHYSICAL_DOMAIN`), and what the implied quantities need.
+        self.physical_domain = getattr(physics, "physical_domain", None)
+        self.domain_bounds = getattr(physics, "PHYSICAL_DOMAIN", {})
+        self.heat_capacity = getattr(physics, "air_heat_capacity", None)
+        self.gravity = float(getattr(physics, "GRAVITY", 9.81))
+        self.hemisphere = np.broadcast_to(np.sign(self.template.coriolis_parameter), (n,))
 
     def fixed_at(self, index):
         return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
 
     def state(self, x, index):
         """(G, mu, z0, valid, h) for unknowns x of records ``index``."""
+        # (unbound: `_DefaultDepth` evaluates through it too)
+        return _ProfileModel._evaluate(self, x, index)[:5]
+
+    def _evaluate(self, x, index):
+        """(G, mu, z0, valid, h, where each state lies in the physical domain: a `DomainCheck`
+        of the ABL's module, or None without one) for unknowns x of records ``index``."""
         log_u = x[:, 0]
-        u_star = np.exp(log_u)
-        z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
-        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
-        mu = sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        # (a trial step may run far: its overflow is a state the validity below discards)
+        with np.errstate(all="ignore"):
+            u_star = np.exp(log_u)
+            z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
+            sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
+            mu = sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
         p = {k: v[index] for k, v in self.params.items()}
         p["value"], p["z0"] = mu, z0
-        if self.fit_mixed_layer:
-            p["zi"] = np.exp(x[:, -1])
         with np.errstate(all="ignore"):
+            if self.fit_mixed_layer:
+                p["zi"] = np.exp(x[:, -1])
             _, _, h_hat, _, b, along = self.template._state(log_u, p)
             g = u_star * np.hypot(along, b) / self.kappa
             h = h_hat * u_star / p["f"]
@@ -505,8 +601,39 @@ class _ProfileModel:
             )
             if self.fit_mixed_layer:
                 # z_i an input the ABL class accepts, whatever the sign the state takes
-                valid &= np.exp(x[:, -1]) >= 1.001 * self.min_depth
-        return g, mu, z0, valid, h
+                valid &= (np.isfinite(p["zi"]) & (p["zi"] >= 1.001 * self.min_depth)
+                          & (p["zi"] <= self.max_mixed_layer_height))
+            # inside the physical domain of the ABL's solved states (heat flux, G, the
+            # convective turning): a trial state outside it is no state the fit may reach
+            # (docs/measurements.md#physical-domain)
+            check = None
+            if self.physical_domain is not None:
+                heat_flux = (-mu * p["f"] * u_star**2 * p["theta0"] / self.gravity
+                             * self.heat_capacity(p["theta0"]))
+                angle = np.rad2deg(np.arctan2(-self.hemisphere[index] * b, along))
+                check = self.physical_domain(heat_flux, g, angle, mu)
+                # (with a margin: the ABL re-solved from G must land inside too)
+                valid &= check.inside & (check.margin > _DOMAIN_MARGIN)
+        return g, mu, z0, valid, h, check
+
+    def bound(self, x, index):
+        """Per state of unknowns x of records ``index``: the bound of the physical domain that
+        binds, as text ("sensible heat flux 800 W/m^2"), "" where none does: the state pushed a
+        little further from neutral (its 1/L times 1.02) leaves the domain across it."""
+        pushed = x.copy()
+        pushed[:, 1] *= 1.02
+        check = self._evaluate(pushed, index)[5]
+        if check is None:
+            return np.full(x.shape[0], "", dtype=object)
+        names = np.reshape(check.binding, -1)
+        text = np.full(names.size, "", dtype=object)
+        for name in set(names) - {""}:
+            low, high, unit = self.domain_bounds[name]
+            value = np.reshape(check.values[name], -1)
+            edge = np.where(value < low, low, high)
+            here = names == name
+            text[here] = [f"{name.replace('_', ' ')} {e:g} {unit}" for e in edge[here]]
+        return text
 
     def abl(self, log_u, g, mu, z0, valid, index, mixed_layer_height=None):
         """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
@@ -535,8 +662,9 @@ class _ProfileModel:
         :meth:`abl`, an invalid state evaluated at a harmless stand-in (to be discarded)."""
         g, mu, z0, valid, _ = self.state(x, index)
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl = self.abl(x[:, 0], g, mu, z0, valid, index,
-                       np.exp(x[:, -1]) if self.fit_mixed_layer else None)
+        with np.errstate(over="ignore"):
+            depth = np.exp(x[:, -1]) if self.fit_mixed_layer else None
+        abl = self.abl(x[:, 0], g, mu, z0, valid, index, depth)
         return abl, valid
 
     def residuals(self, x, index):
@@ -548,7 +676,7 @@ class _ProfileModel:
         angle = None if self.d is None else np.transpose(np.rad2deg(np.arctan2(v, u)))
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
-            self.sigma_s, self.sigma_d, offset=True)
+            self.sigma_s[index], self.sigma_d, offset=True)
         if self.turbulence is not None:
             r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
@@ -603,7 +731,31 @@ def _solve_normal(jtj, jtr, damping, x_lam, bounded):
         a[bounded, 1, :] = 0.0
         a[bounded, 1, 1] = 1.0
         rhs[bounded, 1] = fixed_step[bounded]
-    return np.linalg.solve(a, rhs[..., None])[..., 0]
+    return _stacked_solve(a, rhs)
+
+
+def _stacked_solve(a, rhs):
+    """x of a x = rhs for stacked systems (k, p, p), each record on its own: the
+    minimum-norm least-squares step (pseudo-inverse) where a record's system is singular to
+    round-off (a Jacobian of rank below p: e.g. a state whose speeds do not move with its
+    stability, the damping spent), no step where it is not finite. One record's system never
+    aborts the others' (NumPy's stacked solve raises for the whole stack)."""
+    finite = np.all(np.isfinite(a), axis=(1, 2)) & np.all(np.isfinite(rhs), axis=1)
+    a = np.where(finite[:, None, None], a, np.eye(a.shape[-1]))
+    rhs = np.where(finite[:, None], rhs, 0.0)
+    try:
+        # (the stack at once where no system is singular: the usual case, and the cheapest)
+        return np.linalg.solve(a, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        pass
+    singular_values = np.linalg.svd(a, compute_uv=False)
+    regular = singular_values[:, -1] > 1e-13 * singular_values[:, 0]
+    x = np.zeros_like(rhs)
+    if np.any(regular):
+        x[regular] = np.linalg.solve(a[regular], rhs[regular][..., None])[..., 0]
+    if not np.all(regular):
+        x[~regular] = np.einsum("kpq,kq->kp", np.linalg.pinv(a[~regular]), rhs[~regular])
+    return x
 
 
 def _jacobian(model, x, r, records):
@@ -611,9 +763,21 @@ def _jacobian(model, x, r, records):
     at unknowns x (k, p) of ``records`` (k,), all unknowns and records in one evaluation; 0
     where a step leaves the model's states."""
     k, p = x.shape
-    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
-    rt, vt, _ = model.residuals(trial, np.repeat(records, p))
-    jac = (rt.reshape(k, p, -1) - r[:, None, :]) / _JACOBIAN_STEP
+    steps = _JACOBIAN_STEP * np.eye(p)[None]
+    trial = (x[:, None, :] + steps).reshape(-1, p)
+    rows = np.repeat(records, p)
+    rt, vt, _ = model.residuals(trial, rows)
+    jac = (rt - np.repeat(r, p, axis=0)) / _JACOBIAN_STEP
+    # A state on a bound of the physical domain (or next to a collapse): its forward step
+    # leaves the model's states, the backward one gives the slope inside.
+    out = np.flatnonzero(~vt)
+    if out.size:
+        back = (x[:, None, :] - steps).reshape(-1, p)[out]
+        rb, vb, _ = model.residuals(back, rows[out])
+        jac[out] = (np.repeat(r, p, axis=0)[out] - rb) / _JACOBIAN_STEP
+        vt = vt.copy()
+        vt[out] = vb
+    jac = jac.reshape(k, p, -1)
     return np.where(vt.reshape(k, p)[:, :, None], jac, 0.0)
 
 
@@ -674,6 +838,42 @@ def _check_option_names(abl_class, fixed_inputs):
             f"{valid[len(FIT_OPTIONS):]}")
 
 
+#: [deg] A record whose directions all lie within 0 to 2 pi and spread over less than this
+#: between its vanes (a veer and a vane noise of a few hundredths of a "degree") looks like
+#: directions in radians: a warning.
+RADIANS_VEER = 0.5
+#: True inside the two fits of one ``stability="either"`` fit (which warns once, on its own).
+_ONE_OF_TWO_SIGNS = contextvars.ContextVar("one_of_two_signs", default=False)
+
+
+def _warn_if_radians(fit):
+    """:class:`DirectionUnitsWarning`, once, naming the records whose directions all lie within
+    0 to 2 pi and turn by less than :data:`RADIANS_VEER` between their vanes: a real veer of a
+    few degrees and a vane's noise, given in radians, are a few hundredths of a "degree" (in
+    degrees a vane's noise alone spreads them wider). Two records or more all in radians are
+    refused (`_check_degrees`); a northerly wind within 6.3 deg of north, steady to 0.5 deg, is
+    warned about too."""
+    if fit.directions is None:
+        return
+    d = np.atleast_2d(fit.directions)
+    measured = np.sum(np.isfinite(d), axis=1) >= 2
+    within = measured & np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1)
+    if not np.any(within):
+        return
+    rows = np.flatnonzero(within)
+    spread = np.nanmax(d[rows], axis=1) - np.nanmin(d[rows], axis=1)
+    small = spread < RADIANS_VEER
+    if not np.any(small):
+        return
+    labels = [fit.labels[i] for i in rows[small]]
+    shown = ", ".join(str(k) for k in labels[:5]) + (", ..." if len(labels) > 5 else "")
+    warn(f"fit_profile: the directions of {len(labels)} record(s) ({shown}) all lie within 0 to "
+         f"2 pi and turn by only {float(spread[small][0]):.2g} deg between their vanes, as "
+         "directions in radians would: give degrees (np.degrees); a northerly wind in degrees "
+         "can be given as 360 + direction", DirectionUnitsWarning,
+         items=[str(k) for k in labels])
+
+
 def _check_degrees(directions):
     """Directions given in radians are refused: all of them within +-2 pi in two records or
     more (a table of winds all within 6.3 deg of north). One record cannot tell: a northerly
@@ -717,6 +917,67 @@ def _checked_turbulence(turbulence_intensity, noise, n, z0, fit_roughness):
     return height, value, np.full(n, float(noise))
 
 
+def _at_direction_heights(heights, speeds, directions, direction_heights):
+    """(heights, speeds, directions) on the heights of both the speeds and the directions
+    (``fit_profile(direction_heights=...)``): the speeds NaN (missing) at a direction's height,
+    the directions NaN at a speed's. Shared heights are merged (one column per height); per-record
+    ones are put side by side."""
+    if directions is None:
+        raise ValueError("fit_profile: direction_heights is given but directions is None; give "
+                         "the directions measured at those heights")
+    z_s = real_array("heights", heights, "> 0 m")
+    z_d = real_array("direction_heights", direction_heights, "> 0 m")
+    require_at(np.isfinite(z_d) & (z_d > 0), "direction_heights", "finite and > 0 m", z_d)
+    s = real_array("speeds", speeds, "real numbers (NaN: missing)")
+    d = real_array("directions", directions, "real numbers (NaN: missing)")
+    single = s.ndim == 1
+    s, d = np.atleast_2d(s), np.atleast_2d(d)
+    if s.ndim != 2 or d.ndim != 2 or d.shape[0] != s.shape[0] or (single and directions is not None
+                                                                   and np.ndim(directions) != 1):
+        raise ValueError(f"fit_profile: directions must be (n_records, n_direction_heights) like "
+                         f"speeds (n_records, n_heights) = {np.shape(speeds)}; got shape "
+                         f"{np.shape(directions)}")
+    n, m_d = d.shape
+    if z_d.shape not in ((m_d,), (n, m_d)) or (single and z_d.ndim != 1):
+        raise ValueError(f"fit_profile: direction_heights must be (n_direction_heights,) = "
+                         f"({m_d},) or (n_records, n_direction_heights) = ({n}, {m_d}), one per "
+                         f"column of directions; got shape {z_d.shape}")
+    if z_s.ndim == 1 and z_d.ndim == 1 and z_s.shape == (s.shape[1],):
+        union = np.union1d(z_s, z_d)
+        speeds_at = np.full((n, union.size), np.nan)
+        directions_at = np.full((n, union.size), np.nan)
+        speeds_at[:, np.searchsorted(union, z_s)] = s
+        directions_at[:, np.searchsorted(union, z_d)] = d
+    else:
+        if z_s.shape not in ((s.shape[1],), s.shape):
+            return heights, speeds, directions  # (fit_profile names the wrong shape)
+        union = np.concatenate([np.broadcast_to(z_s, s.shape), np.broadcast_to(z_d, d.shape)],
+                               axis=1)
+        speeds_at = np.concatenate([s, np.full(d.shape, np.nan)], axis=1)
+        directions_at = np.concatenate([np.full(s.shape, np.nan), d], axis=1)
+    if single:
+        return union if union.ndim == 1 else union[0], speeds_at[0], directions_at[0]
+    return union, speeds_at, directions_at
+
+
+def _checked_speed_noise(speed_noise):
+    """``speed_noise`` as given if valid: a number > 0 [m/s], or (absolute [m/s] > 0, relative
+    in [0, 1)); ValueError naming it otherwise."""
+    def number(v):
+        return (not isinstance(v, bool) and isinstance(v, (int, float, np.integer, np.floating))
+                and np.isfinite(v))
+
+    if number(speed_noise) and speed_noise > 0:
+        return float(speed_noise)
+    if (isinstance(speed_noise, (tuple, list)) and len(speed_noise) == 2
+            and all(number(v) for v in speed_noise) and speed_noise[0] > 0
+            and 0 <= speed_noise[1] < 1):
+        return (float(speed_noise[0]), float(speed_noise[1]))
+    raise ValueError("fit_profile: speed_noise must be a number > 0 [m/s] or a pair (absolute "
+                     "[m/s] > 0, relative to the speed in [0, 1)), e.g. the default "
+                     f"{DEFAULT_SPEED_NOISE}; got {speed_noise!r}")
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -729,19 +990,32 @@ def _checked_data(name, value, shape=None):
 def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
-                on_misfit="raise", labels=None, max_iterations=100, stability="stable",
+                on_misfit="raise", labels=None, max_iterations=100, stability="either",
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
                 turbulence_noise=DEFAULT_TURBULENCE_NOISE,
                 direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
-                **fixed_inputs):
+                direction_heights=None, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
     Args:
         heights: [m] (n_heights,) shared by all records, or (n_records, n_heights); > z0.
         speeds: [m/s] (n_records, n_heights), or (n_heights,) for one record; > 0, NaN missing.
-        directions: [deg] meteorological, same shape (NaN missing), or None (speeds only).
-        speed_noise, direction_noise: measurement noise [m/s], [deg] weighting the residuals.
+        directions: [deg] meteorological, same shape (NaN missing), or None (speeds only);
+            with ``direction_heights``, (n_records, n_direction_heights) (or
+            (n_direction_heights,) for one record).
+        direction_heights: [m] the heights of the directions where the vanes are not at the
+            cups' heights (the usual mast: vanes a few metres below the cups), (n_dir,) shared
+            or (n_records, n_dir); each direction is fitted at its own height (the model's
+            flow angle there), no interpolation. None: the directions are at ``heights``.
+            ``ProfileFit.heights`` then holds the heights of both, the speeds NaN at a
+            direction's height and the directions NaN at a speed's.
+        speed_noise: the noise of a measured speed weighting its residual: a number [m/s], or
+            (absolute [m/s], relative): sqrt(absolute^2 + (relative U)^2) at a measured speed U;
+            default (0.1 m/s, 0.02), the noise model of 10-minute cup means
+            (docs/measurements.md#noise-model).
+        direction_noise: the noise of a measured direction [deg], default 1 (a vane whose
+            offset is removed, docs/measurements.md#noise-model).
         fit_roughness: fit z0 too (``roughness_length`` is then the starting value).
         refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
             the chi-square quantile of this upper-tail probability (degrees of freedom: data
@@ -755,12 +1029,13 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
         labels: a name per record for messages (e.g. time stamps); default its index.
         max_iterations: of the Levenberg-Marquardt iteration.
-        stability: the sign of 1/L fitted: ``"stable"`` (1/L >= 0, the default), ``"convective"``
-            (1/L <= 0: the convective layer of docs/atmosphere.md#convective-boundary-layer, its
-            mixed-layer depth a fixed ``mixed_layer_height``, else fitted where the data reach
-            it and the default elsewhere) or ``"either"``:
-            both, each record taking the sign whose fit misses its data less
-            (``ProfileFit.stability_class`` says which).
+        stability: the sign of 1/L fitted: ``"either"`` (the default: both signs, each record
+            taking the one whose fit misses its data less, ``ProfileFit.stability_class`` says
+            which: a site's days and nights alike), ``"stable"`` (1/L >= 0: stable or neutral
+            only) or ``"convective"`` (1/L <= 0: the convective layer of
+            docs/atmosphere.md#convective-boundary-layer, its mixed-layer depth a fixed
+            ``mixed_layer_height``, else fitted where the data reach it and the default
+            elsewhere).
         turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
             sigma_u divided by the measured speed at its height): ``(height, value)``, each a
             number or one per record (NaN: none for that record); an extra residual, the
@@ -785,9 +1060,14 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         :class:`ProfileFit` (unknowns, direction offset, residuals per record).
     """
     _check_option_names(abl_class, fixed_inputs)
+    if direction_heights is not None:
+        heights, speeds, directions = _at_direction_heights(heights, speeds, directions,
+                                                            direction_heights)
     if stability not in STABILITY_CHOICES:
         raise ValueError(f"fit_profile: stability must be one of {list(STABILITY_CHOICES)}; got "
                          f"{stability!r}")
+    if on_misfit not in ("raise", "flag"):
+        raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
     if stability == "either":
         return _fit_either_sign(
             abl_class, heights, speeds, directions, speed_noise=speed_noise,
@@ -837,7 +1117,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             + ": a zero reading is a calm or a stalled anemometer; give NaN (missing) there")
     if directions is not None:
         _check_degrees(directions)
-    for name, value in (("speed_noise", speed_noise), ("direction_noise", direction_noise),
+    speed_noise = _checked_speed_noise(speed_noise)
+    for name, value in (("direction_noise", direction_noise),
                         ("refusal_probability", refusal_probability)):
         upper = 1.0 if name == "refusal_probability" else np.inf
         if (isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value)
@@ -908,7 +1189,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     # z_i an unknown of convective fits where not given (docs/measurements.md#mixed-layer-depth)
     zi_stage = sign < 0 and fit_mixed_layer_height and "mixed_layer_height" not in fixed
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise), sign, turbulence)
+                          speed_noise, float(direction_noise), sign, turbulence)
     from scipy.stats import chi2
 
     dof = np.maximum(observations - n_unknowns, 1)
@@ -923,7 +1204,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 None if directions is None else directions[chunk],
                 {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
                 z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
-                float(speed_noise), float(direction_noise), sign,
+                speed_noise, float(direction_noise), sign,
                 None if turbulence is None else tuple(a[chunk] for a in turbulence),
                 fit_mixed_layer)
         part = model if chunk.size == n else part_model()
@@ -941,7 +1222,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     if np.any(zi_fitted):
         # every record's state with its z_i (fitted, or the default's own depth: the same state)
         model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array,
-                              fit_roughness, float(speed_noise), float(direction_noise), sign,
+                              fit_roughness, speed_noise, float(direction_noise), sign,
                               turbulence, True)
         # one unknown more where z_i is fitted
         dof = np.maximum(observations - n_unknowns - zi_fitted, 1)
@@ -951,7 +1232,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
-    speed_rms = np.sqrt(np.sum(r[:, :m] ** 2, axis=1) / valid_speeds) * speed_noise
+    speed_rms = np.sqrt(np.sum((r[:, :m] * model.sigma_s) ** 2, axis=1) / valid_speeds)
     if directions is None:
         direction_rms = np.full(n, np.nan)
     else:
@@ -964,18 +1245,26 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         widen[m:2 * m] = direction_noise**2 / (direction_noise**2 + direction_model_error**2)
     refusal_misfit = np.where(valid, np.sqrt(np.sum(r**2 * widen, axis=1) / dof), np.inf)
     fits = refusal_misfit <= misfit_tolerance
+    # A calm record is refused whatever its fit: below the cups' and vanes' starting speeds
+    # the readings are no profile (misfit_reason names it "calm").
+    fits &= ~(np.nanmax(np.where(np.isfinite(speeds), speeds, -np.inf), axis=1) < CALM_SPEED)
     if sign > 0:
         # A stable layer shallower than the highest measurement only where the data show its
         # top (docs/measurements.md#a-top-the-data-show).
         _, _, _, _, depth = model.state(x, index)
         # (a veer stopping is a top only beyond the directions' model error too)
-        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
+        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, model.sigma_record,
                                       float(np.hypot(direction_noise, direction_model_error))))
+    # where a refused fit lies on a bound of the physical domain: the bound that binds
+    bound = np.full(n, "", dtype=object)
+    refused = np.flatnonzero(~fits & valid)
+    if refused.size:
+        bound[refused] = model.bound(x[refused], refused)
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, refusal_misfit, model, misfit_tolerance,
                             float(refusal_probability), depth if sign > 0 else None,
-                            float(direction_model_error))
+                            float(direction_model_error), bound)
 
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
@@ -1009,15 +1298,18 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         iterations=shape(iterations), converged=shape(converged), labels=labels,
         fixed_inputs={k: (v if np.ndim(v) == 0 else shape(v)) for k, v in fixed.items()}
         | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
-        speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
+        speed_noise=speed_noise, direction_noise=float(direction_noise), single=single,
         stability_class=shape(_stability_class(obukhov)),
         misfit_tolerance=shape(misfit_tolerance), refusal_misfit=shape(refusal_misfit),
         direction_model_error=float(direction_model_error),
         mixed_layer_height=shape(mixed_layer), mixed_layer_height_fitted=shape(zi_fitted),
         covariance=shape(_covariance(model, x, valid,
                                      zi_fitted if model.fit_mixed_layer else None)),
+        stability=stability, bound=shape(bound),
     )
     abl.profile_fit = fit
+    if not _ONE_OF_TWO_SIGNS.get():
+        _warn_if_radians(fit)
     return abl
 
 
@@ -1036,11 +1328,15 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     """``fit_profile(stability="either")``: the stable and the convective fits of every record,
     each record keeping the one with the smaller misfit; refused (``on_misfit="raise"``) where
     neither passes the chi-square test, the message naming both misfits."""
-    fits = [
-        fit_profile(abl_class, heights, speeds, directions, on_misfit="flag", labels=labels,
-                    stability=sign, **options).profile_fit
-        for sign in ("stable", "convective")
-    ]
+    inner = _ONE_OF_TWO_SIGNS.set(True)
+    try:
+        fits = [
+            fit_profile(abl_class, heights, speeds, directions, on_misfit="flag", labels=labels,
+                        stability=sign, **options).profile_fit
+            for sign in ("stable", "convective")
+        ]
+    finally:
+        _ONE_OF_TWO_SIGNS.reset(inner)
     stable, convective = fits
     passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
     # Convective where it misses the data less; among equally good fits (data that do not tell
@@ -1056,6 +1352,8 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
                           "speed_noise", "direction_noise", "single", "fitted",
                           "direction_model_error"):
             chosen[field.name] = a
+        elif field.name == "stability":
+            chosen[field.name] = "either"
         elif field.name == "covariance":
             # the stable fit has no z_i unknown: its row and column 0
             a, b = np.reshape(a, (len(stable.labels), *np.shape(a)[-2:])), np.reshape(
@@ -1073,11 +1371,15 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         raise ValueError(
             f"fit_profile: record {fit.labels[i]} fits no atmosphere of the model, stable or "
             f"convective: misfit {np.atleast_1d(stable.refusal_misfit)[i]:.3g} stable, "
-            f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective (about 1 for the "
-            f"model plus the stated noise, refused above "
-            f"{np.atleast_1d(stable.misfit_tolerance)[i]:.3g}; {np.sum(~passes)} record(s) "
-            "refused); fit it with "
-            "stability='stable' for what in its data the model cannot follow"
+            f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective, about 1 for the "
+            f"model plus the stated noise (speed_noise={_noise_text(fit.speed_noise)}"
+            + ("" if fit.directions is None else
+               f", direction_noise={fit.direction_noise:g} deg with direction_model_error="
+               f"{fit.direction_model_error:g} deg")
+            + f"; refused above {np.atleast_1d(stable.misfit_tolerance)[i]:.3g}, "
+            f"refusal_probability={options['refusal_probability']:g}; {np.sum(~passes)} "
+            f"record(s) refused): {fit.reason(i)[1]}. Give on_misfit='flag' to keep the fits "
+            "and read profile_fit.fits"
         )
     mu = np.asarray(fit.stability_parameter, float)
     valid = np.isfinite(np.asarray(fit.geostrophic_wind, float))
@@ -1092,6 +1394,7 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     fit.abl = abl
     fit.boundary_layer_height = np.asarray(abl.boundary_layer_height)
     abl.profile_fit = fit
+    _warn_if_radians(fit)
     return abl
 
 
@@ -1209,7 +1512,10 @@ def _covariance(model, x, valid, fitted_depth=None):
     jtj = np.einsum("kpm,kqm->kpq", jac, jac)
     if fitted_depth is not None:
         jtj[~fitted_depth, -1, -1] = 1.0
-    cov = np.linalg.pinv(jtj)
+    # (a record whose Jacobian is not finite has no covariance: NaN, the others unaffected)
+    finite = np.all(np.isfinite(jtj), axis=(1, 2))
+    valid = valid & finite
+    cov = np.linalg.pinv(np.where(finite[:, None, None], jtj, np.eye(jtj.shape[-1])))
     if fitted_depth is not None:
         cov[~fitted_depth, -1, :] = 0.0
         cov[~fitted_depth, :, -1] = 0.0
@@ -1263,7 +1569,7 @@ def _fit_mixed_layer(model, x, cost, converged, iterations, refused_cost, max_it
     better = cost2 < cost[candidates] - CONFIDENCE_CHI_SQUARE
     d = None if model.d is None else model.d[candidates]
     shown = ~_hidden_top(model.z[candidates], model.s[candidates], d,
-                         np.where(reached, h, np.inf), model.sigma_s,
+                         np.where(reached, h, np.inf), model.sigma_record[candidates],
                          float(np.hypot(model.sigma_d, model_error)))
     keep = reached & better & shown
     chosen = candidates[keep]
@@ -1298,16 +1604,15 @@ CALM_SPEED = 1.0
 
 
 def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hemisphere,
-                  roughness_length):
+                  roughness_length, stability="stable"):
     """(kind, text): why one record (heights, speeds, directions or None: its data) fits no
     atmosphere of the model, as a person reads it. ``hemisphere``: the sign of the Coriolis
     parameter.
 
     Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``falling speeds``,
-    ``convective``
-    (less shear between the lowest and highest speeds than the neutral surface layer's log
-    law, by more than three standard deviations of the noise: an unstable layer, a class the
-    model does not have), ``backing`` (the direction turns the other way than an Ekman layer),
+    ``convective`` (``stability="stable"`` only: less shear between the lowest and highest
+    speeds than the neutral surface layer's log law, by more than three standard deviations of
+    the noise: an unstable layer, a class the stable fit does not have), ``backing`` (the direction turns the other way than an Ekman layer),
     ``misfit``.
     """
     order = np.argsort(heights)
@@ -1330,7 +1635,7 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
     if zs.size >= 2 and ss[0] > 0:
         log_law = np.log(zs[-1] / roughness_length) / np.log(zs[0] / roughness_length)
         spread = 3.0 * speed_noise * np.hypot(1.0, ss[-1] / ss[0]) / ss[0]
-        if ss[-1] / ss[0] < log_law - spread:
+        if stability == "stable" and ss[-1] / ss[0] < log_law - spread:
             return "convective", (
                 f"less shear than a neutral boundary layer, the least the model has (the speed "
                 f"grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to {zs[-1]:.4g} m, the "
@@ -1385,9 +1690,17 @@ def _top_changes(heights, speeds, directions, depth):
         "below": z[rows, low] < depth,
     }
     if directions is not None:
-        d = np.where(np.isfinite(directions), directions, np.nan)
-        changes["turn_below"] = _wrap(d[rows, cross] - d[rows, low])
-        changes["turn_above"] = _wrap(d[rows, high] - d[rows, cross])
+        # (the vanes' own heights: a vane need not stand at a cup's height)
+        measured = np.isfinite(directions)
+        d = np.where(measured, directions, np.nan)
+        zd = np.where(measured, heights, np.nan)
+        low_d = np.argmin(np.where(measured, zd, np.inf), axis=1)
+        high_d = np.argmax(np.where(measured, zd, -np.inf), axis=1)
+        above_d = np.where(measured & (zd >= depth[:, None]), zd, np.inf)
+        cross_d = np.where(np.isfinite(np.min(above_d, axis=1)), np.argmin(above_d, axis=1),
+                           high_d)
+        changes["turn_below"] = _wrap(d[rows, cross_d] - d[rows, low_d])
+        changes["turn_above"] = _wrap(d[rows, high_d] - d[rows, cross_d])
     return changes
 
 
@@ -1436,15 +1749,20 @@ def _hidden_top_reason(heights, speeds, directions, depth, sigma_s, sigma_d):
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability, depth=None, model_error=0.0):
+                  model, tolerance, probability, depth=None, model_error=0.0, bound=None):
     i = int(failing[0])
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
-    _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
-                              model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
+    kind, reason = misfit_reason(heights[i], speeds[i],
+                                 None if directions is None else directions[i],
+                                 model.sigma_record[i], model.sigma_d, hemisphere, model.z0[i],
+                              "stable" if np.all(model.sign > 0) else "convective")
+    if bound is not None and bound[i] and kind == "misfit":
+        reason = (f"its best fit inside the model's physical domain lies on the bound of the "
+                  f"{bound[i]}: the data ask for a state beyond it "
+                  "(docs/measurements.md#physical-domain)")
     if depth is not None and misfit[i] <= tolerance[i]:
         d = None if directions is None else directions[i:i + 1]
-        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], model.sigma_s,
-                                    model.sigma_d)
+        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], None, model.sigma_d)
         return ValueError(
             f"fit_profile: record {labels[i]} fits no atmosphere of the model: {reason}"
             + (f"; {failing.size - 1} more record(s) fail" if failing.size > 1 else "")
@@ -1463,7 +1781,7 @@ def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direc
     return ValueError(
         f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
         f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
-        f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg"
+        f"(speed_noise={_noise_text(model.noise)}, direction_noise={model.sigma_d:g} deg"
         + (f" with direction_model_error={model_error:g} deg" if directions is not None else "")
         + "; refused "
         f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
