@@ -18,7 +18,8 @@ from floris_ekman_veer.studies.site import EXCLUSION_KINDS
 from tests.data.generate_mast_year import HEIGHTS, main as generate
 
 YEAR = Path(__file__).resolve().parent / "data" / "mast_year.csv.gz"
-SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5)
+SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5,
+            direction_offsets=None)  # (its vanes are aligned)
 #: What each true kind of record becomes: the fit's kinds it may be given (a convective hour
 #: with little shear deficit is a neutral fit, a front's slight backing may read as a misfit; a
 #: convective hour whose stable fit is a layer below the heights that its data do not show, and
@@ -82,7 +83,7 @@ def test_one_call_fits_every_fittable_record_and_names_the_others(records, site)
 
 
 def test_summary_counts_what_was_left_out_and_why(site):
-    summary = site.summary()
+    summary = site.summary().exclusions
     counts = site.excluded["kind"].value_counts()
     assert summary.loc["fitted", "records"] == len(site.labels)
     for kind, n in counts.items():
