@@ -22,7 +22,7 @@ from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit import FIT_OPTIONS
 from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
                                             read_instruments)
-from floris_ekman_veer.studies.energy import record_energy
+from floris_ekman_veer.studies.energy import energy_by_period, record_energy
 from floris_ekman_veer.plugin.inflow import set_atmosphere
 
 #: Fractions of the rotor radius at which :func:`atmosphere_from_shear_and_veer` samples the
@@ -244,13 +244,21 @@ class SiteAtmosphere:
         """:func:`~floris_ekman_veer.annual_energy` of ``fmodel`` for these records, each record
         with its fitted atmosphere (``options``: annual_energy's and the optimiser's;
         ``client=`` a ``dask.distributed.Client`` runs the chunks on its cluster, bitwise the
-        serial numbers, docs/coupling.md#annual-energy).
+        serial numbers, docs/coupling.md#annual-energy), as a site report gives it: ``table``
+        by fitted stability class (convective, neutral, stable) and the year, ``by_month``
+        the energy per month of the records' time stamps (None when the records' names are no
+        time stamps).
 
-        The classes are those of :meth:`stability`; the records run as chunks of one vectorised
-        FLORIS model each, with the per-record atmosphere block (as :meth:`apply`), never a
-        model per class."""
-        return record_energy(fmodel, self.time_series(), self.atmosphere,
-                             [str(label) for label in self.labels], optimizer_class, **options)
+        The records run as chunks of one vectorised FLORIS model each, with the per-record
+        atmosphere block (as :meth:`apply`), never a model per class."""
+        energy = record_energy(fmodel, self.time_series(), self.atmosphere,
+                               [str(label) for label in self.labels], optimizer_class,
+                               classes=list(self.stability_classes), **options)
+        times = self.timestamps()
+        if times is not None:
+            energy = attrs.evolve(energy, by_month=energy_by_period(energy,
+                                                                    times.strftime("%Y-%m")))
+        return energy
 
 
 def fit_site(records: pd.DataFrame, reference_height: float, *,
