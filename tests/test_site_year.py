@@ -18,8 +18,7 @@ from floris_ekman_veer.studies.site import EXCLUSION_KINDS
 from tests.data.generate_mast_year import HEIGHTS, main as generate
 
 YEAR = Path(__file__).resolve().parent / "data" / "mast_year.csv.gz"
-SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5,
-            direction_offsets=None)  # (its vanes are aligned)
+SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5)
 #: What each true kind of record becomes: the fit's kinds it may be given (a convective hour
 #: with little shear deficit is a neutral fit, a front's slight backing may read as a misfit; a
 #: convective hour whose stable fit is a layer below the heights that its data do not show, and

@@ -222,16 +222,35 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     cup_heights = columns.cup_heights
     speeds, speed_std, pairs = _combine_cups(records, columns, directions, vane_heights, booms,
                                              shadow_half_width, flags)
+    instruments = Instruments(cup_heights=cup_heights, speeds=speeds,
+                              speed_std=speed_std if columns.has_std else None,
+                              vane_heights=vane_heights, directions=directions, offsets=offsets,
+                              cup_pairs=pairs, flags=flags.table())
     if isinstance(direction_offsets, str) and directions is not None and vane_heights.size > 1:
-        offsets = _estimate_offsets(directions, vane_heights, speeds, cup_heights,
-                                    reference_height, neutral_turning)
-        directions = directions - offsets["offset_deg"].to_numpy()[None, :]
-    elif isinstance(direction_offsets, str):
-        offsets["source"] = "reference"
-    return Instruments(cup_heights=cup_heights, speeds=speeds,
-                       speed_std=speed_std if columns.has_std else None,
-                       vane_heights=vane_heights, directions=directions, offsets=offsets,
-                       cup_pairs=pairs, flags=flags.table())
+        instruments = with_offsets_from(instruments, strong_wind_rows(instruments,
+                                                                      reference_height),
+                                        reference_height, neutral_turning)
+    return instruments
+
+
+def strong_wind_rows(instruments: Instruments, reference_height: float) -> np.ndarray:
+    """The records whose speed at the cup height nearest the reference height is at least
+    :data:`OFFSET_MIN_SPEED` (the vane offsets' records, near-neutral by their wind)."""
+    speed = instruments.speeds[:, reference_index(instruments.cup_heights, reference_height)]
+    return np.flatnonzero(np.isfinite(speed) & (speed >= OFFSET_MIN_SPEED))
+
+
+def with_offsets_from(instruments: Instruments, rows, reference_height: float,
+                      neutral_turning) -> Instruments:
+    """``instruments`` with its vanes' offsets estimated from the records ``rows`` (module
+    docstring) in place of those it has."""
+    applied = instruments.offsets["offset_deg"].to_numpy()
+    readings = instruments.directions + applied[None, :]
+    offsets = _estimate_offsets(readings, instruments.vane_heights, instruments.speeds,
+                                instruments.cup_heights, reference_height, neutral_turning,
+                                np.asarray(rows, dtype=int))
+    return attrs.evolve(instruments, offsets=offsets,
+                        directions=readings - offsets["offset_deg"].to_numpy()[None, :])
 
 
 def _offsets_given(direction_offsets, vane_heights):
@@ -384,14 +403,16 @@ def reference_index(heights, reference_height):
 
 
 def _estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_height,
-                      neutral_turning):
-    """Vane offsets relative to the vane nearest the reference height (module docstring)."""
+                      neutral_turning, rows):
+    """Vane offsets relative to the vane nearest the reference height from the records
+    ``rows`` (module docstring)."""
     ref = reference_index(vane_heights, reference_height)
     cup = reference_index(cup_heights, reference_height)
     table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
                           "source": "reference"}, index=pd.Index(vane_heights, name="height"))
-    strong = np.isfinite(speeds[:, cup]) & (speeds[:, cup] >= OFFSET_MIN_SPEED) & np.isfinite(
-        directions[:, ref])
+    strong = np.zeros(directions.shape[0], dtype=bool)
+    strong[rows] = True
+    strong &= np.isfinite(speeds[:, cup]) & np.isfinite(directions[:, ref])
     for k, height in enumerate(vane_heights):
         if k == ref:
             continue

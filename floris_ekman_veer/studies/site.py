@@ -20,8 +20,9 @@ from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit import FIT_OPTIONS
-from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
-                                            read_instruments)
+from floris_ekman_veer.studies.mast import (OFFSET_MIN_RECORDS, SHADOW_HALF_WIDTH, mast_columns,
+                                            measured_turbulence, read_instruments,
+                                            strong_wind_rows, with_offsets_from)
 from floris_ekman_veer.studies.energy import energy_by_period, record_energy
 from floris_ekman_veer.plugin.inflow import set_atmosphere
 
@@ -336,6 +337,10 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     instruments = read_instruments(
         records, columns, float(reference_height), _neutral_turning(fit_options_and_inputs),
         booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width)
+    if (isinstance(direction_offsets, str)
+            and (instruments.offsets["source"] == "estimated").any()):
+        instruments = _offsets_from_neutral_fits(instruments, columns, float(reference_height),
+                                                 fit_options_and_inputs)
     heights, speeds, directions, speed_columns = _fit_heights(instruments, columns)
     excluded = _screen(speed_columns, labels, heights, speeds, directions,
                        3 if fit_options_and_inputs.get("fit_roughness") else 2)
@@ -432,6 +437,36 @@ def _fit_heights(instruments, columns):
     at_heights = np.full((n, heights.size), np.nan)
     at_heights[:, np.searchsorted(heights, vanes)] = directions
     return heights, speeds, at_heights, [names.get(h, f"(no cup at {h:g} m)") for h in heights]
+
+
+def _offsets_from_neutral_fits(instruments, columns, reference_height, fit_options_and_inputs):
+    """The vane offsets again from the strong-wind records the fit (either sign, the offsets of
+    the first estimate applied) finds neutral: a strong wind of a stable night turns with height
+    more than a neutral one, and would move the median (docs/measurements.md#vane-offsets)."""
+    rows = strong_wind_rows(instruments, reference_height)
+    heights, speeds, directions, _ = _fit_heights(instruments, columns)
+    speeds, directions = speeds[rows], directions[rows]
+    usable = ~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)
+    rows, speeds, directions = rows[usable], speeds[usable], directions[usable]
+    if rows.size < OFFSET_MIN_RECORDS:
+        return instruments
+    n = len(instruments.speeds)
+    inputs = {k: (np.asarray(v)[rows] if np.ndim(v) == 1 and np.size(v) == n else v)
+              for k, v in fit_options_and_inputs.items() if k not in ("stability",)}
+    if "turbulence_intensity" in inputs:
+        inputs["turbulence_intensity"] = tuple(
+            np.asarray(v, float)[rows] if np.ndim(v) == 1 else v
+            for v in inputs["turbulence_intensity"])
+    elif instruments.speed_std is not None:
+        height, intensity = measured_turbulence(instruments, reference_height)
+        inputs["turbulence_intensity"] = (height, intensity[rows])
+    fit = EkmanABL.fit_profile(heights, speeds, directions, on_misfit="flag",
+                               stability="either", **inputs).profile_fit
+    neutral = rows[np.asarray(fit.fits) & (np.asarray(fit.stability_class) == "neutral")]
+    if neutral.size < OFFSET_MIN_RECORDS:
+        return instruments
+    return with_offsets_from(instruments, neutral, reference_height,
+                             _neutral_turning(fit_options_and_inputs))
 
 
 def _neutral_turning(fit_options_and_inputs):
