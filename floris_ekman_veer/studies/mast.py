@@ -95,7 +95,8 @@ def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
         raise ValueError(f"records must be a pandas DataFrame; got {type(records).__name__}")
     booms = {} if booms is None else dict(booms)
     for name, orientation in booms.items():
-        if (isinstance(orientation, bool) or not np.isscalar(orientation)
+        if (isinstance(orientation, (bool, np.bool_))
+                or not isinstance(orientation, (int, float, np.integer, np.floating))
                 or not np.isfinite(orientation)):
             raise ValueError(f"fit_site: booms[{name!r}] must be the boom's orientation in deg "
                              f"(from the mast to the cup, clockwise from north); got "
