@@ -9,7 +9,8 @@ data model's measurement points carry ``height_m``, and the boom as its ``boom_o
   as ``booms={"a": 135.0, "b": 315.0}`` [deg, from the mast to the cup, clockwise from north];
 * ``speed_<h>m_std`` or ``speed_<h>m_<boom>_std``: the cup's standard deviation [m/s] over the
   record (Task 43's statistic ``sd``): the measured turbulence intensity sigma_u / U;
-* ``direction_<h>m``: a vane's mean direction [deg, meteorological] at its own height.
+* ``direction_<h>m``: a vane's mean direction [deg, meteorological] at its own height;
+* ``..._min``, ``..._max`` (and a vane's ``_std``): other statistics, left alone.
 
 What :func:`read_instruments` makes of them:
 
@@ -38,8 +39,13 @@ import pandas as pd
 
 #: Column names: the height in metres, a cup's boom, a cup's standard deviation.
 _NUMBER = r"(\d+(?:\.\d+)?)"
-SPEED_COLUMN = re.compile(rf"^speed_{_NUMBER}m(?:_(?!std$)([A-Za-z][A-Za-z0-9]*))?(_std)?$")
-DIRECTION_COLUMN = re.compile(rf"^direction_{_NUMBER}m$")
+#: Statistics of a record other than the mean (Task 43's statistic types): the cups' ``std`` is
+#: read; ``min`` and ``max`` and the vanes' statistics are left alone.
+STATISTICS = ("std", "min", "max")
+_STATISTIC = "|".join(STATISTICS)
+SPEED_COLUMN = re.compile(
+    rf"^speed_{_NUMBER}m(?:_(?!(?:{_STATISTIC})$)([A-Za-z][A-Za-z0-9]*))?(?:_({_STATISTIC}))?$")
+DIRECTION_COLUMN = re.compile(rf"^direction_{_NUMBER}m(?:_({_STATISTIC}))?$")
 #: Half-width [deg] of the sector around boom orientation + 180 deg in which a cup is in the
 #: mast's wake (IEC 61400-12-1 Annex G: a lattice mast's wake reaches about +-20-30 deg).
 SHADOW_HALF_WIDTH = 30.0
@@ -105,16 +111,21 @@ def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
     for column in map(str, records.columns):
         if (m := SPEED_COLUMN.match(column)):
             where = (float(m[1]), m[2])
-            (stds if m[3] else cups)[where] = column
+            if m[3] is None:
+                cups[where] = column
+            elif m[3] == "std":
+                stds[where] = column
         elif (m := DIRECTION_COLUMN.match(column)):
-            vanes[float(m[1])] = column
+            if m[2] is None:
+                vanes[float(m[1])] = column
         elif column.startswith(("speed_", "direction_")):
             unknown.append(column)
     if unknown:
         raise ValueError(
             f"records: columns {unknown} are named like measurements but read as none: name "
-            "them speed_<height>m, speed_<height>m_<boom>, speed_<height>m[_<boom>]_std or "
-            "direction_<height>m with the height a number >= 0 in metres (e.g. speed_80m_a)")
+            "them speed_<height>m, speed_<height>m_<boom>, speed_<height>m[_<boom>]_std (or _min, "
+            "_max) or direction_<height>m with the height a number >= 0 in metres (e.g. "
+            "speed_80m_a)")
     lone = sorted(set(stds) - set(cups))
     if lone:
         raise ValueError(f"records: standard-deviation columns {[stds[k] for k in lone]} have "
@@ -207,7 +218,9 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     docstring). ``neutral_turning(speeds, height, heights)``: the model's neutral direction at
     ``heights`` minus that at ``height`` [deg, meteorological] for the speeds [m/s] there."""
     booms = {} if booms is None else dict(booms)
-    if not (isinstance(shadow_half_width, (int, float)) and 0 <= shadow_half_width < 90):
+    if (isinstance(shadow_half_width, (bool, np.bool_))
+            or not isinstance(shadow_half_width, (int, float, np.integer, np.floating))
+            or not 0 <= shadow_half_width < 90):
         raise ValueError(f"fit_site: shadow_half_width must be a number in [0, 90) deg; got "
                          f"{shadow_half_width!r}")
     flags = _Flags()

@@ -3,12 +3,14 @@
 
 Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with columns
 ``speed_<height>m`` [m/s] and ``direction_<height>m`` [deg, meteorological] (e.g. ``speed_90m``,
-``direction_90m``; NaN for a missing value) and optionally a ``time`` column naming the records.
+``direction_90m``; NaN for a missing value), or a real mast's cups on booms, their standard
+deviations and vanes at their own heights (studies/mast.py, docs/measurements.md#a-real-mast),
+and optionally a ``time`` column naming the records.
 :func:`fit_site` fits every record (``EkmanABL.fit_profile``, one vectorised call) and gives, per
 record, FLORIS's inputs at the reference height: the wind speed and direction of the fitted
 profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and the atmosphere
 block with one entry per record. Driven by those wind speeds, the block gives back the fitted
-ABLs (checked when it is made).
+ABLs (checked when it is made). ``SiteAtmosphere.summary()`` reports the site.
 """
 
 from __future__ import annotations
@@ -91,7 +93,7 @@ class SiteSummary:
         ax.set_ylabel("fraction of fitted records")
         ax.set_xticks(range(0, 24, 3))
         ax.set_ylim(0.0, 1.0)
-        ax.legend(fontsize=8, loc="lower right")
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         return ax
 
     def __str__(self) -> str:
