@@ -213,10 +213,13 @@ def _remove_bad(values, columns, flags):
 
 def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_height: float,
                      neutral_turning, *, booms=None, direction_offsets="estimate",
-                     shadow_half_width: float = SHADOW_HALF_WIDTH) -> Instruments:
+                     shadow_half_width: float = SHADOW_HALF_WIDTH,
+                     labels=None) -> Instruments:
     """The records' speeds, turbulence and directions as the fit reads them (module
     docstring). ``neutral_turning(speeds, height, heights)``: the model's neutral direction at
-    ``heights`` minus that at ``height`` [deg, meteorological] for the speeds [m/s] there."""
+    ``heights`` minus that at ``height`` [deg, meteorological] for the speeds [m/s] there;
+    ``labels``: the records' names (time stamps) in the reasons (default: their rows)."""
+    labels = [str(i) for i in range(len(records))] if labels is None else list(labels)
     booms = {} if booms is None else dict(booms)
     if (isinstance(shadow_half_width, (bool, np.bool_))
             or not isinstance(shadow_half_width, (int, float, np.integer, np.floating))
@@ -229,7 +232,7 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     if vane_heights.size:
         vane_columns = [columns.vanes[h] for h in vane_heights]
         directions = _remove_bad(_numbers(records, vane_columns), vane_columns, flags)
-        directions = _unstick(directions, vane_columns, flags)
+        directions = _unstick(directions, vane_columns, flags, labels)
     offsets = _offsets_given(direction_offsets, vane_heights)
     if directions is not None:
         directions = directions - offsets["offset_deg"].to_numpy()[None, :]  # given ones
@@ -290,7 +293,7 @@ def _offsets_given(direction_offsets, vane_heights):
     return table
 
 
-def _unstick(directions, vane_columns, flags):
+def _unstick(directions, vane_columns, flags, labels):
     """Readings of vanes that repeat for STUCK_RECORDS records or more while another vane turns
     by more than STUCK_TURN (icing): removed and named."""
     n, m = directions.shape
@@ -315,7 +318,7 @@ def _unstick(directions, vane_columns, flags):
             out[rows, j] = np.nan
             flags.add(rows, vane_columns[j], "stuck vane",
                       f"the vane reads {directions[a, j]:g} deg in {b - a} records in a row "
-                      f"(rows {a} to {b - 1}) while the other vanes turn (icing): removed")
+                      f"({labels[a]} to {labels[b - 1]}) while the other vanes turn (icing): removed")
     return out
 
 

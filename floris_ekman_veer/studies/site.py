@@ -338,7 +338,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                          f"extrapolated further); got {reference_height!r} m")
     instruments = read_instruments(
         records, columns, float(reference_height), _neutral_turning(fit_options_and_inputs),
-        booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width)
+        booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width,
+        labels=labels)
     if (isinstance(direction_offsets, str)
             and (instruments.offsets["source"] == "estimated").any()):
         instruments = _offsets_from_neutral_fits(instruments, columns, float(reference_height),
