@@ -30,6 +30,7 @@ from floris_ekman_veer.studies.optimization import optimize_yaw
 from floris_ekman_veer.studies.site import fit_site
 from floris_ekman_veer.studies.validity import validity_report
 from floris_ekman_veer.warnings import (
+    DirectionUnitsWarning,
     FlorisEkmanVeerWarning,
     HeterogeneousInflowWarning,
     ModelSettingsWarning,
@@ -39,7 +40,7 @@ from floris_ekman_veer.warnings import (
     silence_warnings,
 )
 
-__all__ = ["EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
+__all__ = ["DirectionUnitsWarning", "EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
            "ModelSettingsWarning", "ParFlorisModel", "ShallowBoundaryLayerWarning",
            "ThrustLimitWarning", "TurbinePlacementWarning", "__version__", "annual_energy",
            "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings",

@@ -74,11 +74,17 @@ class HeterogeneousInflowWarning(FlorisEkmanVeerWarning):
     docs/user_guide.md#heterogeneous-inflow)."""
 
 
+class DirectionUnitsWarning(FlorisEkmanVeerWarning):
+    """A fitted record's directions all lie within 0 to 2 pi and its fitted veer is
+    implausibly small: directions given in radians would look like this."""
+
+
 #: Every warning class, by name (what ``silence_warnings`` and the environment variable take).
 CLASSES = {
     cls.__name__: cls
     for cls in (FlorisEkmanVeerWarning, ShallowBoundaryLayerWarning, ThrustLimitWarning,
-                ModelSettingsWarning, TurbinePlacementWarning, HeterogeneousInflowWarning)
+                ModelSettingsWarning, TurbinePlacementWarning, HeterogeneousInflowWarning,
+                DirectionUnitsWarning)
 }
 
 

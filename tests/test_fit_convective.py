@@ -27,7 +27,9 @@ def profiles(lengths, speed=8.0):
 
 
 def test_noise_free_profiles_of_either_sign_are_recovered_exactly():
-    lengths = [-1000.0, -300.0, -100.0, -50.0, -20.0, np.inf, 300.0, 100.0]
+    # (L = -35 m at 8 m/s: 595 W/m^2; -20 m, 1,282 W/m^2, lies outside the physical domain:
+    # test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it)
+    lengths = [-1000.0, -300.0, -100.0, -50.0, -35.0, np.inf, 300.0, 100.0]
     true, speeds, directions = profiles(lengths)
     abl = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=0.1, stability="either",
                                **SITE)
@@ -40,12 +42,37 @@ def test_noise_free_profiles_of_either_sign_are_recovered_exactly():
     assert np.all(fit.misfit < 1e-4)
 
 
+def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
+    """The model's own profile of L = -20 m at 8 m/s implies 1,282 W/m^2, beyond the sensible
+    heat flux the atmosphere accepts as input (800 W/m^2): the fit's states stay inside, its
+    best one on the bound (L = -28.16 m, whose profile the stated noise cannot tell from the
+    truth); with a noise that can, the record is refused and the bound named."""
+    true, speeds, directions = profiles([-20.0])
+    assert true.sensible_heat_flux[0] == pytest.approx(1282.0, abs=1.0)
+    fit = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
+                               **SITE).profile_fit
+    assert fit.fits and fit.stability_class == "convective"
+    assert 0.999 * 800.0 < float(fit.abl.sensible_heat_flux) <= 800.0
+    assert fit.obukhov_length == pytest.approx(-28.16, abs=0.01)
+    fine = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
+                                speed_noise=0.001, direction_noise=0.01, on_misfit="flag",
+                                **SITE).profile_fit
+    assert not fine.fits and float(fine.abl.sensible_heat_flux) <= 800.0
+    kind, text = fine.reason(0)
+    assert kind == "physical bound" and "sensible heat flux 800 W/m^2" in text
+    with pytest.raises(ValueError, match=r"record 0 .*on the bound of the sensible heat flux "
+                                         r"800 W/m\^2"):
+        EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
+                             speed_noise=0.001, direction_noise=0.01, stability="convective",
+                             **SITE)
+
+
 def test_the_stable_only_fit_cannot_follow_a_convective_layer():
-    """stability="stable" (the default) puts a convective profile at the neutral bound, with a
-    worse misfit than the convective fit; "convective" recovers it."""
+    """stability="stable" puts a convective profile at the neutral bound, with a worse misfit
+    than the convective fit; "convective" recovers it."""
     _, speeds, directions = profiles([-50.0])
     stable = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
-                                  on_misfit="flag", **SITE).profile_fit
+                                  on_misfit="flag", stability="stable", **SITE).profile_fit
     convective = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
                                       stability="convective", **SITE).profile_fit
     assert np.isinf(stable.obukhov_length) and stable.misfit > 0.5

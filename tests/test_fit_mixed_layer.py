@@ -83,7 +83,8 @@ def test_without_reach_the_default_mixed_layer_is_kept():
                                fit_mixed_layer_height=False, **SITE).profile_fit
     assert not np.any(off.mixed_layer_height_fitted)
     assert off.misfit[1] > 100 * fit.misfit[1]
-    stable = EkmanABL.fit_profile(Z, speeds, directions, on_misfit="flag", **SITE).profile_fit
+    stable = EkmanABL.fit_profile(Z, speeds, directions, on_misfit="flag", stability="stable",
+                                  **SITE).profile_fit
     assert np.all(np.isnan(stable.mixed_layer_height)) and not np.any(
         stable.mixed_layer_height_fitted)
     with pytest.raises(ValueError, match=r"fit_profile: fit_mixed_layer_height must be True or "

@@ -274,3 +274,34 @@ def test_states_set_at_their_known_friction_velocity_are_the_solved_ones():
     np.testing.assert_allclose(at.wind_angle(z), again.wind_angle(z), atol=1e-8)
     np.testing.assert_allclose(at.turbulence_intensity(z), again.turbulence_intensity(z),
                                rtol=1e-10)
+
+
+def test_directions_at_their_own_heights_are_fitted_there():
+    """Vanes 2 m below the cups (the usual mast): each direction is the model's at its own
+    height, so the model's own profile is recovered to the solver's precision, of either sign;
+    the same directions given at the cups' heights (the 2 m ignored) are a different record."""
+    vanes = MAST - 2.0
+    for speed, length in ((8.0, 150.0), (8.0, -100.0)):
+        abl = truth(speed, length)
+        s = abl.speed(MAST)
+        d = np.mod(OFFSET - abl.wind_angle(vanes), 360.0)
+        fit = EkmanABL.fit_profile(MAST, s, d, direction_heights=vanes, **SITE).profile_fit
+        assert fit.obukhov_length == pytest.approx(length, rel=1e-5)
+        assert fit.friction_velocity == pytest.approx(float(abl.friction_velocity), rel=1e-7)
+        assert fit.misfit < 1e-5 and fit.fits
+        # the heights of both, the speeds missing at the vanes' and the directions at the cups'
+        np.testing.assert_array_equal(fit.heights[0], np.sort(np.concatenate([vanes, MAST])))
+        assert np.sum(np.isfinite(fit.speeds)) == MAST.size
+        assert np.sum(np.isfinite(fit.directions)) == vanes.size
+        np.testing.assert_allclose(fit.direction(vanes)[0], d, atol=1e-6)
+    # per-record vane heights, and one vane fewer than cups
+    abl = truth(8.0, 150.0)
+    per_record = np.vstack([vanes[1:], vanes[1:] + 1.0])
+    d = np.mod(OFFSET - abl.wind_angle(per_record), 360.0)
+    fit = EkmanABL.fit_profile(MAST, np.vstack([abl.speed(MAST)] * 2), d,
+                               direction_heights=per_record, **SITE).profile_fit
+    np.testing.assert_allclose(fit.obukhov_length, 150.0, rtol=1e-5)
+    with pytest.raises(ValueError, match=r"direction_heights must be \(n_direction_heights,\)"):
+        EkmanABL.fit_profile(MAST, abl.speed(MAST), d[0], direction_heights=vanes, **SITE)
+    with pytest.raises(ValueError, match="direction_heights is given but directions is None"):
+        EkmanABL.fit_profile(MAST, abl.speed(MAST), direction_heights=vanes, **SITE)

@@ -22,8 +22,12 @@ def model_record(speed=9.0, obukhov_length=150.0):
 def test_a_light_wind_record_is_flagged_not_fatal():
     s, d = model_record()
     fit = EkmanABL.fit_profile(Z, np.vstack([s, s * 0.0056]), np.vstack([d, d]),
-                               on_misfit="flag", **SITE).profile_fit
+                               on_misfit="flag", stability="stable", **SITE).profile_fit
     assert list(fit.fits) == [True, False] and fit.misfit[1] == np.inf
+    # Of either sign (the default) a calm record is refused too, whatever its fit.
+    either = EkmanABL.fit_profile(Z, np.vstack([s, s * 0.0056]), np.vstack([d, d]),
+                                  on_misfit="flag", **SITE).profile_fit
+    assert list(either.fits) == [True, False] and either.reason(1)[0] == "calm"
     assert fit.obukhov_length[0] == pytest.approx(150.0, rel=1e-6)
     assert fit.reason(1)[0] == "calm"
     with pytest.raises(ValueError, match=r"record 1 fits no atmosphere .*calm: every speed below"):
@@ -126,6 +130,24 @@ def test_directions_in_radians_are_refused():
                                 **SITE).profile_fit.fits.all()
 
 
+def test_one_record_in_radians_is_fitted_with_a_warning():
+    """One record cannot be refused as radians (a northerly wind veering a few degrees looks
+    alike), but its fitted veer in "degrees" is a few hundredths: DirectionUnitsWarning, once,
+    at the user's line, naming the record; the same record in degrees fits without one."""
+    import warnings
+
+    from floris_ekman_veer import DirectionUnitsWarning
+
+    s, d = model_record()
+    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(0\) all lie "
+                                                   r"within 0 to 2 pi .* veer is only 0\.\d+ deg") as seen:
+        EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
+    assert len(seen) == 1 and seen[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert EkmanABL.fit_profile(Z, s, d, **SITE).profile_fit.fits
+
+
 def test_unclear_inputs_get_messages_naming_them():
     s, d = model_record()
     with pytest.raises(ValueError, match=r"speeds hold no records"):
@@ -188,3 +210,138 @@ def test_chunks_do_not_change_the_fits():
         np.testing.assert_array_equal(getattr(chunked, name), getattr(whole, name), name)
     with pytest.raises(ValueError, match=r"chunk_size must be an integer >= 1; got 0"):
         EkmanABL.fit_profile(Z, s, d, chunk_size=0, **SITE)
+
+
+# ---------------------------------------------------------------------------- property test
+#: Cup (and vane) heights of the property test's mast [m], and its anchor record: a plain
+#: neutral profile, which every drawn batch keeps (a site's year is never all calm).
+MAST = (40.0, 60.0, 80.0)
+
+
+def _mast_record(draw):
+    """One real-looking 10-minute record of a 40-60-80 m mast: a power-law speed profile
+    (shear exponent -0.1..0.6) from calm to 30 m/s at 80 m, veering or backing up to 20 deg
+    per 40 m, with cup and vane noise, and perhaps a spike, a kinked cup, a stuck vane, NaN
+    or a zero reading."""
+    from hypothesis import strategies as st
+
+    z = np.asarray(MAST)
+    hub = draw(st.one_of(st.floats(0.2, 2.0), st.floats(2.0, 30.0)))
+    shear = draw(st.floats(-0.1, 0.6))
+    veer = draw(st.floats(-20.0, 20.0))
+    direction = draw(st.floats(0.0, 360.0, exclude_max=True))
+    noise = draw(st.floats(0.0, 0.03))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    speeds = hub * (z / 80.0) ** shear * (1.0 + noise * rng.standard_normal(z.size))
+    directions = direction + veer * (z - 80.0) / 40.0 + 2.0 * rng.standard_normal(z.size)
+    effect = draw(st.sampled_from(["none", "spike", "kink", "stuck", "nan", "zero"]))
+    j = draw(st.integers(0, z.size - 1))
+    if effect == "spike":
+        speeds[j] *= draw(st.floats(0.3, 3.0))
+    elif effect == "kink":
+        speeds[j] += draw(st.floats(-3.0, 3.0))
+    elif effect == "stuck":
+        directions[j] = draw(st.sampled_from([0.0, 180.0, 359.9]))
+    elif effect == "nan":
+        speeds[j] = np.nan
+        directions[draw(st.integers(0, z.size - 1))] = np.nan
+    elif effect == "zero":
+        speeds[j] = 0.0
+    speeds = np.where(np.isfinite(speeds), np.abs(speeds), np.nan)
+    return list(speeds) + list(np.mod(directions, 360.0))
+
+
+def _records(draw):
+    from hypothesis import strategies as st
+
+    rows = draw(st.lists(st.builds(lambda: None).flatmap(lambda _: st.composite(
+        lambda d: _mast_record(d))()), min_size=1, max_size=8))
+    anchor = list(8.0 * (np.asarray(MAST) / 80.0) ** 0.14) + [265.0, 266.0, 267.0]
+    table = np.array([anchor] + rows)
+    columns = ([f"speed_{h:.0f}m" for h in MAST] + [f"direction_{h:.0f}m" for h in MAST])
+    frame = pd.DataFrame(table, columns=columns)
+    frame.insert(0, "time", pd.date_range("2026-01-01", periods=len(frame), freq="10min")
+                 .strftime("%Y-%m-%d %H:%M"))
+    return frame
+
+
+def _physical_records():
+    from hypothesis import strategies as st
+
+    return st.composite(lambda draw: _records(draw))()
+
+
+def _check_site(records):
+    """fit_site(..., stability="either", on_misfit="drop") returns, names every record it
+    leaves out with a reason, and every fitted state is one the atmosphere accepts as input."""
+    import warnings
+
+    from floris_ekman_veer.atmosphere.ekman import (MIN_BOUNDARY_LAYER_HEIGHT,
+                                                   SENSIBLE_HEAT_FLUX_RANGE)
+    from floris_ekman_veer.studies.site import EXCLUSION_KINDS
+
+    with warnings.catch_warnings():
+        # (no numpy overflow or invalid-value warning from the fit's trial states)
+        warnings.simplefilter("error", RuntimeWarning)
+        warnings.simplefilter("ignore", UserWarning)
+        site = fit_site(records, 80.0, latitude=53.3, roughness_length=0.05,
+                        stability="either", on_misfit="drop")
+    excluded = site.excluded
+    assert len(site.labels) + len(excluded) == len(records)
+    assert set(site.labels) | set(excluded["time"]) == set(records["time"])
+    assert set(excluded["kind"]) <= set(EXCLUSION_KINDS)
+    assert excluded["reason"].str.len().min() > 20 if len(excluded) else True
+    abl = site.abl
+    heat_flux = np.atleast_1d(abl.sensible_heat_flux)
+    assert np.all((heat_flux >= SENSIBLE_HEAT_FLUX_RANGE[0])
+                  & (heat_flux <= SENSIBLE_HEAT_FLUX_RANGE[1]))
+    assert np.all(np.atleast_1d(abl.boundary_layer_height) >= MIN_BOUNDARY_LAYER_HEIGHT)
+    assert np.all(np.isfinite(site.wind_speeds)) and np.all(site.wind_speeds > 0)
+    assert np.all(np.isfinite(site.turbulence_intensities))
+    # the atmosphere accepts each fitted state as input: as its heat flux, at its wind
+    again = EkmanABL(geostrophic_wind=abl.geostrophic_wind, sensible_heat_flux=heat_flux,
+                     latitude=53.3, roughness_length=0.05,
+                     **site.profile_fit._fitted_depth())
+    np.testing.assert_allclose(again.friction_velocity, abl.friction_velocity, rtol=1e-6)
+    return site
+
+
+def test_the_issues_records_that_aborted_a_site_are_fitted_or_named():
+    """The calm record whose mixed-layer stage tried z_i = inf, and the storm profile whose
+    normal equations were singular: no abort; the storm is fitted, inside the physical domain;
+    an inf reading is named by its time stamp."""
+    calm = pd.DataFrame({"time": ["2016-10-21 02:00", "2016-10-21 03:00"],
+                         "speed_40m": [7.0, 0.334], "speed_60m": [7.6, 0.214],
+                         "speed_80m": [8.0, 0.517], "direction_40m": [265.0, 276.9],
+                         "direction_60m": [266.0, 290.9], "direction_80m": [267.0, 227.2]})
+    site = _check_site(calm)
+    assert list(site.excluded["kind"]) == ["calm"]
+    assert list(site.excluded["time"]) == ["2016-10-21 03:00"]
+    z = np.arange(30.0, 151.0, 20.0)
+    storm_speeds = [23.0972, 24.3032, 25.0759, 25.6527, 26.1189, 26.5145, 26.8618]
+    storm_directions = [248.6223, 248.1136, 247.8107, 247.6787, 247.6918, 247.8291, 248.0733]
+    for stability in ("stable", "either"):
+        fit = EkmanABL.fit_profile(z, storm_speeds, storm_directions, on_misfit="flag",
+                                   latitude=52.0, roughness_length=0.05,
+                                   stability=stability).profile_fit
+        assert np.isfinite(fit.misfit)
+        assert -300.0 <= float(fit.abl.sensible_heat_flux) <= 800.0
+    bad = calm.copy()
+    bad.loc[1, "speed_60m"] = np.inf
+    site = _check_site(bad)
+    assert list(site.excluded["kind"]) == ["infinite reading"]
+    assert list(site.excluded["time"]) == ["2016-10-21 03:00"]
+    with pytest.raises(ValueError, match=r"record 2016-10-21 03:00 cannot be fitted: an infinite "
+                                         r"speed or direction reading"):
+        fit_site(bad, 80.0, latitude=53.3, roughness_length=0.05)
+
+
+def test_random_real_looking_records_never_abort_a_site_and_stay_physical():
+    """Property (hypothesis; the CI and long profiles of tests/conftest.py): batches of
+    real-looking records (calm to 30 m/s, shear -0.1..0.6, veering or backing, noise, spikes,
+    kinks, stuck vanes, NaN, zero readings) through fit_site(..., stability="either",
+    on_misfit="drop"): it returns, every record is fitted or named with a reason, every
+    fitted state lies inside the physical domain and is accepted as the atmosphere's input."""
+    from hypothesis import given
+
+    given(_physical_records())(lambda records: _check_site(records) and None)()

@@ -187,9 +187,15 @@ def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
         abl = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=shear, **SITE)
         model_shear = np.log(float(abl.speed(top) / abl.speed(bottom))) / np.log(top / bottom)
         assert model_shear == pytest.approx(shear, abs=0.01)
-    # Below the neutral shear of this roughness (0.156) no stable atmosphere is left.
+    # Below the neutral shear of this roughness (0.156) the atmosphere is convective (L of
+    # either sign by default); no stable one is left.
+    low = atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.1, **SITE)
+    assert low.profile_fit.stability_class == "convective"
+    model_shear = np.log(float(low.speed(top) / low.speed(bottom))) / np.log(top / bottom)
+    assert model_shear == pytest.approx(0.1, abs=0.01)
     with pytest.raises(ValueError, match="fits no atmosphere"):
-        atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.1, **SITE)
+        atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.1, stability="stable",
+                                       **SITE)
     # Both: at z0 = 0.05 m shear 0.3 goes with about 7.5 deg of veer, not 20.
     with pytest.raises(ValueError, match="fits no atmosphere"):
         atmosphere_from_shear_and_veer(8.0, 90.0, 126.0, shear_exponent=0.3, veer=20.0, **SITE)

@@ -59,12 +59,13 @@ import attrs
 import numpy as np
 
 from floris_ekman_veer._validation import real_array, require_at
+from floris_ekman_veer.warnings import DirectionUnitsWarning, warn
 
 #: Keyword options of the fit (all other keywords are fixed EkmanABL inputs).
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
                "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
                "turbulence_intensity", "turbulence_noise", "direction_model_error",
-               "fit_mixed_layer_height")
+               "fit_mixed_layer_height", "direction_heights")
 #: Default noise of a measured turbulence intensity, relative to its value: the order of the
 #: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
 DEFAULT_TURBULENCE_NOISE = 0.1
@@ -185,6 +186,12 @@ class ProfileFit:
     #: noise, not the misfit); z_i's row and column 0 where not fitted; NaN where no state
     #: (docs/measurements.md#how-well-the-data-pin-the-turbulence).
     covariance: np.ndarray | None = None
+    #: The sign of 1/L fitted: "either" (the default), "stable" or "convective".
+    stability: str = "stable"
+    #: Per record, the bound of the physical domain on which its best fit lies, where that
+    #: fit is refused ("" elsewhere): the data ask for a state beyond it
+    #: (docs/measurements.md#physical-domain).
+    bound: np.ndarray | str | None = None
 
     def turbulence_intensity_interval(self, height, reference_height=None):
         """(low, high): the fitted I_u at ``height`` (`EkmanABL.turbulence_intensity`) minus and
@@ -366,6 +373,20 @@ class ProfileFit:
     def reason(self, i):
         """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
         for a record that fits, its kind is whatever its data look like)."""
+        reason = self._data_reason(i)
+        bound = "" if self.bound is None else str(np.reshape(self.bound, -1)[i])
+        if bound and reason[0] == "misfit":
+            # (what the data show comes first: calm, falling speeds, backing...)
+            return "physical bound", (
+                f"its best fit inside the model's physical domain lies on the bound of the "
+                f"{bound} and misses the data (misfit "
+                f"{np.reshape(self.refusal_misfit, -1)[i]:.3g}, refused above "
+                f"{np.reshape(self.misfit_tolerance, -1)[i]:.3g}): the data ask for a state "
+                "beyond it, one the atmosphere refuses as input "
+                "(docs/measurements.md#physical-domain)")
+        return reason
+
+    def _data_reason(self, i):
         hemisphere = np.sign(np.reshape(np.broadcast_to(self.abl.coriolis_parameter,
                                                         np.shape(self.misfit)), -1)[i])
         depth = np.reshape(self.boundary_layer_height, -1)[i : i + 1]
@@ -381,7 +402,7 @@ class ProfileFit:
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
                              self.speed_noise, self.direction_noise, hemisphere,
-                             np.reshape(self.roughness_length, -1)[i])
+                             np.reshape(self.roughness_length, -1)[i], self.stability)
 
     def subset(self, index):
         """The fitted EkmanABL of records ``index`` only (shape (len(index),)), with its
@@ -475,8 +496,9 @@ class _ProfileModel:
         self.f = params["f"]
         self.kappa = self.template.von_karman
         # The shallowest boundary layer the ABL class accepts (a state below it is no model state).
-        self.min_depth = float(getattr(importlib.import_module(abl_class.__module__),
-                                       "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
+        physics = importlib.import_module(abl_class.__module__)
+        self.min_depth = float(getattr(physics, "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
+        self.domain = _PhysicalDomain(physics)
 
     def fixed_at(self, index):
         return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
@@ -484,15 +506,17 @@ class _ProfileModel:
     def state(self, x, index):
         """(G, mu, z0, valid, h) for unknowns x of records ``index``."""
         log_u = x[:, 0]
-        u_star = np.exp(log_u)
-        z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
-        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
-        mu = sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        # (a trial step may run far: its overflow is a state the validity below discards)
+        with np.errstate(all="ignore"):
+            u_star = np.exp(log_u)
+            z0 = np.exp(x[:, 2]) if self.fit_roughness else self.z0[index]
+            sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
+            mu = sign * u_star * x[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
         p = {k: v[index] for k, v in self.params.items()}
         p["value"], p["z0"] = mu, z0
-        if self.fit_mixed_layer:
-            p["zi"] = np.exp(x[:, -1])
         with np.errstate(all="ignore"):
+            if self.fit_mixed_layer:
+                p["zi"] = np.exp(x[:, -1])
             _, _, h_hat, _, b, along = self.template._state(log_u, p)
             g = u_star * np.hypot(along, b) / self.kappa
             h = h_hat * u_star / p["f"]
@@ -505,8 +529,27 @@ class _ProfileModel:
             )
             if self.fit_mixed_layer:
                 # z_i an input the ABL class accepts, whatever the sign the state takes
-                valid &= np.exp(x[:, -1]) >= 1.001 * self.min_depth
+                valid &= np.isfinite(p["zi"]) & (p["zi"] >= 1.001 * self.min_depth)
+            # inside the physical domain of the ABL's inputs (heat flux, ...): a trial state
+            # outside it is no state the fit may reach (docs/measurements.md#physical-domain)
+            valid &= self.domain.inside(u_star, mu, p)
         return g, mu, z0, valid, h
+
+    def bound(self, x, index):
+        """Per state of unknowns x of records ``index``: the bound of the physical domain that
+        binds, "" where none does: the state pushed a little further from neutral (its 1/L times
+        1.02) leaves the domain across it."""
+        pushed = x.copy()
+        pushed[:, 1] *= 1.02
+        u_star = np.exp(pushed[:, 0])
+        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
+        mu = sign * u_star * pushed[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
+        p = {k: v[index] for k, v in self.params.items()}
+        if self.fit_mixed_layer:
+            with np.errstate(over="ignore"):
+                p["zi"] = np.exp(x[:, -1])
+        with np.errstate(all="ignore"):
+            return self.domain.crossed(u_star, mu, p)
 
     def abl(self, log_u, g, mu, z0, valid, index, mixed_layer_height=None):
         """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
@@ -535,8 +578,9 @@ class _ProfileModel:
         :meth:`abl`, an invalid state evaluated at a harmless stand-in (to be discarded)."""
         g, mu, z0, valid, _ = self.state(x, index)
         z0 = np.where(valid, z0, self.z0[index] if not self.fit_roughness else 0.05)
-        abl = self.abl(x[:, 0], g, mu, z0, valid, index,
-                       np.exp(x[:, -1]) if self.fit_mixed_layer else None)
+        with np.errstate(over="ignore"):
+            depth = np.exp(x[:, -1]) if self.fit_mixed_layer else None
+        abl = self.abl(x[:, 0], g, mu, z0, valid, index, depth)
         return abl, valid
 
     def residuals(self, x, index):
@@ -552,6 +596,39 @@ class _ProfileModel:
         if self.turbulence is not None:
             r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
+
+
+class _PhysicalDomain:
+    """The physical domain of the ABL class's inputs, as the states the fit may reach: the
+    surface heat flux H = -rho c_p mu f u*^2 Theta0/g within the ABL's input range of the
+    sensible heat flux (``SENSIBLE_HEAT_FLUX_RANGE``; a fit must never hand FLORIS an
+    atmosphere the package would refuse as input, docs/measurements.md#physical-domain).
+    ``physics``: the ABL class's module."""
+
+    def __init__(self, physics):
+        self.heat_capacity = getattr(physics, "air_heat_capacity", None)
+        self.heat_flux_range = getattr(physics, "SENSIBLE_HEAT_FLUX_RANGE", (-np.inf, np.inf))
+        self.gravity = float(getattr(physics, "GRAVITY", 9.81))
+
+    def heat_flux(self, u_star, mu, p):
+        """H [W/m^2] (upward > 0) of states (u*, mu) with condition parameters p."""
+        if self.heat_capacity is None:
+            return np.zeros(np.shape(mu))
+        return (-mu * p["f"] * u_star**2 * p["theta0"] / self.gravity
+                * self.heat_capacity(p["theta0"]))
+
+    def crossed(self, u_star, mu, p):
+        """Per state: the name and value of the bound it lies beyond, "" where inside."""
+        low, high = self.heat_flux_range
+        with np.errstate(all="ignore"):
+            flux = self.heat_flux(u_star, mu, p)
+        return np.where(flux > high, f"sensible heat flux {high:g} W/m^2 (convective)",
+                        np.where(flux < low, f"sensible heat flux {low:g} W/m^2 (stable)", ""))
+
+    def inside(self, u_star, mu, p):
+        low, high = self.heat_flux_range
+        flux = self.heat_flux(u_star, mu, p)
+        return (flux >= low) & (flux <= high)
 
 
 def _turbulence_residual(abl, turbulence, index):
@@ -603,7 +680,26 @@ def _solve_normal(jtj, jtr, damping, x_lam, bounded):
         a[bounded, 1, :] = 0.0
         a[bounded, 1, 1] = 1.0
         rhs[bounded, 1] = fixed_step[bounded]
-    return np.linalg.solve(a, rhs[..., None])[..., 0]
+    return _stacked_solve(a, rhs)
+
+
+def _stacked_solve(a, rhs):
+    """x of a x = rhs for stacked systems (k, p, p), each record on its own: the
+    minimum-norm least-squares step (pseudo-inverse) where a record's system is singular to
+    round-off (a Jacobian of rank below p: e.g. a state whose speeds do not move with its
+    stability, the damping spent), no step where it is not finite. One record's system never
+    aborts the others' (NumPy's stacked solve raises for the whole stack)."""
+    finite = np.all(np.isfinite(a), axis=(1, 2)) & np.all(np.isfinite(rhs), axis=1)
+    a = np.where(finite[:, None, None], a, np.eye(a.shape[-1]))
+    rhs = np.where(finite[:, None], rhs, 0.0)
+    singular_values = np.linalg.svd(a, compute_uv=False)
+    regular = singular_values[:, -1] > 1e-13 * singular_values[:, 0]
+    x = np.zeros_like(rhs)
+    if np.any(regular):
+        x[regular] = np.linalg.solve(a[regular], rhs[regular][..., None])[..., 0]
+    if not np.all(regular):
+        x[~regular] = np.einsum("kpq,kq->kp", np.linalg.pinv(a[~regular]), rhs[~regular])
+    return x
 
 
 def _jacobian(model, x, r, records):
@@ -674,6 +770,45 @@ def _check_option_names(abl_class, fixed_inputs):
             f"{valid[len(FIT_OPTIONS):]}")
 
 
+#: [deg] A fitted veer between a record's lowest and highest vane below this, with every one
+#: of its directions within 0 to 2 pi, is what directions in radians look like: a warning.
+RADIANS_VEER = 0.5
+
+
+def _warn_if_radians(fit):
+    """:class:`DirectionUnitsWarning`, once, naming the records whose directions all lie within
+    0 to 2 pi and whose fitted veer between their lowest and highest vane is below
+    :data:`RADIANS_VEER` (a real veer of a few degrees given in radians is a few hundredths
+    of a "degree"). Two records or more all in radians are refused (`_check_degrees`)."""
+    if fit.directions is None:
+        return
+    d = np.atleast_2d(fit.directions)
+    z = np.where(np.isfinite(d), np.atleast_2d(fit.heights), np.nan)
+    measured = np.sum(np.isfinite(d), axis=1) >= 2
+    within = np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1) & measured
+    if not np.any(within):
+        return
+    rows = np.flatnonzero(within)
+    low = np.nanmin(z[rows], axis=1)
+    high = np.nanmax(z[rows], axis=1)
+    direction = np.reshape(fit.direction(np.stack([low, high], axis=1)
+                                         if not fit.single else np.array([low[0], high[0]])),
+                           (-1, 2))
+    if not fit.single:
+        direction = direction[rows]
+    veer = np.abs(_wrap(direction[:, 1] - direction[:, 0]))
+    small = veer < RADIANS_VEER
+    if not np.any(small):
+        return
+    labels = [fit.labels[i] for i in rows[small]]
+    shown = ", ".join(str(k) for k in labels[:5]) + (", ..." if len(labels) > 5 else "")
+    warn(f"fit_profile: the directions of {len(labels)} record(s) ({shown}) all lie within 0 to "
+         f"2 pi and their fitted veer is only {float(veer[small][0]):.2g} deg between "
+         f"{low[small][0]:.4g} and {high[small][0]:.4g} m, as directions in radians would: "
+         "give degrees (np.degrees); a northerly wind in degrees can be given as 360 + "
+         "direction", DirectionUnitsWarning, items=[str(k) for k in labels])
+
+
 def _check_degrees(directions):
     """Directions given in radians are refused: all of them within +-2 pi in two records or
     more (a table of winds all within 6.3 deg of north). One record cannot tell: a northerly
@@ -717,6 +852,49 @@ def _checked_turbulence(turbulence_intensity, noise, n, z0, fit_roughness):
     return height, value, np.full(n, float(noise))
 
 
+def _at_direction_heights(heights, speeds, directions, direction_heights):
+    """(heights, speeds, directions) on the heights of both the speeds and the directions
+    (``fit_profile(direction_heights=...)``): the speeds NaN (missing) at a direction's height,
+    the directions NaN at a speed's. Shared heights are merged (one column per height); per-record
+    ones are put side by side."""
+    if directions is None:
+        raise ValueError("fit_profile: direction_heights is given but directions is None; give "
+                         "the directions measured at those heights")
+    z_s = real_array("heights", heights, "> 0 m")
+    z_d = real_array("direction_heights", direction_heights, "> 0 m")
+    require_at(np.isfinite(z_d) & (z_d > 0), "direction_heights", "finite and > 0 m", z_d)
+    s = real_array("speeds", speeds, "real numbers (NaN: missing)")
+    d = real_array("directions", directions, "real numbers (NaN: missing)")
+    single = s.ndim == 1
+    s, d = np.atleast_2d(s), np.atleast_2d(d)
+    if s.ndim != 2 or d.ndim != 2 or d.shape[0] != s.shape[0] or (single and directions is not None
+                                                                   and np.ndim(directions) != 1):
+        raise ValueError(f"fit_profile: directions must be (n_records, n_direction_heights) like "
+                         f"speeds (n_records, n_heights) = {np.shape(speeds)}; got shape "
+                         f"{np.shape(directions)}")
+    n, m_d = d.shape
+    if z_d.shape not in ((m_d,), (n, m_d)) or (single and z_d.ndim != 1):
+        raise ValueError(f"fit_profile: direction_heights must be (n_direction_heights,) = "
+                         f"({m_d},) or (n_records, n_direction_heights) = ({n}, {m_d}), one per "
+                         f"column of directions; got shape {z_d.shape}")
+    if z_s.ndim == 1 and z_d.ndim == 1 and z_s.shape == (s.shape[1],):
+        union = np.union1d(z_s, z_d)
+        speeds_at = np.full((n, union.size), np.nan)
+        directions_at = np.full((n, union.size), np.nan)
+        speeds_at[:, np.searchsorted(union, z_s)] = s
+        directions_at[:, np.searchsorted(union, z_d)] = d
+    else:
+        if z_s.shape not in ((s.shape[1],), s.shape):
+            return heights, speeds, directions  # (fit_profile names the wrong shape)
+        union = np.concatenate([np.broadcast_to(z_s, s.shape), np.broadcast_to(z_d, d.shape)],
+                               axis=1)
+        speeds_at = np.concatenate([s, np.full(d.shape, np.nan)], axis=1)
+        directions_at = np.concatenate([np.full(s.shape, np.nan), d], axis=1)
+    if single:
+        return union if union.ndim == 1 else union[0], speeds_at[0], directions_at[0]
+    return union, speeds_at, directions_at
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -729,18 +907,26 @@ def _checked_data(name, value, shape=None):
 def fit_profile(abl_class, heights, speeds, directions=None, *,
                 speed_noise=DEFAULT_SPEED_NOISE, direction_noise=DEFAULT_DIRECTION_NOISE,
                 fit_roughness=False, refusal_probability=DEFAULT_REFUSAL_PROBABILITY,
-                on_misfit="raise", labels=None, max_iterations=100, stability="stable",
+                on_misfit="raise", labels=None, max_iterations=100, stability="either",
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
                 turbulence_noise=DEFAULT_TURBULENCE_NOISE,
                 direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
-                **fixed_inputs):
+                direction_heights=None, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
     Args:
         heights: [m] (n_heights,) shared by all records, or (n_records, n_heights); > z0.
         speeds: [m/s] (n_records, n_heights), or (n_heights,) for one record; > 0, NaN missing.
-        directions: [deg] meteorological, same shape (NaN missing), or None (speeds only).
+        directions: [deg] meteorological, same shape (NaN missing), or None (speeds only);
+            with ``direction_heights``, (n_records, n_direction_heights) (or
+            (n_direction_heights,) for one record).
+        direction_heights: [m] the heights of the directions where the vanes are not at the
+            cups' heights (the usual mast: vanes a few metres below the cups), (n_dir,) shared
+            or (n_records, n_dir); each direction is fitted at its own height (the model's
+            flow angle there), no interpolation. None: the directions are at ``heights``.
+            ``ProfileFit.heights`` then holds the heights of both, the speeds NaN at a
+            direction's height and the directions NaN at a speed's.
         speed_noise, direction_noise: measurement noise [m/s], [deg] weighting the residuals.
         fit_roughness: fit z0 too (``roughness_length`` is then the starting value).
         refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
@@ -755,12 +941,13 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         on_misfit: ``"raise"`` (ValueError naming the first such record) or ``"flag"``.
         labels: a name per record for messages (e.g. time stamps); default its index.
         max_iterations: of the Levenberg-Marquardt iteration.
-        stability: the sign of 1/L fitted: ``"stable"`` (1/L >= 0, the default), ``"convective"``
-            (1/L <= 0: the convective layer of docs/atmosphere.md#convective-boundary-layer, its
-            mixed-layer depth a fixed ``mixed_layer_height``, else fitted where the data reach
-            it and the default elsewhere) or ``"either"``:
-            both, each record taking the sign whose fit misses its data less
-            (``ProfileFit.stability_class`` says which).
+        stability: the sign of 1/L fitted: ``"either"`` (the default: both signs, each record
+            taking the one whose fit misses its data less, ``ProfileFit.stability_class`` says
+            which: a site's days and nights alike), ``"stable"`` (1/L >= 0: stable or neutral
+            only) or ``"convective"`` (1/L <= 0: the convective layer of
+            docs/atmosphere.md#convective-boundary-layer, its mixed-layer depth a fixed
+            ``mixed_layer_height``, else fitted where the data reach it and the default
+            elsewhere).
         turbulence_intensity: a measured streamwise turbulence intensity sigma_u/U (or
             sigma_u divided by the measured speed at its height): ``(height, value)``, each a
             number or one per record (NaN: none for that record); an extra residual, the
@@ -785,9 +972,14 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         :class:`ProfileFit` (unknowns, direction offset, residuals per record).
     """
     _check_option_names(abl_class, fixed_inputs)
+    if direction_heights is not None:
+        heights, speeds, directions = _at_direction_heights(heights, speeds, directions,
+                                                            direction_heights)
     if stability not in STABILITY_CHOICES:
         raise ValueError(f"fit_profile: stability must be one of {list(STABILITY_CHOICES)}; got "
                          f"{stability!r}")
+    if on_misfit not in ("raise", "flag"):
+        raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
     if stability == "either":
         return _fit_either_sign(
             abl_class, heights, speeds, directions, speed_noise=speed_noise,
@@ -964,6 +1156,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         widen[m:2 * m] = direction_noise**2 / (direction_noise**2 + direction_model_error**2)
     refusal_misfit = np.where(valid, np.sqrt(np.sum(r**2 * widen, axis=1) / dof), np.inf)
     fits = refusal_misfit <= misfit_tolerance
+    # A calm record is refused whatever its fit: below the cups' and vanes' starting speeds
+    # the readings are no profile (misfit_reason names it "calm").
+    fits &= ~(np.nanmax(np.where(np.isfinite(speeds), speeds, -np.inf), axis=1) < CALM_SPEED)
     if sign > 0:
         # A stable layer shallower than the highest measurement only where the data show its
         # top (docs/measurements.md#a-top-the-data-show).
@@ -971,11 +1166,16 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         # (a veer stopping is a top only beyond the directions' model error too)
         fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
                                       float(np.hypot(direction_noise, direction_model_error))))
+    # where a refused fit lies on a bound of the physical domain: the bound that binds
+    bound = np.full(n, "", dtype=object)
+    refused = np.flatnonzero(~fits & valid)
+    if refused.size:
+        bound[refused] = model.bound(x[refused], refused)
     if on_misfit == "raise" and not np.all(fits):
         raise _misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, refusal_misfit, model, misfit_tolerance,
                             float(refusal_probability), depth if sign > 0 else None,
-                            float(direction_model_error))
+                            float(direction_model_error), bound)
 
     g = np.where(valid, g, np.nan)
     safe = valid | (on_misfit == "raise")
@@ -1016,8 +1216,10 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         mixed_layer_height=shape(mixed_layer), mixed_layer_height_fitted=shape(zi_fitted),
         covariance=shape(_covariance(model, x, valid,
                                      zi_fitted if model.fit_mixed_layer else None)),
+        stability=stability, bound=shape(bound),
     )
     abl.profile_fit = fit
+    _warn_if_radians(fit)
     return abl
 
 
@@ -1056,6 +1258,8 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
                           "speed_noise", "direction_noise", "single", "fitted",
                           "direction_model_error"):
             chosen[field.name] = a
+        elif field.name == "stability":
+            chosen[field.name] = "either"
         elif field.name == "covariance":
             # the stable fit has no z_i unknown: its row and column 0
             a, b = np.reshape(a, (len(stable.labels), *np.shape(a)[-2:])), np.reshape(
@@ -1073,11 +1277,15 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         raise ValueError(
             f"fit_profile: record {fit.labels[i]} fits no atmosphere of the model, stable or "
             f"convective: misfit {np.atleast_1d(stable.refusal_misfit)[i]:.3g} stable, "
-            f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective (about 1 for the "
-            f"model plus the stated noise, refused above "
-            f"{np.atleast_1d(stable.misfit_tolerance)[i]:.3g}; {np.sum(~passes)} record(s) "
-            "refused); fit it with "
-            "stability='stable' for what in its data the model cannot follow"
+            f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective, about 1 for the "
+            f"model plus the stated noise (speed_noise={fit.speed_noise:g} m/s"
+            + ("" if fit.directions is None else
+               f", direction_noise={fit.direction_noise:g} deg with direction_model_error="
+               f"{fit.direction_model_error:g} deg")
+            + f"; refused above {np.atleast_1d(stable.misfit_tolerance)[i]:.3g}, "
+            f"refusal_probability={options['refusal_probability']:g}; {np.sum(~passes)} "
+            f"record(s) refused): {fit.reason(i)[1]}. Give on_misfit='flag' to keep the fits "
+            "and read profile_fit.fits"
         )
     mu = np.asarray(fit.stability_parameter, float)
     valid = np.isfinite(np.asarray(fit.geostrophic_wind, float))
@@ -1209,7 +1417,10 @@ def _covariance(model, x, valid, fitted_depth=None):
     jtj = np.einsum("kpm,kqm->kpq", jac, jac)
     if fitted_depth is not None:
         jtj[~fitted_depth, -1, -1] = 1.0
-    cov = np.linalg.pinv(jtj)
+    # (a record whose Jacobian is not finite has no covariance: NaN, the others unaffected)
+    finite = np.all(np.isfinite(jtj), axis=(1, 2))
+    valid = valid & finite
+    cov = np.linalg.pinv(np.where(finite[:, None, None], jtj, np.eye(jtj.shape[-1])))
     if fitted_depth is not None:
         cov[~fitted_depth, -1, :] = 0.0
         cov[~fitted_depth, :, -1] = 0.0
@@ -1298,16 +1509,15 @@ CALM_SPEED = 1.0
 
 
 def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hemisphere,
-                  roughness_length):
+                  roughness_length, stability="stable"):
     """(kind, text): why one record (heights, speeds, directions or None: its data) fits no
     atmosphere of the model, as a person reads it. ``hemisphere``: the sign of the Coriolis
     parameter.
 
     Kinds, in this order: ``calm`` (every speed below :data:`CALM_SPEED`), ``falling speeds``,
-    ``convective``
-    (less shear between the lowest and highest speeds than the neutral surface layer's log
-    law, by more than three standard deviations of the noise: an unstable layer, a class the
-    model does not have), ``backing`` (the direction turns the other way than an Ekman layer),
+    ``convective`` (``stability="stable"`` only: less shear between the lowest and highest
+    speeds than the neutral surface layer's log law, by more than three standard deviations of
+    the noise: an unstable layer, a class the stable fit does not have), ``backing`` (the direction turns the other way than an Ekman layer),
     ``misfit``.
     """
     order = np.argsort(heights)
@@ -1330,7 +1540,7 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
     if zs.size >= 2 and ss[0] > 0:
         log_law = np.log(zs[-1] / roughness_length) / np.log(zs[0] / roughness_length)
         spread = 3.0 * speed_noise * np.hypot(1.0, ss[-1] / ss[0]) / ss[0]
-        if ss[-1] / ss[0] < log_law - spread:
+        if stability == "stable" and ss[-1] / ss[0] < log_law - spread:
             return "convective", (
                 f"less shear than a neutral boundary layer, the least the model has (the speed "
                 f"grows {ss[-1] / ss[0]:.3g} times from {zs[0]:.4g} m to {zs[-1]:.4g} m, the "
@@ -1385,9 +1595,17 @@ def _top_changes(heights, speeds, directions, depth):
         "below": z[rows, low] < depth,
     }
     if directions is not None:
-        d = np.where(np.isfinite(directions), directions, np.nan)
-        changes["turn_below"] = _wrap(d[rows, cross] - d[rows, low])
-        changes["turn_above"] = _wrap(d[rows, high] - d[rows, cross])
+        # (the vanes' own heights: a vane need not stand at a cup's height)
+        measured = np.isfinite(directions)
+        d = np.where(measured, directions, np.nan)
+        zd = np.where(measured, heights, np.nan)
+        low_d = np.argmin(np.where(measured, zd, np.inf), axis=1)
+        high_d = np.argmax(np.where(measured, zd, -np.inf), axis=1)
+        above_d = np.where(measured & (zd >= depth[:, None]), zd, np.inf)
+        cross_d = np.where(np.isfinite(np.min(above_d, axis=1)), np.argmin(above_d, axis=1),
+                           high_d)
+        changes["turn_below"] = _wrap(d[rows, cross_d] - d[rows, low_d])
+        changes["turn_above"] = _wrap(d[rows, high_d] - d[rows, cross_d])
     return changes
 
 
@@ -1436,11 +1654,17 @@ def _hidden_top_reason(heights, speeds, directions, depth, sigma_s, sigma_d):
 
 
 def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direction_rms, misfit,
-                  model, tolerance, probability, depth=None, model_error=0.0):
+                  model, tolerance, probability, depth=None, model_error=0.0, bound=None):
     i = int(failing[0])
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
-    _, reason = misfit_reason(heights[i], speeds[i], None if directions is None else directions[i],
-                              model.sigma_s, model.sigma_d, hemisphere, model.z0[i])
+    kind, reason = misfit_reason(heights[i], speeds[i],
+                                 None if directions is None else directions[i],
+                                 model.sigma_s, model.sigma_d, hemisphere, model.z0[i],
+                              "stable" if np.all(model.sign > 0) else "convective")
+    if bound is not None and bound[i] and kind == "misfit":
+        reason = (f"its best fit inside the model's physical domain lies on the bound of the "
+                  f"{bound[i]}: the data ask for a state beyond it "
+                  "(docs/measurements.md#physical-domain)")
     if depth is not None and misfit[i] <= tolerance[i]:
         d = None if directions is None else directions[i:i + 1]
         reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], model.sigma_s,

@@ -419,9 +419,10 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
 
 
 #: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
-EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "zero reading", "missing data",
+EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "infinite reading",
+                   "zero reading", "missing data",
                    "calm", "falling speeds", "convective", "backing", "no top", "misfit",
-                   "two states")
+                   "physical bound", "two states")
 
 
 def _fit_heights(instruments, columns):
@@ -506,6 +507,13 @@ def _screen(speed_columns, labels, heights, speeds, directions, unknowns):
                                    f"time stamp {stamp} is given to {len(same)} records (rows "
                                    f"{', '.join(str(j) for j in same)}) with different data: "
                                    "which one is the record of that time is unknown")
+    # An infinite reading (a logger's overflow) is no measurement: named by its time stamp.
+    infinite = np.isinf(speeds) | (np.isinf(directions) if directions is not None else False)
+    for i in np.flatnonzero(np.atleast_2d(infinite).any(axis=1)):
+        if i not in excluded:
+            excluded[i] = ("infinite reading", "an infinite speed or direction reading: a "
+                           "logger or instrument fault; give NaN (missing) where a reading is "
+                           "not a measurement")
     bad = ~(np.isnan(speeds) | (speeds > 0))
     for i in np.flatnonzero(bad.any(axis=1)):
         if i in excluded:
