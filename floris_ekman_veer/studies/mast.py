@@ -14,7 +14,7 @@ data model's measurement points carry ``height_m``, and the boom as its ``boom_o
 
 What :func:`read_instruments` makes of them:
 
-* readings that are no number a cup or vane gives (inf) are removed, named ("bad reading");
+* readings that are no number a cup or vane gives (inf) are removed, named ("infinite reading");
 * redundant cups: the cup in the mast's wake (the wind from its boom's orientation + 180 deg,
   within ``shadow_half_width``; IEC 61400-12-1 Annex G) is not used, the other one is; both are
   averaged where neither is in the wake. A pair that disagrees beyond the cups' uncertainty in a
@@ -63,14 +63,14 @@ MAX_SHADOW_DEFICIT = 0.4
 PAIR_TOLERANCE = 0.03
 #: A vane repeating its reading (within its 0.1 deg resolution) this many records in a row
 #: while another vane turns by more than :data:`STUCK_TURN` is stuck.
-STUCK_RECORDS = 3
+STUCK_RECORDS = 4
 STUCK_TURN = 2.0
 #: Records from which vane offsets are estimated: the speed at the reference height from this
 #: [m/s] (near-neutral: mechanical mixing), at least :data:`OFFSET_MIN_RECORDS` of them.
 OFFSET_MIN_SPEED = 12.0
 OFFSET_MIN_RECORDS = 20
 #: What is named per value removed.
-FLAG_KINDS = ("bad reading", "cups disagree", "stuck vane")
+FLAG_KINDS = ("infinite reading", "cups disagree", "stuck vane")
 
 
 @attrs.frozen(eq=False)
@@ -200,13 +200,14 @@ class _Flags:
                           "reason": reason(int(r)) if callable(reason) else reason} for r in rows)
 
     def table(self):
-        return pd.DataFrame(self.rows, columns=["row", "column", "kind", "reason"])
+        table = pd.DataFrame(self.rows, columns=["row", "column", "kind", "reason"])
+        return table.sort_values("row", kind="stable").reset_index(drop=True)
 
 
 def _remove_bad(values, columns, flags):
     bad = np.isinf(values)
     for j in np.flatnonzero(bad.any(axis=0)):
-        flags.add(np.flatnonzero(bad[:, j]), columns[j], "bad reading",
+        flags.add(np.flatnonzero(bad[:, j]), columns[j], "infinite reading",
                   lambda r, v=values[:, j]: f"{v[r]} is no reading an instrument gives: removed")
     return np.where(bad, np.nan, values)
 

@@ -184,9 +184,10 @@ class SiteAtmosphere:
         classes = pd.Categorical(self.stability_classes, categories=STABILITY_CLASSES)
         by_hour = None
         if times is not None:
-            by_hour = pd.crosstab(pd.Index(times.hour, name="hour"),
-                                  pd.Series(classes, name="class"), dropna=False)
-            by_hour = by_hour.reindex(index=range(24), columns=list(STABILITY_CLASSES),
+            by_hour = pd.crosstab(np.asarray(times.hour), np.asarray(classes, dtype=str),
+                                  rownames=["hour"], colnames=["class"])
+            by_hour = by_hour.reindex(index=pd.RangeIndex(24, name="hour"),
+                                      columns=pd.Index(STABILITY_CLASSES, name="class"),
                                       fill_value=0)
         flags = self.flags if self.flags is not None else pd.DataFrame(
             columns=["row", "time", "column", "kind", "reason"])
@@ -308,9 +309,10 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     if on_misfit not in MISFIT_POLICIES:
         raise ValueError(f"fit_site: on_misfit must be one of {list(MISFIT_POLICIES)}; got "
                          f"{on_misfit!r}")
-    if "on_misfit" in fit_options_and_inputs or "labels" in fit_options_and_inputs:
-        raise ValueError("fit_site sets fit_profile's on_misfit and labels itself (from its "
-                         "own on_misfit and the time column)")
+    if {"on_misfit", "labels", "direction_heights"} & set(fit_options_and_inputs):
+        raise ValueError("fit_site sets fit_profile's on_misfit, labels and direction_heights "
+                         "itself (from its own on_misfit, the time column and the vanes' "
+                         "columns)")
     if (isinstance(reference_height, (bool, np.bool_))
             or not isinstance(reference_height, (int, float, np.integer, np.floating))
             or not np.isfinite(reference_height) or reference_height <= 0):
@@ -342,7 +344,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         labels=labels)
     if (isinstance(direction_offsets, str)
             and (instruments.offsets["source"] == "estimated").any()):
-        instruments = _offsets_from_neutral_fits(instruments, columns, float(reference_height),
+        instruments = _offsets_from_neutral_fits(instruments, float(reference_height),
                                                  fit_options_and_inputs)
     heights, speeds, directions, speed_columns = _fit_heights(instruments, columns)
     excluded = _screen(speed_columns, labels, heights, speeds, directions,
@@ -366,7 +368,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         inputs["turbulence_intensity"] = tuple(
             np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
     abl = EkmanABL.fit_profile(
-        heights, speeds[candidates], None if directions is None else directions[candidates],
+        **_fit_data(instruments, candidates),
         on_misfit="raise" if on_misfit == "raise" else "flag",
         labels=[labels[i] for i in candidates], **inputs,
     )
@@ -443,15 +445,13 @@ def _fit_heights(instruments, columns):
     return heights, speeds, at_heights, [names.get(h, f"(no cup at {h:g} m)") for h in heights]
 
 
-def _offsets_from_neutral_fits(instruments, columns, reference_height, fit_options_and_inputs):
+def _offsets_from_neutral_fits(instruments, reference_height, fit_options_and_inputs):
     """The vane offsets again from the strong-wind records the fit (either sign, the offsets of
     the first estimate applied) finds neutral: a strong wind of a stable night turns with height
     more than a neutral one, and would move the median (docs/measurements.md#vane-offsets)."""
     rows = strong_wind_rows(instruments, reference_height)
-    heights, speeds, directions, _ = _fit_heights(instruments, columns)
-    speeds, directions = speeds[rows], directions[rows]
-    usable = ~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)
-    rows, speeds, directions = rows[usable], speeds[usable], directions[usable]
+    speeds = instruments.speeds[rows]
+    rows = rows[~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)]
     if rows.size < OFFSET_MIN_RECORDS:
         return instruments
     n = len(instruments.speeds)
@@ -464,13 +464,25 @@ def _offsets_from_neutral_fits(instruments, columns, reference_height, fit_optio
     elif instruments.speed_std is not None:
         height, intensity = measured_turbulence(instruments, reference_height)
         inputs["turbulence_intensity"] = (height, intensity[rows])
-    fit = EkmanABL.fit_profile(heights, speeds, directions, on_misfit="flag",
+    fit = EkmanABL.fit_profile(**_fit_data(instruments, rows), on_misfit="flag",
                                stability="either", **inputs).profile_fit
     neutral = rows[np.asarray(fit.fits) & (np.asarray(fit.stability_class) == "neutral")]
     if neutral.size < OFFSET_MIN_RECORDS:
         return instruments
     return with_offsets_from(instruments, neutral, reference_height,
                              _neutral_turning(fit_options_and_inputs))
+
+
+def _fit_data(instruments, rows):
+    """``fit_profile``'s data of the records ``rows``: the cups' heights and speeds, and the
+    vanes' directions with their own heights (``direction_heights``) where those differ."""
+    cups, vanes = instruments.cup_heights, instruments.vane_heights
+    data = {"heights": cups, "speeds": instruments.speeds[rows], "directions": None}
+    if instruments.directions is not None:
+        data["directions"] = instruments.directions[rows]
+        if not (cups.size == vanes.size and np.allclose(cups, vanes)):
+            data["direction_heights"] = vanes
+    return data
 
 
 def _neutral_turning(fit_options_and_inputs):

@@ -37,7 +37,7 @@ The instruments, each effect seeded and recorded (module constants):
 * vanes: offsets :data:`VANE_OFFSETS` (the reading minus the true direction; the 78 m vane is
   aligned), 1 deg random error, rounded to 0.1 deg;
 * icing: :data:`N_ICING` winter nights on which one vane sticks at its last reading for 6 to
-  36 hours (``true_stuck_vane``: the height of the stuck vane, NaN where none);
+  36 hours (``true_stuck_<h>m``: the vane at h m is stuck);
 * missing values: 0.5 % of each column NaN.
 
     python tests/data/generate_mast_instruments.py   # prints what it makes
@@ -98,7 +98,7 @@ def shadow_deficit(wind_direction, boom_orientation):
 def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.DataFrame:
     """The records (module docstring): one row per record, the instruments' columns and the
     generator's truth (``true_class``, ``true_obukhov_length``, ``true_calm``,
-    ``true_stuck_vane``, ``true_direction_80m``), in time order."""
+    ``true_stuck_<h>m``, ``true_direction_80m``), in time order."""
     rng = np.random.default_rng(seed)
     time = pd.date_range("2025-01-01 00:00", periods=periods, freq=freq)
     n = time.size
@@ -146,7 +146,7 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
                    * np.exp(rng.normal(0.0, STD_SAMPLING_ERROR, n)))
             columns[f"speed_{h:.0f}m_{name}"] = np.round(np.maximum(read, 0.0), 2)
             columns[f"speed_{h:.0f}m_{name}_std"] = np.round(std, 3)
-    stuck = np.full(n, np.nan)
+    stuck = {h: np.zeros(n, dtype=bool) for h in VANE_HEIGHTS}
     vanes = {}
     for h in VANE_HEIGHTS:
         true = direction - (abl.wind_angle(h) - turning)
@@ -157,7 +157,7 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
         h = VANE_HEIGHTS[rng.integers(len(VANE_HEIGHTS))]
         stop = min(n, start + int(round(rng.uniform(6.0, 36.0) / step)))
         vanes[h][start:stop] = vanes[h][start]
-        stuck[start:stop] = h
+        stuck[h][start:stop] = True
     for h in VANE_HEIGHTS:
         columns[f"direction_{h:.0f}m"] = np.round(np.mod(vanes[h], 360.0), 1)
     table = pd.DataFrame(columns)
@@ -167,14 +167,15 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     table["true_class"] = kind
     table["true_obukhov_length"] = length
     table["true_calm"] = np.all([abl.speed(h) < 1.0 for h in CUP_HEIGHTS], axis=0)
-    table["true_stuck_vane"] = stuck
+    for h in VANE_HEIGHTS:
+        table[f"true_stuck_{h:.0f}m"] = stuck[h]
     table["true_direction_80m"] = np.mod(direction, 360.0)
     return table
 
 
 if __name__ == "__main__":
     year = mast_year()
+    stuck = sum(int(year[f"true_stuck_{h:.0f}m"].sum()) for h in VANE_HEIGHTS)
     print(f"{len(year)} records; classes {year['true_class'].value_counts().to_dict()}; calm "
-          f"{int(year['true_calm'].sum())}; stuck-vane records "
-          f"{int(year['true_stuck_vane'].notna().sum())}")
+          f"{int(year['true_calm'].sum())}; stuck vane readings {stuck}")
     print(year.head().to_string())
