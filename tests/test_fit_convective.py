@@ -55,7 +55,7 @@ def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
     assert 0.999 * 800.0 < float(fit.abl.sensible_heat_flux) <= 800.0
     assert fit.obukhov_length == pytest.approx(-28.16, abs=0.01)
     fine = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
-                                speed_noise=0.001, direction_noise=0.01, on_misfit="flag",
+                                speed_noise=0.001, direction_noise=0.5, on_misfit="flag",
                                 **SITE).profile_fit
     assert not fine.fits and float(fine.abl.sensible_heat_flux) <= 800.0
     kind, text = fine.reason(0)
@@ -63,7 +63,7 @@ def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
     with pytest.raises(ValueError, match=r"record 0 .*on the bound of the sensible heat flux "
                                          r"800 W/m\^2"):
         EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
-                             speed_noise=0.001, direction_noise=0.01, stability="convective",
+                             speed_noise=0.001, direction_noise=0.5, stability="convective",
                              **SITE)
 
 

@@ -139,8 +139,9 @@ def test_one_record_in_radians_is_fitted_with_a_warning():
     from floris_ekman_veer import DirectionUnitsWarning
 
     s, d = model_record()
-    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(0\) all lie "
-                                                   r"within 0 to 2 pi .* veer is only 0\.\d+ deg") as seen:
+    with pytest.warns(DirectionUnitsWarning,
+                      match=r"directions of 1 record\(s\) \(0\) all lie within 0 to 2 pi .* "
+                            r"veer is only 0\.\d+ deg") as seen:
         EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
     assert len(seen) == 1 and seen[0].filename == __file__
     with warnings.catch_warnings():

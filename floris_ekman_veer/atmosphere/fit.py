@@ -77,8 +77,18 @@ STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", 
 #: The signs of 1/L a fit may take (``stability``): 1/L >= 0 (stable or neutral), 1/L <= 0
 #: (convective or neutral), or either, chosen per record by the smaller misfit.
 STABILITY_CHOICES = ("stable", "convective", "either")
-#: Default measurement noise: cup or sonic anemometer [m/s] and wind vane [deg].
-DEFAULT_SPEED_NOISE = 0.2
+#: Default noise of a 10-minute mean speed (docs/measurements.md#noise-model): (absolute [m/s],
+#: relative to the speed), sigma_U = sqrt(0.1^2 + (0.02 U)^2): the cup's calibration (about
+#: 0.05 m/s + 0.5 %) and operational class (1.7/sqrt(3) = 1.0 %, IEC 61400-12-1 class 1.7A),
+#: its mounting on a boom (0.5-1 %, IEC 61400-12-1 Annex G), the part of the 10-minute mean's
+#: sampling error not shared by the heights (about 1.3 %), and the model's own error in a
+#: profile's shape (1 %), in quadrature; 0.1 m/s of resolution and starting threshold below.
+DEFAULT_SPEED_NOISE = (0.1, 0.02)
+#: Default noise of a 10-minute mean direction [deg]: the vane's resolution (1.4 deg steps,
+#: sigma 0.4 deg), its alignment after a boom survey or the offsets estimated from the records
+#: (about 0.7 deg), the 10-minute mean's sampling (about 0.5 deg), in quadrature about 1 deg
+#: (docs/measurements.md#noise-model). A vane offset not removed is a few degrees: remove it
+#: first or state it here.
 DEFAULT_DIRECTION_NOISE = 1.0
 #: Default model error of the directions [deg], added in variance to ``direction_noise`` in the
 #: chi-square refusal only (docs/measurements.md#direction-model-error): a neutral layer with 5 deg
@@ -365,7 +375,8 @@ class ProfileFit:
             speed = np.transpose(abl.speed(z))[index]
             angle = np.transpose(abl.wind_angle(z))[index]
         r, observations, _ = _normalised_residuals(speed, angle, speeds, directions,
-                                                self.speed_noise, self.direction_noise)
+                                                _speed_sigma(speeds, self.speed_noise),
+                                                self.direction_noise)
         depth = np.reshape(np.asarray(self.mixed_layer_height_fitted, int), -1)
         depth = np.broadcast_to(depth, np.shape(self.misfit) or (1,))[index]
         return np.sum(r**2, axis=1), np.maximum(observations - len(self.fitted) - depth, 1)
@@ -395,13 +406,14 @@ class ProfileFit:
                 and np.reshape(self.refusal_misfit, -1)[i]
                 <= np.reshape(self.misfit_tolerance, -1)[i]
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
-                                depth, self.speed_noise,
+                                depth, _record_sigma(self.speeds[i : i + 1], self.speed_noise),
                                 np.hypot(self.direction_noise, self.direction_model_error))[0]):
             return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
-                                                depth[0], self.speed_noise, self.direction_noise)
+                                                depth[0], None, self.direction_noise)
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
-                             self.speed_noise, self.direction_noise, hemisphere,
+                             _record_sigma(self.speeds[i], self.speed_noise),
+                             self.direction_noise, hemisphere,
                              np.reshape(self.roughness_length, -1)[i], self.stability)
 
     def subset(self, index):
@@ -464,6 +476,35 @@ def _wrap(angle):
     return angle - 360.0 * np.round(angle / 360.0)
 
 
+def _noise_pair(speed_noise):
+    """(absolute [m/s], relative) of ``speed_noise``: a number is absolute alone."""
+    if np.ndim(speed_noise) == 0:
+        return float(speed_noise), 0.0
+    absolute, relative = speed_noise
+    return float(absolute), float(relative)
+
+
+def _speed_sigma(speeds, speed_noise):
+    """[m/s] the noise of each measured speed, sqrt(a^2 + (r U)^2) (a where missing)."""
+    absolute, relative = _noise_pair(speed_noise)
+    return np.hypot(absolute, relative * np.where(np.isfinite(speeds), speeds, 0.0))
+
+
+def _record_sigma(speeds, speed_noise):
+    """[m/s] per record (rows of ``speeds``), the noise at its largest speed: the scale of the
+    tests on what its data show (a speed maximum, a fall, a shear deficit)."""
+    absolute, relative = _noise_pair(speed_noise)
+    largest = np.max(np.where(np.isfinite(speeds), speeds, 0.0), axis=-1)
+    return np.hypot(absolute, relative * largest)
+
+
+def _noise_text(speed_noise):
+    absolute, relative = _noise_pair(speed_noise)
+    return (f"{absolute:g} m/s" if relative == 0 else
+            f"({absolute:g} m/s, {relative:g}): {absolute:g} m/s and {100 * relative:g} % of the "
+            "speed in quadrature")
+
+
 class _ProfileModel:
     """The model's speeds and direction changes at the data heights for unknowns
     x = (ln u*, lam = 100 m/L, [ln z0], [ln z_i]) per record, and the normalised residuals
@@ -481,7 +522,11 @@ class _ProfileModel:
         # per record where the records' signs differ (ProfileFit's states of an "either" fit).
         self.sign = np.asarray(sign, float) if np.ndim(sign) else float(sign)
         self.z, self.s, self.d = heights, speeds, directions
-        self.sigma_s, self.sigma_d = speed_noise, direction_noise
+        # the noise of each speed ((n, m), docs/measurements.md#noise-model) and per record
+        self.noise = speed_noise
+        self.sigma_s = _speed_sigma(speeds, speed_noise)
+        self.sigma_record = _record_sigma(speeds, speed_noise)
+        self.sigma_d = direction_noise
         self.ms = np.isfinite(speeds)
         self.md = None if directions is None else np.isfinite(directions)
         n = speeds.shape[0]
@@ -592,7 +637,7 @@ class _ProfileModel:
         angle = None if self.d is None else np.transpose(np.rad2deg(np.arctan2(v, u)))
         r, _, offset = _normalised_residuals(
             speed, angle, self.s[index], None if self.d is None else self.d[index],
-            self.sigma_s, self.sigma_d, offset=True)
+            self.sigma_s[index], self.sigma_d, offset=True)
         if self.turbulence is not None:
             r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
@@ -895,6 +940,24 @@ def _at_direction_heights(heights, speeds, directions, direction_heights):
     return union, speeds_at, directions_at
 
 
+def _checked_speed_noise(speed_noise):
+    """``speed_noise`` as given if valid: a number > 0 [m/s], or (absolute [m/s] > 0, relative
+    in [0, 1)); ValueError naming it otherwise."""
+    def number(v):
+        return (not isinstance(v, bool) and isinstance(v, (int, float, np.integer, np.floating))
+                and np.isfinite(v))
+
+    if number(speed_noise) and speed_noise > 0:
+        return float(speed_noise)
+    if (isinstance(speed_noise, (tuple, list)) and len(speed_noise) == 2
+            and all(number(v) for v in speed_noise) and speed_noise[0] > 0
+            and 0 <= speed_noise[1] < 1):
+        return (float(speed_noise[0]), float(speed_noise[1]))
+    raise ValueError("fit_profile: speed_noise must be a number > 0 [m/s] or a pair (absolute "
+                     "[m/s] > 0, relative to the speed in [0, 1)), e.g. the default "
+                     f"{DEFAULT_SPEED_NOISE}; got {speed_noise!r}")
+
+
 def _checked_data(name, value, shape=None):
     array = real_array(name, value, "real numbers (NaN: missing)")
     if shape is not None and array.shape != shape:
@@ -927,7 +990,12 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             flow angle there), no interpolation. None: the directions are at ``heights``.
             ``ProfileFit.heights`` then holds the heights of both, the speeds NaN at a
             direction's height and the directions NaN at a speed's.
-        speed_noise, direction_noise: measurement noise [m/s], [deg] weighting the residuals.
+        speed_noise: the noise of a measured speed weighting its residual: a number [m/s], or
+            (absolute [m/s], relative): sqrt(absolute^2 + (relative U)^2) at a measured speed U;
+            default (0.1 m/s, 0.02), the noise model of 10-minute cup means
+            (docs/measurements.md#noise-model).
+        direction_noise: the noise of a measured direction [deg], default 1 (a vane whose
+            offset is removed, docs/measurements.md#noise-model).
         fit_roughness: fit z0 too (``roughness_length`` is then the starting value).
         refusal_probability: a record whose sum of squared normalised residuals chi^2 exceeds
             the chi-square quantile of this upper-tail probability (degrees of freedom: data
@@ -1029,7 +1097,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             + ": a zero reading is a calm or a stalled anemometer; give NaN (missing) there")
     if directions is not None:
         _check_degrees(directions)
-    for name, value in (("speed_noise", speed_noise), ("direction_noise", direction_noise),
+    speed_noise = _checked_speed_noise(speed_noise)
+    for name, value in (("direction_noise", direction_noise),
                         ("refusal_probability", refusal_probability)):
         upper = 1.0 if name == "refusal_probability" else np.inf
         if (isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value)
@@ -1100,7 +1169,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     # z_i an unknown of convective fits where not given (docs/measurements.md#mixed-layer-depth)
     zi_stage = sign < 0 and fit_mixed_layer_height and "mixed_layer_height" not in fixed
     model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          float(speed_noise), float(direction_noise), sign, turbulence)
+                          speed_noise, float(direction_noise), sign, turbulence)
     from scipy.stats import chi2
 
     dof = np.maximum(observations - n_unknowns, 1)
@@ -1115,7 +1184,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 None if directions is None else directions[chunk],
                 {k: (v if np.ndim(v) == 0 else v[chunk]) for k, v in fixed.items()},
                 z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
-                float(speed_noise), float(direction_noise), sign,
+                speed_noise, float(direction_noise), sign,
                 None if turbulence is None else tuple(a[chunk] for a in turbulence),
                 fit_mixed_layer)
         part = model if chunk.size == n else part_model()
@@ -1133,7 +1202,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     if np.any(zi_fitted):
         # every record's state with its z_i (fitted, or the default's own depth: the same state)
         model = _ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array,
-                              fit_roughness, float(speed_noise), float(direction_noise), sign,
+                              fit_roughness, speed_noise, float(direction_noise), sign,
                               turbulence, True)
         # one unknown more where z_i is fitted
         dof = np.maximum(observations - n_unknowns - zi_fitted, 1)
@@ -1143,7 +1212,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     g, mu, z0_fit, valid, _ = model.state(x, index)
     r, _, offset = model.residuals(x, index)
     misfit = np.where(valid, np.sqrt(cost / dof), np.inf)
-    speed_rms = np.sqrt(np.sum(r[:, :m] ** 2, axis=1) / valid_speeds) * speed_noise
+    speed_rms = np.sqrt(np.sum((r[:, :m] * model.sigma_s) ** 2, axis=1) / valid_speeds)
     if directions is None:
         direction_rms = np.full(n, np.nan)
     else:
@@ -1164,7 +1233,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         # top (docs/measurements.md#a-top-the-data-show).
         _, _, _, _, depth = model.state(x, index)
         # (a veer stopping is a top only beyond the directions' model error too)
-        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, float(speed_noise),
+        fits &= ~(valid & _hidden_top(heights, speeds, directions, depth, model.sigma_record,
                                       float(np.hypot(direction_noise, direction_model_error))))
     # where a refused fit lies on a bound of the physical domain: the bound that binds
     bound = np.full(n, "", dtype=object)
@@ -1209,7 +1278,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         iterations=shape(iterations), converged=shape(converged), labels=labels,
         fixed_inputs={k: (v if np.ndim(v) == 0 else shape(v)) for k, v in fixed.items()}
         | ({} if fit_roughness else {"roughness_length": z0_array[()]}),
-        speed_noise=float(speed_noise), direction_noise=float(direction_noise), single=single,
+        speed_noise=speed_noise, direction_noise=float(direction_noise), single=single,
         stability_class=shape(_stability_class(obukhov)),
         misfit_tolerance=shape(misfit_tolerance), refusal_misfit=shape(refusal_misfit),
         direction_model_error=float(direction_model_error),
@@ -1278,7 +1347,7 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
             f"fit_profile: record {fit.labels[i]} fits no atmosphere of the model, stable or "
             f"convective: misfit {np.atleast_1d(stable.refusal_misfit)[i]:.3g} stable, "
             f"{np.atleast_1d(convective.refusal_misfit)[i]:.3g} convective, about 1 for the "
-            f"model plus the stated noise (speed_noise={fit.speed_noise:g} m/s"
+            f"model plus the stated noise (speed_noise={_noise_text(fit.speed_noise)}"
             + ("" if fit.directions is None else
                f", direction_noise={fit.direction_noise:g} deg with direction_model_error="
                f"{fit.direction_model_error:g} deg")
@@ -1474,7 +1543,7 @@ def _fit_mixed_layer(model, x, cost, converged, iterations, refused_cost, max_it
     better = cost2 < cost[candidates] - CONFIDENCE_CHI_SQUARE
     d = None if model.d is None else model.d[candidates]
     shown = ~_hidden_top(model.z[candidates], model.s[candidates], d,
-                         np.where(reached, h, np.inf), model.sigma_s,
+                         np.where(reached, h, np.inf), model.sigma_record[candidates],
                          float(np.hypot(model.sigma_d, model_error)))
     keep = reached & better & shown
     chosen = candidates[keep]
@@ -1659,7 +1728,7 @@ def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direc
     hemisphere = np.sign(np.broadcast_to(model.template.coriolis_parameter, (len(speeds),))[i])
     kind, reason = misfit_reason(heights[i], speeds[i],
                                  None if directions is None else directions[i],
-                                 model.sigma_s, model.sigma_d, hemisphere, model.z0[i],
+                                 model.sigma_record[i], model.sigma_d, hemisphere, model.z0[i],
                               "stable" if np.all(model.sign > 0) else "convective")
     if bound is not None and bound[i] and kind == "misfit":
         reason = (f"its best fit inside the model's physical domain lies on the bound of the "
@@ -1667,8 +1736,7 @@ def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direc
                   "(docs/measurements.md#physical-domain)")
     if depth is not None and misfit[i] <= tolerance[i]:
         d = None if directions is None else directions[i:i + 1]
-        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], model.sigma_s,
-                                    model.sigma_d)
+        reason = _hidden_top_reason(heights[i], speeds[i], d, depth[i], None, model.sigma_d)
         return ValueError(
             f"fit_profile: record {labels[i]} fits no atmosphere of the model: {reason}"
             + (f"; {failing.size - 1} more record(s) fail" if failing.size > 1 else "")
@@ -1687,7 +1755,7 @@ def _misfit_error(failing, labels, heights, speeds, directions, speed_rms, direc
     return ValueError(
         f"fit_profile: record {labels[i]} fits no atmosphere of the model: its best fit misses "
         f"the speeds by {speed_rms[i]:.3g} m/s{direction} rms, {misfit[i]:.3g} times the noise "
-        f"(speed_noise={model.sigma_s:g} m/s, direction_noise={model.sigma_d:g} deg"
+        f"(speed_noise={_noise_text(model.noise)}, direction_noise={model.sigma_d:g} deg"
         + (f" with direction_model_error={model_error:g} deg" if directions is not None else "")
         + "; refused "
         f"above {tolerance[i]:.3g}, refusal_probability={probability:g}): "
