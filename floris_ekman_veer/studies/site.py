@@ -359,7 +359,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     turbulence = fit_inputs.pop("turbulence_intensity", None)
     if turbulence is None and instruments.speed_std is not None:
         turbulence = measured_turbulence(instruments, float(reference_height))
-    per_record = {k: v for k, v in fit_inputs.items() if np.ndim(v) == 1}
+    # (fixed inputs may be one per record; the fit's options, a noise pair say, are not)
+    per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
     candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
     if candidates.size == 0:
         raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
@@ -454,8 +455,7 @@ def _offsets_from_neutral_fits(instruments, reference_height, fit_options_and_in
     rows = rows[~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)]
     if rows.size < OFFSET_MIN_RECORDS:
         return instruments
-    n = len(instruments.speeds)
-    inputs = {k: (np.asarray(v)[rows] if np.ndim(v) == 1 and np.size(v) == n else v)
+    inputs = {k: (np.asarray(v)[rows] if k not in FIT_OPTIONS and np.ndim(v) == 1 else v)
               for k, v in fit_options_and_inputs.items() if k not in ("stability",)}
     if "turbulence_intensity" in inputs:
         inputs["turbulence_intensity"] = tuple(

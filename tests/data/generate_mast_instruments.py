@@ -153,7 +153,7 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
         vanes[h] = true + VANE_OFFSETS[h] + rng.normal(0.0, VANE_ERROR, n)
     # Icing: a winter night's vane holds its last reading for 6 to 36 hours.
     winter_nights = np.flatnonzero(night & (summer < -0.6) & (hour >= 18.0))
-    for start in rng.choice(winter_nights, N_ICING, replace=False):
+    for start in rng.choice(winter_nights, min(N_ICING, winter_nights.size), replace=False):
         h = VANE_HEIGHTS[rng.integers(len(VANE_HEIGHTS))]
         stop = min(n, start + int(round(rng.uniform(6.0, 36.0) / step)))
         vanes[h][start:stop] = vanes[h][start]
