@@ -144,6 +144,9 @@ def test_one_record_in_radians_is_fitted_with_a_warning():
                             r"veer is only 0\.\d+ deg") as seen:
         EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
     assert len(seen) == 1 and seen[0].filename == __file__
+    # among records in degrees, the one in radians is named
+    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(1\)"):
+        EkmanABL.fit_profile(Z, np.vstack([s, s, s]), np.vstack([d, np.radians(d), d]), **SITE)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert EkmanABL.fit_profile(Z, s, d, **SITE).profile_fit.fits

@@ -218,8 +218,12 @@ class ProfileFit:
         # (the stability step on the fit's own side of neutral: the two sides are two models)
         trial = x[:, None, :] + step * np.eye(p)[None] * np.where(
             np.arange(p) == 1, sign[:, None], 1.0)[:, None, :]
-        shifted = self._intensity_at(trial.reshape(-1, p), sign, z, ref)
-        gradient = (shifted.reshape(-1, p) - centre[:, None]) / step
+        shifted = self._intensity_at(trial.reshape(-1, p), sign, z, ref).reshape(-1, p)
+        gradient = (shifted - centre[:, None]) / step
+        # (a fit on a bound of the physical domain: the backward step, inside it)
+        backward = 2.0 * x[:, None, :] - trial
+        behind = self._intensity_at(backward.reshape(-1, p), sign, z, ref).reshape(-1, p)
+        gradient = np.where(np.isfinite(shifted), gradient, (centre[:, None] - behind) / step)
         gradient[:, 1] *= sign
         cov = np.reshape(self.covariance, (-1, p, p))
         sigma = np.sqrt(np.einsum("kp,kpq,kq->k", gradient, cov, gradient))
@@ -752,9 +756,21 @@ def _jacobian(model, x, r, records):
     at unknowns x (k, p) of ``records`` (k,), all unknowns and records in one evaluation; 0
     where a step leaves the model's states."""
     k, p = x.shape
-    trial = (x[:, None, :] + _JACOBIAN_STEP * np.eye(p)[None]).reshape(-1, p)
-    rt, vt, _ = model.residuals(trial, np.repeat(records, p))
-    jac = (rt.reshape(k, p, -1) - r[:, None, :]) / _JACOBIAN_STEP
+    steps = _JACOBIAN_STEP * np.eye(p)[None]
+    trial = (x[:, None, :] + steps).reshape(-1, p)
+    rows = np.repeat(records, p)
+    rt, vt, _ = model.residuals(trial, rows)
+    jac = (rt - np.repeat(r, p, axis=0)) / _JACOBIAN_STEP
+    # A state on a bound of the physical domain (or next to a collapse): its forward step
+    # leaves the model's states, the backward one gives the slope inside.
+    out = np.flatnonzero(~vt)
+    if out.size:
+        back = (x[:, None, :] - steps).reshape(-1, p)[out]
+        rb, vb, _ = model.residuals(back, rows[out])
+        jac[out] = (np.repeat(r, p, axis=0)[out] - rb) / _JACOBIAN_STEP
+        vt = vt.copy()
+        vt[out] = vb
+    jac = jac.reshape(k, p, -1)
     return np.where(vt.reshape(k, p)[:, :, None], jac, 0.0)
 
 
@@ -834,13 +850,11 @@ def _warn_if_radians(fit):
     if not np.any(within):
         return
     rows = np.flatnonzero(within)
-    low = np.nanmin(z[rows], axis=1)
-    high = np.nanmax(z[rows], axis=1)
-    direction = np.reshape(fit.direction(np.stack([low, high], axis=1)
-                                         if not fit.single else np.array([low[0], high[0]])),
-                           (-1, 2))
-    if not fit.single:
-        direction = direction[rows]
+    # (every record's lowest and highest vane: the fit's profiles are evaluated all at once)
+    anywhere = np.where(measured[:, None], z, np.atleast_2d(fit.heights)[:, :1])
+    ends = np.stack([np.nanmin(anywhere, axis=1), np.nanmax(anywhere, axis=1)], axis=1)
+    direction = np.reshape(fit.direction(ends[0] if fit.single else ends), (-1, 2))[rows]
+    low, high = ends[rows, 0], ends[rows, 1]
     veer = np.abs(_wrap(direction[:, 1] - direction[:, 0]))
     small = veer < RADIANS_VEER
     if not np.any(small):
