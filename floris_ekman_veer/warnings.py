@@ -383,6 +383,17 @@ def study_scope():
 
 
 @contextlib.contextmanager
+def discarding():
+    """Drop the package's warnings of an auxiliary computation whose results the user sees
+    through another call (which warns for itself)."""
+    token = _COLLECTING.set([])
+    try:
+        yield
+    finally:
+        _COLLECTING.reset(token)
+
+
+@contextlib.contextmanager
 def collecting():
     """Record the package's warnings (and the per-run thrust-limit notes) instead of issuing
     them, in a worker process; yields the list of records (None in the main process, where

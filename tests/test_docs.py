@@ -351,12 +351,20 @@ SCRIPT_NUMBERS = [
     ("README.md", r"in CNBL, without veer, M-1, M-2 and M-3 agree \(([\d.]+)\)",
      ("examples/paper_power.py",),
      r"beta = \+0 deg.*?CNBL\s+M-1(?:\s+\S+ \(\S+\)){3}\s+([\d.]+) "),
-    ("docs/measurements.md", r"\| zero reading \| (\d+) \| \| calm \| (\d+) \| \| convective \| "
-                             r"(\d+) \| \| backing \| (\d+) \| \| no top \| (\d+) \| \| misfit \| "
-                             r"(\d+) \| \| fitted \| (\d+) \|",
+    ("docs/measurements.md", r"\| zero reading \| (\d+) \| \| calm \| (\d+) \| \| backing \| "
+                             r"(\d+) \| \| no top \| (\d+) \| \| misfit \| (\d+) \| \| physical "
+                             r"bound \| (\d+) \| \| fitted \| (\d+) \|",
      ("examples/site_year.py",),
-     r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?convective\s+(\d+) .*?backing\s+(\d+) .*?"
-     r"no top\s+(\d+) .*?misfit\s+(\d+) .*?fitted\s+(\d+) "),
+     r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?backing\s+(\d+) .*?no top\s+(\d+) .*?"
+     r"misfit\s+(\d+) .*?physical bound\s+(\d+) .*?fitted\s+(\d+) "),
+    ("docs/measurements.md", r"It keeps [\d,]+ of the 8,760 records, ([\d.]+) % of the records the "
+                             r"generator made not calm .*? the fitted class is the generator's for "
+                             r"([\d.]+) % of them .*? the vane offsets found are ([\-+][\d.]+) \+- "
+                             r"[\d.]+ and ([\-+][\d.]+) \+-",
+     ("examples/site_report.py", "--no-energy"),
+     r"against the generator's truth: ([\d.]+) % of the non-calm records "
+     r"kept; fitted class the generator's for ([\d.]+) %.*?38 m ([\-+][\d.]+) .*?58 m "
+     r"([\-+][\d.]+) "),
     ("docs/measurements.md", r"\| convective \| no \| (\d+) \| (\d+) \| (\d+) \| (\d+) \| ([\d.]+) % "
                              r"\| (\d+) of 200 \| (\d+) of 200 \|",
      ("benchmarks/fit_stability_classes.py",),

@@ -52,11 +52,15 @@ SHADOW_HALF_WIDTH = 30.0
 #: A cup's standard uncertainty of a record's mean speed, relative: calibration, mounting and
 #: the 10-minute sampling of a class-1 cup (IEC 61400-12-1 Annex E, 1-2 %).
 CUP_UNCERTAINTY = 0.015
+#: Bins [deg] of the angle from the mast wake's centre in which the records give its ratio, and
+#: the records a bin needs.
+WAKE_BIN = 5.0
+WAKE_MIN_RECORDS = 20
 #: A pair of cups disagrees in a record beyond this many standard deviations of their
 #: difference (plus 0.2 m/s: the cups' resolution and starting threshold).
 PAIR_SIGMAS = 5.0
 #: The largest mast-wake deficit a cup in the wake shows (IEC 61400-12-1 Annex G: up to
-#: 20-40 % behind a lattice mast).
+#: 20-40 % behind a lattice mast): the span of a wake bin the records do not measure.
 MAX_SHADOW_DEFICIT = 0.4
 #: Median ratio of a pair beyond 1 +- this: the pair disagrees (two class-1 calibrations, 1 %
 #: each, at two standard deviations of their ratio).
@@ -238,8 +242,9 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     if directions is not None:
         directions = directions - offsets["offset_deg"].to_numpy()[None, :]  # given ones
     cup_heights = columns.cup_heights
+    cup_flags = _Flags()
     speeds, speed_std, pairs = _combine_cups(records, columns, directions, vane_heights, booms,
-                                             shadow_half_width, flags)
+                                             shadow_half_width, cup_flags)
     instruments = Instruments(cup_heights=cup_heights, speeds=speeds,
                               speed_std=speed_std if columns.has_std else None,
                               vane_heights=vane_heights, directions=directions, offsets=offsets,
@@ -248,7 +253,16 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
         instruments = with_offsets_from(instruments, strong_wind_rows(instruments,
                                                                       reference_height),
                                         reference_height, neutral_turning)
-    return instruments
+        # The mast's wake again with the vanes' offsets removed: its sector and its ratio
+        # against the direction are sharper (a vane 4 deg off moves the wake's centre 4 deg).
+        cup_flags = _Flags()
+        speeds, speed_std, pairs = _combine_cups(records, columns, instruments.directions,
+                                                 vane_heights, booms, shadow_half_width,
+                                                 cup_flags)
+        instruments = attrs.evolve(instruments, speeds=speeds, cup_pairs=pairs,
+                                   speed_std=speed_std if columns.has_std else None)
+    flags.rows.extend(cup_flags.rows)
+    return attrs.evolve(instruments, flags=flags.table())
 
 
 def strong_wind_rows(instruments: Instruments, reference_height: float) -> np.ndarray:
@@ -344,27 +358,34 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
             continue
         wind = _direction_near(directions, vane_heights, height, n)
         orientation = np.array([booms[b] for b, _, _ in group])
-        shadowed = np.abs(_angle(wind[:, None] - orientation[None, :] - 180.0)) < half_width
-        clear = np.isfinite(values) & ~shadowed
-        # Where the wind is unknown (no vane reading) or every cup is in the wake: all cups.
-        clear = np.where(clear.any(axis=1)[:, None], clear, np.isfinite(values))
+        # Each cup's angle from its wake's centre: the wind from its boom's orientation + 180.
+        offset = _angle(wind[:, None] - orientation[None, :] - 180.0)
+        shadowed = np.abs(offset) < half_width
+        finite = np.isfinite(values)
+        # A cup in the wake is never used (with its partner missing, the height is missing);
+        # where the wind is unknown (no vane reading), every cup.
+        clear = np.where(np.isfinite(wind)[:, None], finite & ~shadowed, finite)
         used = np.where(clear, values, np.nan)
         mean = _row_mean(values, clear)
-        # The pair test: clear cups within the cups' uncertainty; a cup in the wake reads
-        # lower, by at most MAX_SHADOW_DEFICIT.
+        # The pair test: clear cups within the cups' uncertainty; a cup in the wake as much
+        # below the clear one as the wake's own ratio at that angle, measured from the records.
         allowance = PAIR_SIGMAS * np.sqrt(2.0) * CUP_UNCERTAINTY * mean + 0.2
+        wake = np.where(finite & ~clear, values, np.nan)
+        expected, spread, deficit = _wake_ratio(np.abs(offset), wake, mean, half_width)
         with np.errstate(invalid="ignore"):
             high = np.fmax.reduce(used, axis=1) - np.fmin.reduce(used, axis=1) > allowance
-            wake = np.where(np.isfinite(values) & ~clear, values, np.nan)
-            low = np.any(wake > mean[:, None] + allowance[:, None], axis=1) | np.any(
-                wake < mean[:, None] * (1.0 - MAX_SHADOW_DEFICIT) - allowance[:, None], axis=1)
+            # (the wake ratio's spread holds both cups' uncertainty already)
+            low = np.any(np.abs(wake - expected * mean[:, None])
+                         > PAIR_SIGMAS * spread * mean[:, None] + 0.2, axis=1)
         disagree = np.flatnonzero(high | low)
         for r in disagree:
             shown = ", ".join(f"{c} {values[r, k]:g}" for k, c in enumerate(names))
+            waked = [names[k] for k in np.flatnonzero(np.isfinite(wake[r]))]
             flags.add([r], ", ".join(names), "cups disagree",
-                      f"the cups at {height:g} m read {shown} m/s, beyond their uncertainty "
-                      f"({'a cup in the mast wake, ' if (~clear[r] & np.isfinite(values[r])).any() else ''}"
-                      "a spike or a stalled cup): the height's speed is removed")
+                      f"the cups at {height:g} m read {shown} m/s, beyond their uncertainty"
+                      + (f" and the mast wake's ratio at that direction ({', '.join(waked)} in "
+                         "it)" if waked else "") + " (a spike or a stalled cup): the height's "
+                      "speed is removed")
         mean_var = _row_mean(stds**2, clear & np.isfinite(stds))
         mean[disagree] = np.nan
         mean_var[disagree] = np.nan
@@ -378,10 +399,38 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
             median, error = _median_and_error(ratio[:, k - 1]) if len(ratio) else (np.nan, np.nan)
             pairs.append({"height": height, "cups": f"{names[k]} / {names[0]}",
                           "median_ratio": median, "uncertainty": error, "records": len(ratio),
-                          "disagree": bool(abs(median - 1.0) > PAIR_TOLERANCE)})
+                          "disagree": bool(abs(median - 1.0) > PAIR_TOLERANCE),
+                          "wake_deficit": deficit})
     pairs = pd.DataFrame(pairs, columns=["height", "cups", "median_ratio", "uncertainty",
-                                         "records", "disagree"])
+                                         "records", "disagree", "wake_deficit"])
     return speeds, np.sqrt(variance), pairs
+
+
+def _wake_ratio(angle, wake, clear_mean, half_width):
+    """The mast wake as the records show it (IEC 61400-12-1 Annex G: the ratio of the two cups
+    against the direction): per record and cup, the median ratio of a cup in the wake to the
+    clear cups' mean at its angle from the wake's centre (bins of :data:`WAKE_BIN` deg, both
+    sides and all cups together) and its robust spread; where a bin holds fewer than
+    :data:`WAKE_MIN_RECORDS`, (1 - MAX_SHADOW_DEFICIT / 2) +- MAX_SHADOW_DEFICIT / 2 spans every
+    deficit up to MAX_SHADOW_DEFICIT. Also the largest median deficit (NaN: none measured)."""
+    edges = np.arange(0.0, half_width + WAKE_BIN, WAKE_BIN)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = wake / clear_mean[:, None]
+    where = np.clip(np.searchsorted(edges, angle, side="right") - 1, 0, edges.size - 1)
+    expected = np.full(ratio.shape, 1.0 - 0.5 * MAX_SHADOW_DEFICIT)
+    spread = np.full(ratio.shape, 0.5 * MAX_SHADOW_DEFICIT / PAIR_SIGMAS)
+    deficit = np.nan
+    measured = np.isfinite(ratio)
+    for b in range(edges.size - 1):
+        in_bin = measured & (where == b)
+        if np.count_nonzero(in_bin) < WAKE_MIN_RECORDS:
+            continue
+        median = float(np.median(ratio[in_bin]))
+        sigma = max(1.4826 * float(np.median(np.abs(ratio[in_bin] - median))),
+                    np.sqrt(2.0) * CUP_UNCERTAINTY)
+        expected[where == b], spread[where == b] = median, sigma
+        deficit = np.nanmax([deficit, 1.0 - median])
+    return expected, spread, deficit
 
 
 def _row_mean(values, use):

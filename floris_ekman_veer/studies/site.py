@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit import FIT_OPTIONS
 from floris_ekman_veer.studies.mast import (OFFSET_MIN_RECORDS, SHADOW_HALF_WIDTH, mast_columns,
@@ -464,8 +465,10 @@ def _offsets_from_neutral_fits(instruments, reference_height, fit_options_and_in
     elif instruments.speed_std is not None:
         height, intensity = measured_turbulence(instruments, reference_height)
         inputs["turbulence_intensity"] = (height, intensity[rows])
-    fit = EkmanABL.fit_profile(**_fit_data(instruments, rows), on_misfit="flag",
-                               stability="either", **inputs).profile_fit
+    # (the records are fitted again, and warned about, by fit_site's own fit)
+    with package_warnings.discarding():
+        fit = EkmanABL.fit_profile(**_fit_data(instruments, rows), on_misfit="flag",
+                                   stability="either", **inputs).profile_fit
     neutral = rows[np.asarray(fit.fits) & (np.asarray(fit.stability_class) == "neutral")]
     if neutral.size < OFFSET_MIN_RECORDS:
         return instruments
