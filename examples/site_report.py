@@ -44,12 +44,13 @@ def arguments(argv=None) -> argparse.Namespace:
 
 
 def truth_table(records: pd.DataFrame, site) -> tuple[pd.DataFrame, float, float]:
-    """(the generator's classes against the fitted ones, the fraction of non-calm records
-    kept, the fraction of kept records whose class is the generator's)."""
+    """(the generator's classes against the fitted ones, the fraction of the generator's
+    non-calm records fitted, the fraction of fitted records whose class is the generator's)."""
     truth = records["true_class"].to_numpy()[site.rows]
     table = pd.crosstab(pd.Series(truth, name="generator"),
                         pd.Series(site.stability_classes, name="fitted"))
-    kept = len(site.labels) / int((~records["true_calm"]).sum())
+    not_calm = ~records["true_calm"].to_numpy()
+    kept = int(np.sum(not_calm[site.rows])) / int(np.sum(not_calm))
     return table, kept, float(np.mean(truth == site.stability_classes))
 
 

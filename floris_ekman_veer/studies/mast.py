@@ -17,9 +17,12 @@ What :func:`read_instruments` makes of them:
 * readings that are no number a cup or vane gives (inf) are removed, named ("infinite reading");
 * redundant cups: the cup in the mast's wake (the wind from its boom's orientation + 180 deg,
   within ``shadow_half_width``; IEC 61400-12-1 Annex G) is not used, the other one is; both are
-  averaged where neither is in the wake. A pair that disagrees beyond the cups' uncertainty in a
-  record is removed at that height and named ("cups disagree"); a pair whose median ratio over
-  the year departs from 1 by more than :data:`PAIR_TOLERANCE` is named in ``cup_pairs``;
+  averaged where neither is in the wake; a cup in the wake alone is not used. The wake's ratio
+  against the direction is measured from the records (Annex G's two-cup ratio). A pair that
+  disagrees beyond the cups' uncertainty (clear cups) or beyond the wake's measured ratio (a cup
+  in the wake) in a record is removed at that height and named ("cups disagree"); a pair whose
+  median ratio over the year departs from 1 by more than :data:`PAIR_TOLERANCE` is named in
+  ``cup_pairs``;
 * stuck vanes (icing): a vane repeating its reading for :data:`STUCK_RECORDS` records or more
   while another vane turns is removed there and named ("stuck vane");
 * vane offsets: what a vane reads minus the true direction, relative to a reference vane (the
