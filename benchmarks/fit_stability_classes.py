@@ -4,9 +4,10 @@ class. Hand-run script, not a test:
     PYTHONPATH=. python benchmarks/fit_stability_classes.py [n_per_class]
 
 Records: n_per_class (default 200) per class of the model's own profiles driven by 5-12 m/s at
-90 m (uniform), f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s: convective (L log-uniform in
--400..-20 m, the default mixed-layer depth), neutral (L infinite) and stable (L log-uniform in
-50..400 m); speeds and meteorological directions at 30, 50, ..., 150 m with 0.1 m/s and 0.5 deg of
+90 m (uniform), f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s: convective (the surface sensible
+heat flux log-uniform in 20..700 W/m^2, inside the physical domain of
+docs/atmosphere.md#physical-domain; the default mixed-layer depth), neutral (L infinite) and
+stable (L log-uniform in 50..400 m); speeds and meteorological directions at 30, 50, ..., 150 m with 0.1 m/s and 0.5 deg of
 Gaussian noise (seed 1), fitted in one call with those noises. Printed: per true class, the
 fitted classes (convective -500 m <= L < 0, neutral |L| > 500 m, stable 0 < L <= 500 m), the
 records refused by the chi-square test, and the largest hub-height (90 m) speed error.
@@ -51,13 +52,16 @@ CLASSES = ("convective", "neutral", "stable")
 def records(n, seed=1):
     """(true class, hub speed, speeds, directions) of n records per class."""
     rng = np.random.default_rng(seed)
-    lengths = np.concatenate([-np.exp(rng.uniform(np.log(20.0), np.log(400.0), n)),
-                              np.full(n, np.inf),
+    heat_flux = np.exp(rng.uniform(np.log(20.0), np.log(700.0), n))
+    lengths = np.concatenate([np.full(n, np.inf),
                               np.exp(rng.uniform(np.log(50.0), np.log(400.0), n))])
     hub = rng.uniform(5.0, 12.0, 3 * n)
-    true = EkmanABL.from_reference_wind(hub, 90.0, obukhov_length=lengths, **SITE)
-    speeds = true.speed(HEIGHTS[:, None]).T + rng.normal(0.0, 0.1, (3 * n, HEIGHTS.size))
-    directions = 270.0 - true.wind_angle(HEIGHTS[:, None]).T + rng.normal(0.0, 0.5, (3 * n, HEIGHTS.size))
+    truths = (EkmanABL.from_reference_wind(hub[:n], 90.0, sensible_heat_flux=heat_flux, **SITE),
+              EkmanABL.from_reference_wind(hub[n:], 90.0, obukhov_length=lengths, **SITE))
+    speeds = np.concatenate([t.speed(HEIGHTS[:, None]).T for t in truths])
+    angles = np.concatenate([t.wind_angle(HEIGHTS[:, None]).T for t in truths])
+    speeds = speeds + rng.normal(0.0, 0.1, (3 * n, HEIGHTS.size))
+    directions = 270.0 - angles + rng.normal(0.0, 0.5, (3 * n, HEIGHTS.size))
     return np.repeat(CLASSES, n), hub, speeds, directions
 
 

@@ -4,14 +4,14 @@ docs/yaw_steering.md#the-validated-envelope).
 
 ``inputs/farm_day.yaml`` is a convective afternoon named by its surface heat flux (+150 W/m^2)
 and mixed-layer depth (1500 m); ``inputs/farm_night.yaml`` a stable night named by its Obukhov
-length (100 m); ``inputs/farm_sbl6.yaml`` fixes Table 1's SBL-6 mu. For each, at 3-25 m/s at
+length (100 m); ``inputs/farm_sbl6.yaml`` fixes Table 1's SBL-6 mu. For each, at 3-19 m/s at
 90 m, this prints the boundary-layer height, the
 Obukhov length, the implied surface sensible heat flux, the friction Rossby number, the
 stability class, the veer across the NREL 5 MW rotor, I_u(90 m) and whether the condition lies
 inside the paper's validated envelope (floris_ekman_veer.validity_report), then the farm power
 of FLORIS's gauss and the package's ekman_veer on the day's inflow (same inflow hook). Last, the
 convective layer against the paper's CNBL at 8 m/s at 90 m: how it departs from it as L goes
-from -1e5 m to -10 m, with z_i the default (the neutral height) and 1500 m, and the geostrophic
+from -1e5 m to -30 m, with z_i the default (the neutral height) and 1500 m, and the geostrophic
 drag law's A and B over that range (docs/atmosphere.md#the-geostrophic-drag-law-of-a-convective-layer).
 
 Run: python examples/day_and_night.py
@@ -37,9 +37,13 @@ SITE = dict(coriolis_parameter=1e-4, roughness_length=0.1, brunt_vaisala_frequen
 #: Convective Obukhov lengths of the sweep: near-neutral to about +350 W/m^2 at 8 m/s at 90 m.
 OBUKHOV_LENGTHS = [-1e5, -1e3, -300.0, -150.0, -100.0]
 #: Obukhov lengths of the drag-law table, with the labels the page prints them by.
+#: To -30 m (733 W/m^2 at 8 m/s at 90 m): -10 m would need 3.5 kW/m^2, outside the physical
+#: domain (docs/atmosphere.md#physical-domain).
 DRAG_LAW_LENGTHS = {-1e5: "-1e5", -1e4: "-1e4", -1e3: "-1000", -300.0: "-300", -100.0: "-100",
-                    -30.0: "-30", -10.0: "-10"}
-SPEEDS = [3.0, 4.0, 6.0, 8.0, 10.0, 11.0, 12.0, 15.0, 19.5, 25.0]
+                    -30.0: "-30"}
+#: To 19 m/s: above it the fixed mu of farm_sbl6 and L of farm_night imply H < -300 W/m^2,
+#: outside the physical domain (docs/atmosphere.md#physical-domain).
+SPEEDS = [3.0, 4.0, 6.0, 8.0, 10.0, 11.0, 12.0, 15.0, 19.0]
 
 
 def farm(name: str, speeds=SPEEDS) -> FlorisModel:

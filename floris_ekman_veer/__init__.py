@@ -34,14 +34,16 @@ from floris_ekman_veer.warnings import (
     FlorisEkmanVeerWarning,
     HeterogeneousInflowWarning,
     ModelSettingsWarning,
+    ReferenceWindWarning,
     ShallowBoundaryLayerWarning,
     ThrustLimitWarning,
     TurbinePlacementWarning,
     silence_warnings,
 )
 
-__all__ = ["DirectionUnitsWarning", "EkmanABL", "FlorisEkmanVeerWarning", "HeterogeneousInflowWarning",
-           "ModelSettingsWarning", "ParFlorisModel", "ShallowBoundaryLayerWarning",
+__all__ = ["DirectionUnitsWarning", "EkmanABL", "FlorisEkmanVeerWarning",
+           "HeterogeneousInflowWarning", "ModelSettingsWarning", "ParFlorisModel",
+           "ReferenceWindWarning", "ShallowBoundaryLayerWarning",
            "ThrustLimitWarning", "TurbinePlacementWarning", "__version__", "annual_energy",
            "example_input", "example_inputs", "fit_site", "optimize_yaw", "register", "silence_warnings",
            "validity_report"]

@@ -187,9 +187,24 @@ def real_array(name: str, value, valid: str = "finite") -> np.ndarray:
     if not _is_real(value):
         raise ValueError(
             f"{name} must be a real number or an array of real numbers ({valid}); got "
-            f"{_describe(value)}"
+            f"{_describe(value)}{_yaml_hint(value)}"
         )
     return np.asarray(value, dtype=float)
+
+
+def _yaml_hint(value) -> str:
+    """For a string YAML read from an infinity or a number: how to write it as a number."""
+    if not isinstance(value, str):
+        return ""
+    text = value.strip().lower().lstrip("+")
+    if text.lstrip("-") in ("inf", "infinity", ".inf"):
+        sign = "-" if text.startswith("-") else ""
+        return f" (YAML writes infinity as {sign}.inf, unquoted: {value!r} is a string there)"
+    try:
+        float(text)
+    except ValueError:
+        return ""
+    return " (write the number unquoted: a quoted number is a string in YAML)"
 
 
 def require_at(ok, name: str, valid: str, value) -> None:
@@ -208,3 +223,12 @@ def finite_real(name: str, value, valid: str = "finite") -> np.ndarray:
     array = real_array(name, value, valid)
     require_at(np.isfinite(array), name, valid, array)
     return array
+
+
+def require_floris_model(fmodel, caller: str) -> None:
+    """TypeError naming ``fmodel`` unless it is a FLORIS model (it has FLORIS's ``core``)."""
+    if not hasattr(fmodel, "core") or not hasattr(fmodel.core, "flow_field"):
+        raise TypeError(
+            f"{caller}: fmodel must be a FlorisModel, ParFlorisModel or UncertainFlorisModel; "
+            f"got {fmodel!r} ({type(fmodel).__name__})"
+        )

@@ -79,12 +79,18 @@ class DirectionUnitsWarning(FlorisEkmanVeerWarning):
     implausibly small: directions given in radians would look like this."""
 
 
+class ReferenceWindWarning(FlorisEkmanVeerWarning):
+    """The reference-wind solve met some speeds only to more than its tolerance (the speed lies
+    in the profile's step where the boundary-layer top crosses the reference height); the
+    closest state is taken."""
+
+
 #: Every warning class, by name (what ``silence_warnings`` and the environment variable take).
 CLASSES = {
     cls.__name__: cls
     for cls in (FlorisEkmanVeerWarning, ShallowBoundaryLayerWarning, ThrustLimitWarning,
                 ModelSettingsWarning, TurbinePlacementWarning, HeterogeneousInflowWarning,
-                DirectionUnitsWarning)
+                DirectionUnitsWarning, ReferenceWindWarning)
 }
 
 
@@ -117,9 +123,13 @@ def silence_warnings(*categories) -> None:
         os.environ.pop(ENVIRONMENT_VARIABLE, None)
         return
     names = [c if isinstance(c, str) else getattr(c, "__name__", repr(c)) for c in categories]
-    setting = ",".join(names) if names else "ignore"
-    _parse(setting)  # an unknown name is an error now, not in a worker later
-    os.environ[ENVIRONMENT_VARIABLE] = setting
+    unknown = sorted(set(names) - set(CLASSES) - {"ignore"})
+    if unknown:  # an unknown name is an error now, not in a worker later
+        raise ValueError(
+            f"silence_warnings: unknown warning class(es) {unknown}; give none (all of them), "
+            f"None (restore them) or classes or names among {sorted(CLASSES)}"
+        )
+    os.environ[ENVIRONMENT_VARIABLE] = ",".join(names) if names else "ignore"
 
 
 def apply_setting(setting: str | None) -> None:
@@ -217,6 +227,13 @@ def warn(message: str, category: type, items=()) -> None:
         module=module_globals.get("__name__", "<unknown>"),
         registry=module_globals.setdefault("__warningregistry__", {}),
     )
+
+
+def values_seen(key: str, values) -> set:
+    """Record ``values`` under ``key`` for this study (forgotten, as :func:`warn`'s items, when a
+    recording context starts) and return every value recorded under it so far."""
+    _REPORTED.new(key, tuple(values))
+    return _REPORTED.items[key]
 
 
 def speeds_text(speeds) -> str:

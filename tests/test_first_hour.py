@@ -377,7 +377,9 @@ def test_reference_height_minus_one_keeps_the_shallow_check():
 
 def test_hub_in_the_roughness_sublayer_warns():
     config = load_yaml(str(FARM))
-    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]["roughness_length"] = 40.0
+    atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
+    # neutral: with SBL-6's mu a 40 m roughness implies H = -1,969 W/m^2 (docs/atmosphere.md#physical-domain)
+    atmosphere.update(roughness_length=40.0, stability_parameter=0.0)
     with caught() as records:
         FlorisModel(config)
     (record,) = of(records, floris_ekman_veer.TurbinePlacementWarning)

@@ -34,15 +34,50 @@ def defaults(velocity="ekman_veer", deflection="ekman_veer", **flow_field):
     return config
 
 
-def settings_warnings(config, repeat=2):
+#: The ekman_veer wake model's notice that FLORIS's turbulence intensities are not its ambient
+#: turbulence (test_floris_turbulence_intensities_are_said_unused_by_ekman_veer).
+TURBULENCE_NOTICE = "flow_field.turbulence_intensities"
+
+
+def settings_warnings(config, repeat=2, intensities=(0.06, 0.06), turbulence_notice=False):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         for _ in range(repeat):
             fmodel = FlorisModel(config)
             fmodel.set(wind_speeds=[8.0, 9.0], wind_directions=[270.0] * 2,
-                       turbulence_intensities=[0.06] * 2)
+                       turbulence_intensities=list(intensities))
             fmodel.run()
-    return [str(w.message) for w in caught if issubclass(w.category, ModelSettingsWarning)]
+    return [str(w.message) for w in caught if issubclass(w.category, ModelSettingsWarning)
+            and (turbulence_notice or not str(w.message).startswith(TURBULENCE_NOTICE))]
+
+
+def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
+    """ekman_veer takes I_u from the atmosphere: FLORIS's TI changes none of its powers (0.02,
+    0.06, 0.15), and where the TI given vary one ModelSettingsWarning per study says so, with
+    the values given (one TI throughout, FLORIS's required placeholder, is silent); gauss on the
+    same inflow reads them, silently."""
+    assert settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), turbulence_notice=True) == []
+    found = settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), intensities=(0.02, 0.15),
+                              turbulence_notice=True)
+    assert len(found) == 1
+    assert found[0].startswith("flow_field.turbulence_intensities (0.02 to 0.15) are not used as "
+                               "the ambient turbulence by the ekman_veer wake model: it takes I_u")
+    assert settings_warnings(defaults("gauss", "gauss", wind_shear=0.0, wind_veer=0.0),
+                             turbulence_notice=True) == []
+    powers = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for ti in (0.02, 0.06, 0.15):  # one study: said once, at the second value
+            fmodel = FlorisModel(defaults(wind_shear=0.0, wind_veer=0.0))
+            fmodel.set(layout_x=[0.0, 630.0], layout_y=[0.0, 0.0], wind_speeds=[8.0],
+                       wind_directions=[270.0], turbulence_intensities=[ti])
+            fmodel.run()
+            powers.append(fmodel.get_turbine_powers())
+    notices = [str(w.message) for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
+    assert len(notices) == 1 and notices[0].startswith(
+        "flow_field.turbulence_intensities (0.02 to 0.06) are not used")
+    np.testing.assert_array_equal(powers[0], powers[1])
+    np.testing.assert_array_equal(powers[0], powers[2])
 
 
 def test_floris_wind_shear_and_veer_without_effect_warn_once():

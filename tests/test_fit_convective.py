@@ -27,8 +27,7 @@ def profiles(lengths, speed=8.0):
 
 
 def test_noise_free_profiles_of_either_sign_are_recovered_exactly():
-    # (L = -35 m at 8 m/s: 595 W/m^2; -20 m, 1,282 W/m^2, lies outside the physical domain:
-    # test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it)
+    # (L = -35 m at 8 m/s: 595 W/m^2; -20 m, 1,282 W/m^2, lies outside the physical domain)
     lengths = [-1000.0, -300.0, -100.0, -50.0, -35.0, np.inf, 300.0, 100.0]
     true, speeds, directions = profiles(lengths)
     abl = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=0.1, stability="either",
@@ -43,18 +42,22 @@ def test_noise_free_profiles_of_either_sign_are_recovered_exactly():
 
 
 def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
-    """The model's own profile of L = -20 m at 8 m/s implies 1,282 W/m^2, beyond the sensible
-    heat flux the atmosphere accepts as input (800 W/m^2): the fit's states stay inside, its
-    best one on the bound (L = -28.16 m, whose profile the stated noise cannot tell from the
-    truth); with a noise that can, the record is refused and the bound named."""
-    true, speeds, directions = profiles([-20.0])
-    assert true.sensible_heat_flux[0] == pytest.approx(1282.0, abs=1.0)
-    fit = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
+    """A Businger-Dyer surface layer (Paulson 1970's psi_m) with u* = 0.7 m/s and L = -20 m
+    implies 1,493 W/m^2, beyond the sensible heat flux the atmosphere accepts (800 W/m^2; the
+    model's own solve refuses such a state): the fit's states stay inside the physical domain,
+    its best one on that bound; with a speed noise that tells the shapes apart the record is
+    refused and the bound named."""
+    u_star, length, z0 = 0.7, -20.0, 0.1
+    x = (1.0 - 16.0 * Z / length) ** 0.25
+    psi = 2.0 * np.log((1.0 + x) / 2.0) + np.log((1.0 + x * x) / 2.0) - 2.0 * np.arctan(x) + np.pi / 2
+    speeds = u_star / 0.41 * (np.log(Z / z0) - psi)
+    assert u_star**3 / (0.41 * 9.81 / 265.0 * -length) * 1321.0 == pytest.approx(1493.0, abs=2.0)
+    directions = np.full(Z.size, 270.0)
+    fit = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0, on_misfit="flag",
                                **SITE).profile_fit
-    assert fit.fits and fit.stability_class == "convective"
-    assert 0.999 * 800.0 < float(fit.abl.sensible_heat_flux) <= 800.0
-    assert fit.obukhov_length == pytest.approx(-28.16, abs=0.01)
-    fine = EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
+    assert fit.stability_class == "convective"
+    assert 0.99 * 800.0 < float(fit.abl.sensible_heat_flux) <= 800.0
+    fine = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0,
                                 speed_noise=0.001, direction_noise=0.5, on_misfit="flag",
                                 **SITE).profile_fit
     assert not fine.fits and float(fine.abl.sensible_heat_flux) <= 800.0
@@ -62,9 +65,8 @@ def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
     assert kind == "physical bound" and "sensible heat flux 800 W/m^2" in text
     with pytest.raises(ValueError, match=r"record 0 .*on the bound of the sensible heat flux "
                                          r"800 W/m\^2"):
-        EkmanABL.fit_profile(Z, speeds[0], directions[0], roughness_length=0.1,
-                             speed_noise=0.001, direction_noise=0.5, stability="convective",
-                             **SITE)
+        EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0, speed_noise=0.001,
+                             direction_noise=0.5, stability="convective", **SITE)
 
 
 def test_the_stable_only_fit_cannot_follow_a_convective_layer():
@@ -83,11 +85,11 @@ def test_the_stable_only_fit_cannot_follow_a_convective_layer():
 def test_noisy_records_are_classed_by_the_misfit():
     """30 records per class, 0.1 m/s and 0.5 deg of noise (benchmarks/fit_stability_classes.py,
     which gives the table of 200 per class): every stable and neutral record in its class, at
-    least 90 % of the convective ones (the rest near-neutral, |L| > 500 m), none refused, the
-    hub speed within 2 %."""
+    least 80 % of the convective ones (heat fluxes 20-700 W/m^2: the rest near-neutral, a weak
+    heat flux in a strong wind being |L| > 500 m), none refused, the hub speed within 2 %."""
     table = confusion(30)
     assert table["stable"][0]["stable"] == 30 and table["neutral"][0]["neutral"] == 30
-    assert table["convective"][0]["convective"] >= 27 and table["convective"][0]["stable"] == 0
+    assert table["convective"][0]["convective"] >= 24 and table["convective"][0]["stable"] == 0
     for counts, refused, error in table.values():
         assert refused == 0 and error <= 0.02
 

@@ -8,22 +8,25 @@ import pytest
 
 from floris_ekman_veer import EkmanABL
 
-SITE = dict(coriolis_parameter=1e-4, brunt_vaisala_frequency=6.1e-3,
+# A mixed layer shallow enough for a 150 m mast to reach lies inside the physical domain (a
+# convective cross-isobaric angle within 45 deg, docs/atmosphere.md#physical-domain) only at
+# light winds and high latitudes: f_c = 1.4e-4 1/s (74 deg), 3-5 m/s at 90 m.
+SITE = dict(coriolis_parameter=1.4e-4, brunt_vaisala_frequency=6.1e-3,
             reference_potential_temperature=265.0, roughness_length=0.1)
 Z = np.arange(30.0, 151.0, 20.0)
 
 
-def model_records(lengths, depths, hub=8.0):
+def model_records(lengths, depths, hub=4.0):
     true = EkmanABL.from_reference_wind(hub, 90.0, obukhov_length=np.asarray(lengths),
                                         mixed_layer_height=np.asarray(depths), **SITE)
     return true, true.speed(Z[:, None]).T, 270.0 - true.wind_angle(Z[:, None]).T
 
 
 def test_a_mixed_layer_top_the_data_reach_is_recovered_exactly():
-    """The model's own convective profiles, z_i = 80-150 m at or below the highest measurement
+    """The model's own convective profiles, z_i = 100-150 m at or below the highest measurement
     (150 m), noise-free: L, u* and z_i come back to the solver's tolerance, z_i marked fitted;
     the block of the fit gives back the fitted ABL in FLORIS."""
-    lengths, depths = [-50.0, -100.0, -200.0, -30.0, -80.0], [80.0, 100.0, 120.0, 140.0, 150.0]
+    lengths, depths = [-50.0, -100.0, -60.0, -30.0, -80.0], [100.0, 120.0, 140.0, 150.0, 130.0]
     true, speeds, directions = model_records(lengths, depths)
     abl = EkmanABL.fit_profile(Z, speeds, directions, stability="either", **SITE)
     fit = abl.profile_fit
@@ -38,15 +41,16 @@ def test_a_mixed_layer_top_the_data_reach_is_recovered_exactly():
     np.testing.assert_allclose(block["mixed_layer_height"], depths, rtol=1e-6)
 
 
-def test_a_noisy_mixed_layer_top_is_recovered_within_three_percent():
-    """40 such records (z_i 70-140 m, L -300..-30 m, 6-12 m/s at 90 m) with 0.1 m/s and 0.5 deg
-    of noise: at least 36 have z_i fitted, each within 3 % of the true z_i, the hub speed
+def test_a_noisy_mixed_layer_top_is_recovered_within_four_percent():
+    """40 such records (z_i 100-150 m, L -300..-30 m, 3-5 m/s at 90 m) with 0.1 m/s and 0.5 deg
+    of noise: at least 32 have z_i fitted (0.1 m/s is 2-3 % of these light winds), each within
+    4 % of the true z_i, the hub speed
     within 4 %."""
     rng = np.random.default_rng(7)
     n = 40
-    depths = rng.uniform(70.0, 140.0, n)
+    depths = rng.uniform(100.0, 150.0, n)
     lengths = -np.exp(rng.uniform(np.log(30.0), np.log(300.0), n))
-    hub = rng.uniform(6.0, 12.0, n)
+    hub = rng.uniform(3.0, 5.0, n)
     true = EkmanABL.from_reference_wind(hub, 90.0, obukhov_length=lengths,
                                         mixed_layer_height=depths, **SITE)
     speeds = true.speed(Z[:, None]).T + rng.normal(0.0, 0.1, (n, Z.size))
@@ -54,9 +58,9 @@ def test_a_noisy_mixed_layer_top_is_recovered_within_three_percent():
     fit = EkmanABL.fit_profile(Z, speeds, directions, stability="either", on_misfit="flag",
                                speed_noise=0.1, direction_noise=0.5, **SITE).profile_fit
     fitted = np.asarray(fit.mixed_layer_height_fitted)
-    assert fitted.sum() >= 36
+    assert fitted.sum() >= 32
     np.testing.assert_array_less(np.abs(fit.mixed_layer_height[fitted] / depths[fitted] - 1.0),
-                                 0.03)
+                                 0.04)
     np.testing.assert_array_less(np.abs(fit.speed([90.0])[:, 0] / hub - 1.0), 0.04)
 
 

@@ -67,8 +67,10 @@ def run(fmodel, speeds, directions, yaw):
         return fmodel.get_turbine_powers(), fmodel.get_turbine_thrust_coefficients()
 
 
+# (to 19 m/s: above about 19.5 m/s SBL-6's fixed mu implies H < -300 W/m^2, outside the
+# physical domain, docs/atmosphere.md#physical-domain)
 conditions = st.integers(2, 4).flatmap(lambda n: st.tuples(
-    st.lists(st.floats(3.0, 25.0), min_size=n, max_size=n),
+    st.lists(st.floats(3.0, 19.0), min_size=n, max_size=n),
     st.lists(st.floats(0.0, 359.9), min_size=n, max_size=n),
     st.lists(st.lists(st.floats(-30.0, 30.0), min_size=N_TURBINES, max_size=N_TURBINES),
              min_size=n, max_size=n),

@@ -124,9 +124,10 @@ def test_the_convective_day_is_flagged_beyond_the_paper():
 
 def test_stability_beyond_sbl6_is_outside():
     # With the Rossby-number check widened, stability and depth alone decide.
-    report = floris_ekman_veer.validity_report(farm("farm_night", [3.0, 19.0, 20.0]),
+    report = floris_ekman_veer.validity_report(farm("farm_night", [3.0, 19.0, 19.7]),
                                                rossby_range=(1e3, 1e6))
-    assert list(report.inside_envelope) == [False, True, False]  # h < 1.33 rotor top; mu > 169
+    assert list(report.inside_envelope) == [False, True, False]
+    # h < 1.33 rotor top; mu > 169 at 19.7 m/s (H = -296 W/m^2, inside the physical domain)
     assert report.stability_parameter.iloc[2] > MU_ENVELOPE
     assert list(report.stability_class) == ["SBL-2", "SBL-6", "beyond SBL-6"]
     # The LES's own range: 19 m/s has u*/(f z0) = 6.7e4 > 6.27e4.

@@ -26,10 +26,16 @@ makes the speed at the reference height explicit; its root is bracketed by the c
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import finite_real, real_array, require_at
 from floris_ekman_veer.atmosphere.turbulence import (
+    ALPHA_PRIME,
+    MERGE_EXPONENT,
+    MIXING_LAYER_FLOOR,
     TOWNSEND_PERRY_A1,
     TOWNSEND_PERRY_B1,
     convective_variance,
@@ -68,9 +74,6 @@ REFERENCE_PRESSURE = 1.0e5
 #: Sensible heat flux bounds [W/m^2]: beyond the strongest nocturnal (about -100) and desert
 #: afternoon (about +600) surface fluxes; they catch kW/m^2 and other unit mistakes.
 SENSIBLE_HEAT_FLUX_RANGE = (-300.0, 800.0)
-#: Kinematic heat flux bound [K m/s] for heating: about 600 W/m^2 (a W/m^2 value given as K m/s
-#: would be far above it).
-MAX_KINEMATIC_HEAT_FLUX = 0.5
 _EITHER_SIGN = "negative for convective (unstable) layers"
 #: Physical bounds of the thermal inputs (docs/atmosphere.md#input-ranges): they catch unit
 #: mistakes (a potential temperature in degrees Celsius, a lapse rate in K/km, a cooling rate in
@@ -87,6 +90,29 @@ MIN_COOLING_RATE = -10.0
 #: measurement mast stands inside the Ekman-surface-layer profile (its surface layer, 0.2 h,
 #: would be 2 m deep); shallower solutions raise ValueError (docs/atmosphere.md#shallow-boundary-layer).
 MIN_BOUNDARY_LAYER_HEIGHT = 10.0
+#: The deepest convective mixed layer accepted [m]: afternoon layers over land reach 1-2 km, over
+#: deserts 4-5 km (Stull 1988, An Introduction to Boundary Layer Meteorology, Sect. 1.5; Garratt
+#: 1992, The Atmospheric Boundary Layer, Sect. 6.1); a z_i in feet or above the troposphere's
+#: lower half is refused (docs/atmosphere.md#physical-domain).
+MAX_MIXED_LAYER_HEIGHT = 5000.0
+#: The strongest geostrophic wind accepted [m/s]: above the 50-60 m/s of the deepest
+#: extratropical storms at the boundary-layer top; the gradient winds of tropical cyclones are
+#: cyclostrophic, outside the f-plane Ekman balance (docs/atmosphere.md#physical-domain).
+MAX_GEOSTROPHIC_WIND = 75.0
+#: The largest cross-isobaric angle of a convective layer [deg]: the laminar Ekman layer's 45 deg
+#: (Ekman 1905) bounds the turning of a layer mixed at least as strongly; convective layers turn
+#: the wind less than neutral ones (docs/atmosphere.md#physical-domain).
+MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE = 45.0
+#: The physical domain of a solved atmosphere, whichever stability input drives it
+#: (`physical_domain`, docs/atmosphere.md#physical-domain): the implied quantity, its range and
+#: its unit. The cross-isobaric angle's bound holds where the layer is convective (mu < 0).
+PHYSICAL_DOMAIN = {
+    "sensible_heat_flux": (SENSIBLE_HEAT_FLUX_RANGE[0], SENSIBLE_HEAT_FLUX_RANGE[1], "W/m^2"),
+    "geostrophic_wind": (0.0, MAX_GEOSTROPHIC_WIND, "m/s"),
+    "cross_isobaric_angle": (
+        -MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE, MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE, "deg"
+    ),
+}
 #: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#input-ranges
 #: state it. Every input is a real number or an array of them (strings and booleans are refused).
 VALID_RANGES = {
@@ -117,9 +143,10 @@ VALID_RANGES = {
         "convective layer)"
     ),
     "surface_heat_flux": (
-        f"finite and <= {MAX_KINEMATIC_HEAT_FLUX:g} K m/s, the kinematic upward heat flux "
-        f"(negative: stable; positive: convective; {MAX_KINEMATIC_HEAT_FLUX:g} K m/s is about "
-        "600 W/m^2 — for W/m^2 use sensible_heat_flux)"
+        "the kinematic upward heat flux Q0 [K m/s] with rho c_p Q0 within "
+        f"{SENSIBLE_HEAT_FLUX_RANGE[0]:g} to {SENSIBLE_HEAT_FLUX_RANGE[1]:g} W/m^2 (-0.227 to "
+        "0.606 K m/s at the default 265 K; negative: stable; positive: convective — for W/m^2 "
+        "use sensible_heat_flux)"
     ),
     "sensible_heat_flux": (
         f"{SENSIBLE_HEAT_FLUX_RANGE[0]:g} to {SENSIBLE_HEAT_FLUX_RANGE[1]:g} W/m^2, the upward "
@@ -129,8 +156,9 @@ VALID_RANGES = {
         "> 0 m stable, < 0 m convective (unstable), inf or -inf neutral; not 0 and not NaN"
     ),
     "mixed_layer_height": (
-        f">= {10.0:g} m and finite, the convective mixed-layer depth z_i (used where the layer "
-        "is convective; default: the neutral height of Eq. h_hat_model)"
+        f"{MIN_BOUNDARY_LAYER_HEIGHT:g} to {MAX_MIXED_LAYER_HEIGHT:g} m, the convective "
+        "mixed-layer depth z_i (used where the layer is convective; default: the neutral height "
+        "of Eq. h_hat_model)"
     ),
     **{name: "> 0 and finite (a model constant)"
        for name in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns",
@@ -159,6 +187,12 @@ def _checked(name, value, ok, valid=None):
     return array
 
 
+def _within_heat_flux_range(sensible_heat_flux):
+    """The physical domain's sensible heat flux bounds [W/m^2] (NaN outside)."""
+    return (sensible_heat_flux >= SENSIBLE_HEAT_FLUX_RANGE[0]) & (
+        sensible_heat_flux <= SENSIBLE_HEAT_FLUX_RANGE[1])
+
+
 def require_broadcastable(named) -> None:
     """ValueError naming two inputs whose shapes do not broadcast together (numpy's rules: one
     number, or arrays of one shape with one entry per condition)."""
@@ -183,6 +217,59 @@ def require_broadcastable(named) -> None:
         ) from None
 
 
+class DomainCheck(NamedTuple):
+    """Where states lie in the `PHYSICAL_DOMAIN` (`physical_domain`); every array has the
+    states' broadcast shape.
+
+    - ``inside``: bool, True where every bound holds;
+    - ``binding``: str, the name of the first bound a state leaves (in `PHYSICAL_DOMAIN`'s
+      order), "" inside;
+    - ``margin``: float, the smallest relative slack over the bounds, (value - bound)/|range
+      end| on the side that binds: > 0 inside, <= 0 outside (a continuous constraint value for
+      a fit that keeps its trial states inside);
+    - ``values``: the implied quantities checked, by name.
+    """
+
+    inside: np.ndarray
+    binding: np.ndarray
+    margin: np.ndarray
+    values: dict
+
+
+def physical_domain(sensible_heat_flux, geostrophic_wind, cross_isobaric_angle,
+                    stability_parameter) -> DomainCheck:
+    """Which bound of the `PHYSICAL_DOMAIN` each state leaves, vectorised, without raising
+    (docs/atmosphere.md#physical-domain): the surface sensible heat flux H [W/m^2], the
+    geostrophic wind G [m/s] and, where the layer is convective (``stability_parameter`` mu < 0),
+    the cross-isobaric angle [deg]. Arguments broadcast together; NaN counts as outside.
+    `EkmanABL.physical_domain` applies it to a solved atmosphere, whichever stability input
+    drove it; the constructor and `EkmanABL.from_reference_wind` refuse states outside."""
+    values = {
+        "sensible_heat_flux": np.asarray(sensible_heat_flux, dtype=float),
+        "geostrophic_wind": np.asarray(geostrophic_wind, dtype=float),
+        "cross_isobaric_angle": np.asarray(cross_isobaric_angle, dtype=float),
+    }
+    convective = np.asarray(stability_parameter, dtype=float) < 0
+    shape = np.broadcast_shapes(convective.shape, *(v.shape for v in values.values()))
+    binding = np.full(shape, "", dtype=object)
+    margin = np.full(shape, np.inf)
+    for name, value in values.items():
+        low, high, _ = PHYSICAL_DOMAIN[name]
+        with np.errstate(invalid="ignore"):
+            slack = np.minimum(
+                (value - low) / max(abs(low), 1.0) if low < 0 else (value - low) / high,
+                (high - value) / high,
+            )
+        slack = np.where(np.isnan(slack), -np.inf, slack)
+        if name == "cross_isobaric_angle":
+            slack = np.where(convective, slack, np.inf)
+        binding = np.where((binding == "") & (slack <= 0), name, binding)
+        margin = np.minimum(margin, slack)
+    inside = binding == ""
+    return DomainCheck(inside[()], binding[()], margin[()],
+                       {k: np.broadcast_to(v, shape)[()] for k, v in values.items()})
+
+
 def coriolis_parameter_from_latitude(latitude):
     """f_c = 2 Omega sin(phi) [1/s]; latitude in degrees, negative in the south."""
     latitude = _checked(
@@ -193,7 +280,10 @@ def coriolis_parameter_from_latitude(latitude):
 
 def boundary_layer_height_hat(stability_parameter, zilitinkevich_number, c_tn, c_cn, c_ns):
     """h_hat = h f_c/u* from 1/h_hat^2 = 1/C_TN^2 + mu_N/C_CN^2 + mu/C_NS^2, Eq. (h_hat_model)."""
-    return (1.0 / c_tn**2 + zilitinkevich_number / c_cn**2 + stability_parameter / c_ns**2) ** -0.5
+    # np.power, not **: on a numpy scalar (one condition) ** takes C's pow, whose last bit can
+    # differ from numpy's array loop; np.power gives a condition the same bits alone as in a batch.
+    return np.power(1.0 / c_tn**2 + zilitinkevich_number / c_cn**2 + stability_parameter / c_ns**2,
+                    -0.5)
 
 
 def air_heat_capacity(reference_potential_temperature):
@@ -207,13 +297,13 @@ def air_heat_capacity(reference_potential_temperature):
 def unstable_phi_m(zeta, gamma=BUSINGER_DYER_GAMMA):
     """phi_m(z/L) = (1 - gamma z/L)^(-1/4) for z/L <= 0: the Businger-Dyer dimensionless shear
     (Businger et al. 1971; Dyer 1974, gamma = 16; Hogstrom 1988, gamma = 19.3)."""
-    return (1.0 - gamma * np.minimum(zeta, 0.0)) ** -0.25
+    return np.power(1.0 - gamma * np.minimum(zeta, 0.0), -0.25)  # (np.power: see h_hat)
 
 
 def unstable_psi_m(zeta, gamma=BUSINGER_DYER_GAMMA):
     """psi_m(z/L) = int_0^zeta (1 - phi_m)/zeta' dzeta' for z/L <= 0, Paulson (1970)'s integral of
     the Businger-Dyer phi_m: 2 ln((1+x)/2) + ln((1+x^2)/2) - 2 atan(x) + pi/2, x = 1/phi_m."""
-    x = (1.0 - gamma * np.minimum(zeta, 0.0)) ** 0.25
+    x = np.power(1.0 - gamma * np.minimum(zeta, 0.0), 0.25)
     return (
         2.0 * np.log(0.5 * (1.0 + x)) + np.log(0.5 * (1.0 + x * x)) - 2.0 * np.arctan(x)
         + 0.5 * np.pi
@@ -276,15 +366,19 @@ def stability_from_cooling_rate(cooling_rate_per_second, friction_velocity, cori
     c2 = (-(GRAVITY / theta0) * cooling_rate_per_second / (coriolis**2 * friction_velocity)) ** 2
     inv_c2 = 1.0 / c_ns**2
     mu = np.minimum(np.cbrt(c2 / inv_c2), np.sqrt(c2 / a0))
+    active = np.ones(np.shape(mu), dtype=bool)
     for _ in range(30):
         p = inv_c2 * mu**3 + a0 * mu**2 - c2
         dp = 3.0 * inv_c2 * mu**2 + 2.0 * a0 * mu
         d2p = 6.0 * inv_c2 * mu + 2.0 * a0
         # Halley's step: cubic convergence, and it stays above the root like Newton's here.
         denom = 2.0 * dp**2 - p * d2p
-        step = np.divide(2.0 * p * dp, denom, out=np.zeros_like(mu), where=denom > 0)
+        step = np.divide(2.0 * p * dp, denom, out=np.zeros_like(mu), where=active & (denom > 0))
         mu = mu - step
-        if np.all(np.abs(step) <= 1e-14 * mu):
+        # Converged elements are frozen, so that a condition's mu does not depend on the others
+        # solved with it (the same bits alone as in a batch).
+        active &= np.abs(step) > 1e-14 * mu
+        if not np.any(active):
             break
     return mu
 
@@ -403,7 +497,7 @@ class EkmanABL:
         )
         self.mixed_layer_height = None if mixed_layer_height is None else _checked(
             "mixed_layer_height", mixed_layer_height,
-            lambda z: z >= MIN_BOUNDARY_LAYER_HEIGHT,
+            lambda z: (z >= MIN_BOUNDARY_LAYER_HEIGHT) & (z <= MAX_MIXED_LAYER_HEIGHT),
         )
         given = {
             "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
@@ -449,8 +543,12 @@ class EkmanABL:
 
     @staticmethod
     def valid_range(name):
-        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`)."""
-        return VALID_RANGES.get(name, "see EkmanABL")
+        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`);
+        ValueError naming the inputs for a name that is none of them."""
+        if not isinstance(name, str) or name not in VALID_RANGES:
+            raise ValueError(f"valid_range: name must be one of EkmanABL's inputs "
+                             f"{sorted(VALID_RANGES)}; got {name!r}")
+        return VALID_RANGES[name]
 
     # ----------------------------------------------------------------------------- inputs
     def _set_constants(self, kappa, c_g, decay, c_tn, c_cn, c_ns, matching):
@@ -516,11 +614,10 @@ class EkmanABL:
         ok = {
             "stability_parameter": np.isfinite,
             "cooling_rate": lambda v: np.isfinite(v) & (np.abs(v) <= -MIN_COOLING_RATE),
-            "surface_heat_flux": lambda v: np.isfinite(v) & (v <= MAX_KINEMATIC_HEAT_FLUX),
+            "surface_heat_flux": lambda v: _within_heat_flux_range(
+                v * air_heat_capacity(self.reference_potential_temperature)),
             "obukhov_length": lambda v: (v != 0) & ~np.isnan(v),
-            "sensible_heat_flux": lambda v: (
-                (v >= SENSIBLE_HEAT_FLUX_RANGE[0]) & (v <= SENSIBLE_HEAT_FLUX_RANGE[1])
-            ),
+            "sensible_heat_flux": _within_heat_flux_range,
         }[name]
         require_at(ok(value), name, VALID_RANGES[name], value)
         self._stability_value = value
@@ -589,6 +686,8 @@ class EkmanABL:
                 roughness_length=self.roughness_length,
                 **{self.stability_input: self._stability_value},
                 brunt_vaisala_frequency=self.brunt_vaisala_frequency,
+                **({} if self.mixed_layer_height is None
+                   else {"mixed_layer_height": self.mixed_layer_height}),
             ).items()
         )
         return ValueError(f"{lead} ({reason}) for inputs {details}")
@@ -644,6 +743,29 @@ class EkmanABL:
             "the shallowest the model accepts (docs/atmosphere.md#shallow-boundary-layer)",
             lead="no model ABL",
         ))
+        self._require_domain(lambda mask, reason: self._failure(
+            mask, reason, lead="the inputs leave the physical domain",
+        ))
+
+    def physical_domain(self) -> DomainCheck:
+        """Where the solved states lie in the `PHYSICAL_DOMAIN` (`physical_domain`): the implied
+        sensible heat flux, geostrophic wind and, where convective, cross-isobaric angle, per
+        condition, without raising (docs/atmosphere.md#physical-domain)."""
+        return physical_domain(self.sensible_heat_flux, self.geostrophic_wind,
+                               self.cross_isobaric_angle, self.stability_parameter)
+
+    def _require_domain(self, error):
+        """Raise ``error(mask of the offending conditions, reason)`` at the first condition
+        outside the physical domain, the reason naming the implied quantity, its value and range."""
+        check = self.physical_domain()
+        if np.all(check.inside):
+            return
+        outside = np.atleast_1d(~check.inside).reshape(np.shape(check.inside) or (1,))
+        first = tuple(np.argwhere(outside)[0])
+        name = np.atleast_1d(check.binding).reshape(outside.shape)[first]
+        value = np.broadcast_to(np.atleast_1d(check.values[name]).reshape(
+            np.shape(check.values[name]) or (1,)), outside.shape)[first]
+        raise error(outside, _outside_domain(name, value))
 
     def _require_depth(self, error):
         """Raise ``error(mask of the offending conditions)`` where h < MIN_BOUNDARY_LAYER_HEIGHT."""
@@ -652,13 +774,27 @@ class EkmanABL:
             raise error(np.atleast_1d(shallow).reshape(np.shape(shallow) or (1,)))
 
     def _set_solution(self, log_u_star, p):
-        u_star, mu, h_hat, a, b, along = self._state(log_u_star, p)
+        # The state of one condition is computed as an array of one, not as numpy scalars:
+        # ``**`` on a numpy scalar takes C's pow, whose last bit can differ from numpy's array
+        # loop, and a condition must give the same bits alone as in a batch.
+        shape = np.shape(log_u_star)
+        z_i = np.broadcast_to(p["zi"], shape)
+        if shape == ():
+            log_u_star = np.reshape(log_u_star, 1)
+            p = {k: np.reshape(v, 1) for k, v in p.items()}
+        u_star, mu, h_hat, a, b, along = (
+            np.reshape(x, shape) for x in self._state(log_u_star, p))
         kappa = self.von_karman
         self.friction_velocity = u_star[()]
         self.stability_parameter = np.asarray(mu, dtype=float)[()]
         self.h_hat = h_hat[()]
         self.gdl_a, self.gdl_b = a[()], b[()]
-        self.boundary_layer_height = (h_hat * u_star / self._f)[()]
+        # A given z_i is the convective layer's depth itself: z_i f/u* times u*/f would round
+        # it (10 m to 9.999999999999998 m, below the shallowest depth accepted).
+        depth = h_hat * u_star / self._f
+        if not np.all(np.isnan(z_i)):
+            depth = np.where((mu < 0) & ~np.isnan(z_i), z_i, depth)
+        self.boundary_layer_height = depth[()]
         u_g = u_star * along / kappa
         v_g = -self._hemisphere * u_star * b / kappa
         self.geostrophic_components = (u_g[()], v_g[()])
@@ -763,7 +899,7 @@ class EkmanABL:
         g, dg = stress_shape(eta, h_hat, self.c_g, self.stress_decay)
         # 1 - eta and its root once (U and V both take them: the same numbers, fewer passes).
         depth = 1.0 - eta
-        stress = depth**1.5
+        stress = np.power(depth, 1.5)
         depth_root = np.sqrt(depth)
         u_g = self.geostrophic_components[0]
         # The sums below are accumulated in place, term by term in the order written
@@ -843,6 +979,7 @@ class EkmanABL:
         (docs/atmosphere.md#shallow-boundary-layer).
         """
         z = self._log_layer_heights(z, "z")
+        A1, B1 = _turbulence_constants(A1=A1, B1=B1).values()
         if reference_height is None:
             reference_speed = np.hypot(*self._velocity(z))
         else:
@@ -862,6 +999,7 @@ class EkmanABL:
         h exp(B1/A1) up. Raises ValueError for a hub below the roughness length.
         """
         hub_height = self._log_layer_heights(hub_height, "hub_height")
+        constants = _turbulence_constants(**constants)
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,
             np.hypot(*self._velocity(hub_height)), convective=self.convective_variance,
@@ -889,6 +1027,12 @@ class EkmanABL:
         if "geostrophic_wind" in inputs:
             raise ValueError("from_reference_wind takes speed and height instead of geostrophic_wind")
         speed = _checked("speed", speed, lambda s: s > 0, "> 0 m/s")
+        tolerance = float(_checked(
+            "tolerance", tolerance,
+            lambda t: (np.ndim(t) == 0) & (t >= MIN_REFERENCE_WIND_TOLERANCE) & (t <= 1e-3),
+            f"one number from {MIN_REFERENCE_WIND_TOLERANCE:g} to 1e-3, the tolerance on "
+            "ln(speed) at the height (default 1e-13)",
+        ))
         template = cls.check_inputs(**inputs)
         height = _checked("height", height, lambda h: h > 0, "> roughness_length z0")
         require_broadcastable({"speed": speed, "height": height, **{
@@ -957,7 +1101,30 @@ class EkmanABL:
         abl.geostrophic_wind = g
         abl._params, _ = abl._parameters(g, shape)
         abl._set_solution(log_u_star[inverse.ravel()].reshape(shape), abl._params)
-        abl._require_depth(lambda mask: _too_shallow_for_reference_wind(abl, mask, speed, height, inputs))
+        abl._require_depth(lambda mask: _reference_wind_refusal(
+            abl, mask, speed, height, inputs,
+            f"is h = {{h}} m deep, below the {MIN_BOUNDARY_LAYER_HEIGHT:g} m the model accepts (the "
+            "stable boundary layer collapses; docs/atmosphere.md#shallow-boundary-layer): check the "
+            "units of the inputs (cooling rate in K/h, heat flux in K m/s, lapse rate in K/m) or "
+            "give weaker stratification",
+        ))
+        abl._require_domain(lambda mask, reason: _reference_wind_refusal(
+            abl, mask, speed, height, inputs, f"leaves the physical domain: {reason}"))
+        residual = np.abs(log_speed_error(log_u_star))
+        #: |ln(speed at height / speed asked)| of each condition's solution
+        abl.reference_wind_residual = residual[inverse.ravel()].reshape(shape)[()]
+        missed = residual > tolerance
+        if np.any(missed):
+            package_warnings.warn(
+                f"from_reference_wind: {np.count_nonzero(missed)} of {residual.size} distinct "
+                f"conditions (wind speeds {package_warnings.speeds_text(target[missed])} at "
+                f"{package_warnings.range_text(at[missed], 'm')}) meet their speed only to "
+                f"{residual[missed].max():.2g} in ln speed, above the tolerance {tolerance:g}: "
+                "the speed lies in the step of the profile where the top of the boundary layer "
+                "crosses the height (docs/atmosphere.md#reference-wind-solve); the closest state "
+                "is taken, its residual in reference_wind_residual",
+                package_warnings.ReferenceWindWarning,
+                items=tuple(zip(target[missed].round(6), at[missed].round(6))))
         return abl
 
     @classmethod
@@ -979,6 +1146,28 @@ class EkmanABL:
         )
 
 
+#: The constants of Eqs. (Iu_model) and (kw_CNBL_SBL_model) the profile methods take, with the
+#: paper's values: each one positive number.
+TURBULENCE_CONSTANTS = {"A1": TOWNSEND_PERRY_A1, "B1": TOWNSEND_PERRY_B1,
+                        "alpha_prime": ALPHA_PRIME, "floor": MIXING_LAYER_FLOOR,
+                        "n": MERGE_EXPONENT}
+
+
+def _turbulence_constants(**constants):
+    """``constants`` checked: known names (`TURBULENCE_CONSTANTS`), each one positive number."""
+    unknown = sorted(set(constants) - set(TURBULENCE_CONSTANTS))
+    if unknown:
+        raise ValueError(f"unknown constant(s) {unknown}; the constants are "
+                         f"{sorted(TURBULENCE_CONSTANTS)}")
+    return {name: float(_checked(
+        name, value, lambda v: (np.ndim(v) == 0) & (v > 0),
+        f"one number > 0 (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
+        for name, value in constants.items()}
+
+
+#: The tightest tolerance of the reference-wind solve (in ln speed): a few times the spacing of
+#: doubles, below which no state is closer.
+MIN_REFERENCE_WIND_TOLERANCE = 1e-15
 #: Points of the scan in ln u* that brackets the largest root of the reference-wind solve.
 _SCAN_POINTS = 64
 #: Residual (in ln speed) accepted where round-off, not the method, stops the reference-wind solve.
@@ -1052,8 +1241,9 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     return np.where(found & converged, root, np.nan), slowest
 
 
-def _too_shallow_for_reference_wind(abl, mask, speed, height, inputs):
-    """The ValueError of a reference wind whose ABL is shallower than the model accepts."""
+def _reference_wind_refusal(abl, mask, speed, height, inputs, reason):
+    """The ValueError of a reference wind whose ABL the model refuses (too shallow, or outside
+    the physical domain), at the first offending condition; ``{h}`` in ``reason`` is its depth."""
     index = tuple(np.argwhere(mask)[0]) if mask.ndim else ()
     shape = mask.shape
     varying = [i for i, n in zip(index, shape) if n > 1]
@@ -1062,10 +1252,31 @@ def _too_shallow_for_reference_wind(abl, mask, speed, height, inputs):
     given = ", ".join(f"{k}={pick(v):.6g}" for k, v in inputs.items())
     return ValueError(
         f"from_reference_wind: the ABL with {pick(speed):.6g} m/s at {pick(height):.6g} m{where} "
-        f"({given}) is h = {pick(abl.boundary_layer_height):.3g} m deep, below the "
-        f"{MIN_BOUNDARY_LAYER_HEIGHT:g} m the model accepts (the stable boundary layer collapses; "
-        "docs/atmosphere.md#shallow-boundary-layer): check the units of the inputs (cooling "
-        "rate in K/h, heat flux in K m/s, lapse rate in K/m) or give weaker stratification"
+        f"({given}) " + reason.replace("{h}", f"{pick(abl.boundary_layer_height):.3g}")
+    )
+
+
+def _outside_domain(name, value):
+    """Why a state leaves the physical domain: the implied quantity, its value and range."""
+    low, high, unit = PHYSICAL_DOMAIN[name]
+    what, hint = {
+        "sensible_heat_flux": (
+            "the surface sensible heat flux H they imply",
+            "give weaker stability (|L| larger, |mu|, |Q0| or |C_r| smaller) or check its units",
+        ),
+        "geostrophic_wind": (
+            "the geostrophic wind G they imply",
+            "check the units of the wind speed and the roughness length",
+        ),
+        "cross_isobaric_angle": (
+            "the cross-isobaric angle alpha_0 of the convective layer they imply",
+            "the mixed layer is too shallow for its u*/f_c: give a deeper mixed_layer_height "
+            "(or none: the neutral height) or a higher latitude",
+        ),
+    }[name]
+    return (
+        f"{what} is {value:.4g} {unit}, outside {low:g} to {high:g} {unit} "
+        f"(docs/atmosphere.md#physical-domain): {hint}"
     )
 
 

@@ -113,6 +113,9 @@ CONFIDENCE_CHI_SQUARE = 4.0
 DEFAULT_ROUGHNESS_START = 0.05
 #: Scale of the stability unknown: lam = _LENGTH_SCALE / L.
 _LENGTH_SCALE = 100.0
+#: The relative slack a fitted state keeps inside the physical domain's bounds
+#: (`DomainCheck.margin`): far above the round-off of the ABL re-solved from its G.
+_DOMAIN_MARGIN = 1e-9
 _JACOBIAN_STEP = 1e-7
 _STEP_TOLERANCE = 1e-10
 
@@ -547,13 +550,26 @@ class _ProfileModel:
         # The shallowest boundary layer the ABL class accepts (a state below it is no model state).
         physics = importlib.import_module(abl_class.__module__)
         self.min_depth = float(getattr(physics, "MIN_BOUNDARY_LAYER_HEIGHT", 0.0))
-        self.domain = _PhysicalDomain(physics)
+        self.max_mixed_layer_height = float(getattr(physics, "MAX_MIXED_LAYER_HEIGHT", np.inf))
+        # The physical domain of the ABL's solved states (its module's `physical_domain`, the
+        # bounds `PHYSICAL_DOMAIN`), and what the implied quantities need.
+        self.physical_domain = getattr(physics, "physical_domain", None)
+        self.domain_bounds = getattr(physics, "PHYSICAL_DOMAIN", {})
+        self.heat_capacity = getattr(physics, "air_heat_capacity", None)
+        self.gravity = float(getattr(physics, "GRAVITY", 9.81))
+        self.hemisphere = np.broadcast_to(np.sign(self.template.coriolis_parameter), (n,))
 
     def fixed_at(self, index):
         return {k: (v if np.ndim(v) == 0 else np.asarray(v)[index]) for k, v in self.fixed.items()}
 
     def state(self, x, index):
         """(G, mu, z0, valid, h) for unknowns x of records ``index``."""
+        # (unbound: `_DefaultDepth` evaluates through it too)
+        return _ProfileModel._evaluate(self, x, index)[:5]
+
+    def _evaluate(self, x, index):
+        """(G, mu, z0, valid, h, where each state lies in the physical domain: a `DomainCheck`
+        of the ABL's module, or None without one) for unknowns x of records ``index``."""
         log_u = x[:, 0]
         # (a trial step may run far: its overflow is a state the validity below discards)
         with np.errstate(all="ignore"):
@@ -578,27 +594,39 @@ class _ProfileModel:
             )
             if self.fit_mixed_layer:
                 # z_i an input the ABL class accepts, whatever the sign the state takes
-                valid &= np.isfinite(p["zi"]) & (p["zi"] >= 1.001 * self.min_depth)
-            # inside the physical domain of the ABL's inputs (heat flux, ...): a trial state
-            # outside it is no state the fit may reach (docs/measurements.md#physical-domain)
-            valid &= self.domain.inside(u_star, mu, p)
-        return g, mu, z0, valid, h
+                valid &= (np.isfinite(p["zi"]) & (p["zi"] >= 1.001 * self.min_depth)
+                          & (p["zi"] <= self.max_mixed_layer_height))
+            # inside the physical domain of the ABL's solved states (heat flux, G, the
+            # convective turning): a trial state outside it is no state the fit may reach
+            # (docs/measurements.md#physical-domain)
+            check = None
+            if self.physical_domain is not None:
+                heat_flux = (-mu * p["f"] * u_star**2 * p["theta0"] / self.gravity
+                             * self.heat_capacity(p["theta0"]))
+                angle = np.rad2deg(np.arctan2(-self.hemisphere[index] * b, along))
+                check = self.physical_domain(heat_flux, g, angle, mu)
+                # (with a margin: the ABL re-solved from G must land inside too)
+                valid &= check.inside & (check.margin > _DOMAIN_MARGIN)
+        return g, mu, z0, valid, h, check
 
     def bound(self, x, index):
         """Per state of unknowns x of records ``index``: the bound of the physical domain that
-        binds, "" where none does: the state pushed a little further from neutral (its 1/L times
-        1.02) leaves the domain across it."""
+        binds, as text ("sensible heat flux 800 W/m^2"), "" where none does: the state pushed a
+        little further from neutral (its 1/L times 1.02) leaves the domain across it."""
         pushed = x.copy()
         pushed[:, 1] *= 1.02
-        u_star = np.exp(pushed[:, 0])
-        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
-        mu = sign * u_star * pushed[:, 1] / (_LENGTH_SCALE * self.kappa * self.f[index])
-        p = {k: v[index] for k, v in self.params.items()}
-        if self.fit_mixed_layer:
-            with np.errstate(over="ignore"):
-                p["zi"] = np.exp(x[:, -1])
-        with np.errstate(all="ignore"):
-            return self.domain.crossed(u_star, mu, p)
+        check = self._evaluate(pushed, index)[5]
+        if check is None:
+            return np.full(x.shape[0], "", dtype=object)
+        names = np.reshape(check.binding, -1)
+        text = np.full(names.size, "", dtype=object)
+        for name in set(names) - {""}:
+            low, high, unit = self.domain_bounds[name]
+            value = np.reshape(check.values[name], -1)
+            edge = np.where(value < low, low, high)
+            here = names == name
+            text[here] = [f"{name.replace('_', ' ')} {e:g} {unit}" for e in edge[here]]
+        return text
 
     def abl(self, log_u, g, mu, z0, valid, index, mixed_layer_height=None):
         """The ABLs of states (ln u*, g, mu, z0) of records ``index``, set at their known u*
@@ -645,39 +673,6 @@ class _ProfileModel:
         if self.turbulence is not None:
             r = np.concatenate([r, _turbulence_residual(abl, self.turbulence, index)], axis=1)
         return r, valid, offset
-
-
-class _PhysicalDomain:
-    """The physical domain of the ABL class's inputs, as the states the fit may reach: the
-    surface heat flux H = -rho c_p mu f u*^2 Theta0/g within the ABL's input range of the
-    sensible heat flux (``SENSIBLE_HEAT_FLUX_RANGE``; a fit must never hand FLORIS an
-    atmosphere the package would refuse as input, docs/measurements.md#physical-domain).
-    ``physics``: the ABL class's module."""
-
-    def __init__(self, physics):
-        self.heat_capacity = getattr(physics, "air_heat_capacity", None)
-        self.heat_flux_range = getattr(physics, "SENSIBLE_HEAT_FLUX_RANGE", (-np.inf, np.inf))
-        self.gravity = float(getattr(physics, "GRAVITY", 9.81))
-
-    def heat_flux(self, u_star, mu, p):
-        """H [W/m^2] (upward > 0) of states (u*, mu) with condition parameters p."""
-        if self.heat_capacity is None:
-            return np.zeros(np.shape(mu))
-        return (-mu * p["f"] * u_star**2 * p["theta0"] / self.gravity
-                * self.heat_capacity(p["theta0"]))
-
-    def crossed(self, u_star, mu, p):
-        """Per state: the name and value of the bound it lies beyond, "" where inside."""
-        low, high = self.heat_flux_range
-        with np.errstate(all="ignore"):
-            flux = self.heat_flux(u_star, mu, p)
-        return np.where(flux > high, f"sensible heat flux {high:g} W/m^2 (convective)",
-                        np.where(flux < low, f"sensible heat flux {low:g} W/m^2 (stable)", ""))
-
-    def inside(self, u_star, mu, p):
-        low, high = self.heat_flux_range
-        flux = self.heat_flux(u_star, mu, p)
-        return (flux >= low) & (flux <= high)
 
 
 def _turbulence_residual(abl, turbulence, index):

@@ -38,9 +38,9 @@ def convective_variance(mixed_layer_height, obukhov_length):
     z_i = np.asarray(mixed_layer_height, dtype=float)
     inverse = 1.0 / np.asarray(obukhov_length, dtype=float)
     unstable = inverse < 0
-    excess = (PANOFSKY_NEUTRAL - PANOFSKY_BUOYANT * z_i * np.where(unstable, inverse, 0.0)) ** (
-        2.0 / 3.0
-    ) - PANOFSKY_NEUTRAL ** (2.0 / 3.0)
+    # np.power: the same bits for a numpy scalar (one condition) as in an array of conditions
+    excess = np.power(PANOFSKY_NEUTRAL - PANOFSKY_BUOYANT * z_i * np.where(unstable, inverse, 0.0),
+                      2.0 / 3.0) - PANOFSKY_NEUTRAL ** (2.0 / 3.0)
     return np.where(unstable, excess, 0.0)
 
 
@@ -127,4 +127,4 @@ def wake_expansion_rate(
     turbulent = alpha_prime * streamwise_turbulence_intensity(
         hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1, convective
     )
-    return (floor**n + turbulent**n) ** (1.0 / n)
+    return np.power(floor**n + np.power(turbulent, n), 1.0 / n)

@@ -68,7 +68,11 @@ from floris_ekman_veer.plugin.inflow import (
     set_atmosphere,
 )
 from floris_ekman_veer.plugin.names import VELOCITY_MODEL_NAME as MODEL_NAME
-from floris_ekman_veer.studies.optimization import check_optimizer_options, optimize_yaw
+from floris_ekman_veer.studies.optimization import (
+    check_optimizer_options,
+    optimize_yaw,
+    with_default_yaw_bounds,
+)
 
 #: Keys of one class of a stability distribution.
 CLASS_KEYS = ("frequency", "atmosphere")
@@ -428,8 +432,9 @@ def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensit
         raise ValueError("annual energy: wind data with a heterogeneous inflow map is not "
                          "supported (the Ekman profile is the inflow)")
     if optimizer_class is not None:
-        check_optimizer_options(optimizer_class, optimizer_kwargs, len(directions),
-                                fmodel.core.farm.n_turbines)
+        check_optimizer_options(optimizer_class,
+                                with_default_yaw_bounds(optimizer_class, optimizer_kwargs),
+                                len(directions), fmodel.core.farm.n_turbines)
     elif optimizer_kwargs:
         raise ValueError(f"annual energy: optimiser options {sorted(optimizer_kwargs)} given "
                          "without an optimizer_class")
@@ -654,7 +659,7 @@ def _rated_powers(fmodel):
 
 def _option_rows(optimizer_class, options, name, shape):
     """The optimiser's option ``name`` (or its default) as an array of ``shape``."""
-    value = options.get(name)
+    value = with_default_yaw_bounds(optimizer_class, options).get(name)
     if value is None and name not in ("yaw_angles_baseline", "turbine_weights"):
         value = inspect.signature(optimizer_class.__init__).parameters[name].default
     return None if value is None else np.broadcast_to(np.asarray(value, dtype=float), shape)

@@ -29,6 +29,7 @@ from floris.core import FlowField, TurbineCubatureGrid, TurbineGrid, WakeModelMa
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
+from floris_ekman_veer._validation import require_floris_model
 from floris_ekman_veer.plugin.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
@@ -42,6 +43,12 @@ SCIPY_METHODS = (
     "nelder-mead", "powell", "cg", "bfgs", "newton-cg", "l-bfgs-b", "tnc", "cobyla", "cobyqa",
     "slsqp", "trust-constr", "dogleg", "trust-ncg", "trust-exact", "trust-krylov",
 )
+
+#: The yaw bounds [deg] :func:`optimize_yaw` searches where the caller gives none: both signs.
+#: FLORIS's optimisers default to 0..25 deg, one sign only; with veer the two signs differ and
+#: the gain can lie on the negative side (docs/yaw_steering.md#both-signs-by-default). A bound the
+#: caller gives is kept as given.
+DEFAULT_YAW_BOUNDS = {"minimum_yaw_angle": -25.0, "maximum_yaw_angle": 25.0}
 
 #: Conditions per optimiser run: large enough to keep FLORIS's vectorisation efficient, small
 #: enough for the progress bar to move on long studies.
@@ -120,7 +127,10 @@ def optimize_yaw(
         chunk_size: Conditions per optimiser run (results do not depend on it).
         **optimizer_kwargs: The optimiser's own options (``minimum_yaw_angle``,
             ``maximum_yaw_angle``, ``Ny_passes``, ``opt_options``...). The options in
-            :data:`PER_CONDITION_OPTIONS` may be (n_findex, n_turbines) arrays.
+            :data:`PER_CONDITION_OPTIONS` may be (n_findex, n_turbines) arrays. Bounds not
+            given are -25 and 25 deg (:data:`DEFAULT_YAW_BOUNDS`): both signs of yaw are
+            searched, where FLORIS's own default, 0..25 deg, searches one; bounds given are
+            kept.
 
     Returns:
         FLORIS's ``df_opt`` frame: one row per condition of ``fmodel``, in its order (index
@@ -131,6 +141,7 @@ def optimize_yaw(
         ValueError: for a model without conditions, and for options the optimiser does not
             accept or would reject, before any FLORIS evaluation.
     """
+    require_floris_model(fmodel, "optimize_yaw")
     n_findex = fmodel.core.flow_field.n_findex
     n_turbines = fmodel.core.farm.n_turbines
     if n_findex == 0:
@@ -138,6 +149,7 @@ def optimize_yaw(
             "optimize_yaw: the model has no conditions (n_findex = 0): give at least one wind "
             "direction, wind speed and turbulence intensity with fmodel.set(...)"
         )
+    optimizer_kwargs = with_default_yaw_bounds(optimizer_class, optimizer_kwargs)
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
         raise ValueError(f"optimize_yaw: search must be one of {list(SEARCHES)}; got {search!r}")
@@ -178,6 +190,18 @@ def optimize_yaw(
         refined.append(run_within(np.maximum(centre - width, lower),
                                   np.minimum(centre + width, upper)))
     return _best_of(candidates + refined)
+
+
+def with_default_yaw_bounds(optimizer_class, options: Mapping) -> dict:
+    """``options`` with :data:`DEFAULT_YAW_BOUNDS` for the bounds the caller did not give (for
+    optimisers that take them): without bounds the search covers both signs of yaw."""
+    options = dict(options)
+    if inspect.isclass(optimizer_class):
+        accepted = inspect.signature(optimizer_class.__init__).parameters
+        for name, bound in DEFAULT_YAW_BOUNDS.items():
+            if name in accepted and name not in options:
+                options[name] = bound
+    return options
 
 
 @functools.cache

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from floris_ekman_veer._validation import real_array, require_floris_model
 from floris_ekman_veer.plugin.inflow import atmosphere_of, solve
 
 #: The paper's Table 1 stability parameter of SBL-6, the most stable validated case.
@@ -158,12 +159,14 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
             ``rossby_range`` is not two increasing positive numbers.
     """
-    low, high = (float(v) for v in rossby_range)
-    if not (0 < low < high):
+    require_floris_model(fmodel, "validity_report")
+    valid = "two positive numbers (low, high) with low < high"
+    bounds = real_array("validity_report: rossby_range", rossby_range, valid)
+    if bounds.shape != (2,) or not (0 < bounds[0] < bounds[1] < np.inf):
         raise ValueError(
-            f"validity_report: rossby_range must be two positive numbers (low, high) with "
-            f"low < high; got {tuple(rossby_range)!r}"
+            f"validity_report: rossby_range must be {valid}; got {tuple(np.ravel(bounds))!r}"
         )
+    low, high = (float(v) for v in bounds)
     core = fmodel.core
     spec = atmosphere_of(core)
     if spec is None:

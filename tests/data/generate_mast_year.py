@@ -7,7 +7,8 @@ A 150 m mast at 52 N over grass (z0 = 0.05 m), cup anemometers and vanes at 30, 
 random walk. Each record is one ``true_kind``:
 
 * ``neutral``: a near-neutral day, the EkmanABL with Obukhov length inf or 500 to 5,000 m;
-* ``stable``: a night (20:00 to 05:00), the EkmanABL with L = 30 to 400 m;
+* ``stable``: a night (20:00 to 05:00), the EkmanABL with L = 30 to 400 m (a night's storm
+  above 21 m/s at 90 m is neutral, L = 2,000 m: inside the physical domain);
 * ``convective``: some summer afternoons (11:00 to 16:00): an unstable surface layer (Businger-
   Dyer, L = -15 to -60 m) with almost no turn of direction, a layer the model (CNBL and SBL
   only) does not have;
@@ -86,6 +87,12 @@ def main(output: Path = OUTPUT) -> pd.DataFrame:
     # A night's light wind is stable but not collapsing: at least 3 m/s where L < 60 m.
     hub_speed = np.where((kind == "stable") & (obukhov < 60.0), np.maximum(hub_speed, 3.0),
                          hub_speed)
+    # A night's storm is near-neutral: above 21 m/s at 90 m a stable L of 30-400 m would imply
+    # a surface cooling beyond -300 W/m^2, outside the physical domain
+    # (docs/atmosphere.md#physical-domain); those records are neutral, L = 2,000 m.
+    storm = (kind == "stable") & (hub_speed > 21.0)
+    kind[storm] = "neutral"
+    obukhov[storm] = 2000.0
     abl = EkmanABL.from_reference_wind(hub_speed, HUB_HEIGHT, obukhov_length=obukhov, **SITE)
     speeds = abl.speed(HEIGHTS[:, None]).T
     turn = abl.wind_angle(HEIGHTS[:, None]).T - abl.wind_angle(HUB_HEIGHT)[:, None]
