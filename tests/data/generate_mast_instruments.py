@@ -10,7 +10,10 @@ a few metres lower, at 38, 58 and 78 m (``direction_<h>m``). The site: 53.3 N, g
 0.05 m). Hourly by default; ``freq="10min", periods=105120`` gives two years of 10-minute means.
 
 The atmosphere of each record is the package's own EkmanABL (``from_reference_wind`` at 80 m),
-in one of three classes (``true_class``) with their Obukhov length (``true_obukhov_length``):
+in one of three classes (``true_class``) with their Obukhov length (``true_obukhov_length``),
+inside the atmosphere's physical domain: where the drawn L would imply a heat flux beyond
+:data:`MAX_HEAT_FLUX` (with u* of the neutral log law) |L| is enlarged to meet it, and a record
+whose |L| then exceeds 500 m is neutral (the fit's class convention):
 
 * ``stable``: nights (sunset to sunrise, longer in winter) with an 80 m wind below 11 m/s,
   L = 20 to 200 m (log-uniform; at least 4 m/s where L < 60 m: a night's light wind is stable,
@@ -74,6 +77,8 @@ STD_SAMPLING_ERROR = 0.1
 SPIKE_FRACTION = 0.002
 N_ICING = 6
 MISSING_FRACTION = 0.005
+#: Sensible heat flux [W/m^2] the drawn stratification may imply (stable, convective).
+MAX_HEAT_FLUX = (-150.0, 250.0)
 #: Wind [m/s] at 80 m from which every record is neutral (mechanical mixing).
 NEUTRAL_SPEED = 11.0
 
@@ -127,6 +132,15 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     length[stable] = np.exp(rng.uniform(np.log(20.0), np.log(200.0), stable.sum()))
     length[convective] = -np.exp(rng.uniform(np.log(10.0), np.log(150.0), convective.sum()))
     speed = np.where(stable & (length < 60.0), np.maximum(speed, 4.0), speed)
+    # Inside the atmosphere's physical domain (docs/atmosphere.md#physical-domain): |L| grows
+    # with the wind where the heat flux it implies (u* of the neutral log law) would exceed
+    # MAX_HEAT_FLUX; a strong wind's stratification is weak. The class is then that of L.
+    u_star = 0.41 * speed / np.log(REFERENCE_HEIGHT / SITE["roughness_length"])
+    heat_flux = -1.2 * 1005.0 * 290.0 * u_star**3 / (0.41 * 9.81 * length)
+    factor = np.clip(heat_flux / MAX_HEAT_FLUX[1], 1.0, None) * np.clip(
+        heat_flux / MAX_HEAT_FLUX[0], 1.0, None)
+    length = np.where(np.isfinite(length), length * factor, length)
+    kind = np.where(np.abs(length) > 500.0, "neutral", kind).astype(object)
 
     abl = EkmanABL.from_reference_wind(speed, REFERENCE_HEIGHT, obukhov_length=length, **SITE)
     turning = abl.wind_angle(REFERENCE_HEIGHT)  # meteorological direction = const - wind_angle
