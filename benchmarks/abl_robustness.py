@@ -9,6 +9,8 @@ cooling rate, surface heat flux, Obukhov length) over the ranges a user meets: r
 2-30 m/s at 20-200 m, |latitude| 5-80 deg (both hemispheres), z0 1e-4 to 1 m (log-uniform),
 N 0-0.02 1/s. For each it reports
 
+* ``from_reference_wind`` refusals of states outside the physical domain
+  (docs/atmosphere.md#physical-domain), counted apart;
 * ``from_reference_wind`` failures, and how many of them have a solution. Existence is decided
   independently of the root solve: the ABL is parametrised by u* (mu, h_hat, A, B and G are
   explicit in u*), a log-spaced u* scan keeps the states with a physical branch (ln Ro > A) and
@@ -26,7 +28,7 @@ import time
 
 import numpy as np
 
-from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.atmosphere.ekman import MIN_BOUNDARY_LAYER_HEIGHT, EkmanABL
 
 KINDS = ("neutral", "stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length")
 
@@ -50,33 +52,41 @@ def draw(rng, kind):
 
 def solution_exists(speed, height, inputs):
     """Whether some valid ABL has |(U, V)(height)| = speed (scan in u*, see the module doc)."""
-    probe = EkmanABL(geostrophic_wind=1000.0, **inputs)  # deep enough never to collapse
-    p = {k: np.asarray(v).ravel()[0] for k, v in probe._params.items()}
+    probe = EkmanABL.check_inputs(**inputs)
+    params, _ = probe._parameters(1000.0)
+    p = {k: np.asarray(v).ravel()[0] for k, v in params.items()}
     log_u = np.log(np.logspace(-5, 1, 3000))
     u_star, _, h_hat, _, b, along = probe._state(log_u, p)
-    valid = (along > 0) & (probe.matching_fraction * h_hat * u_star / p["f"] > p["z0"])
+    depth = h_hat * u_star / p["f"]
+    # a model state: a physical branch, a surface layer, and h at least the shallowest accepted
+    valid = ((along > 0) & (probe.matching_fraction * depth > p["z0"])
+             & (depth >= MIN_BOUNDARY_LAYER_HEIGHT))
     if not np.any(valid):
         return False
     g = u_star[valid] * np.hypot(along[valid], b[valid]) / probe.von_karman
-    speeds = EkmanABL(geostrophic_wind=g, **inputs).speed(height)
+    # the states themselves (explicit in u*), the physical domain aside: existence of a root
+    speeds = EkmanABL._solved_at(log_u[valid], g, **inputs).speed(height)
     return bool(speeds.min() <= speed <= speeds.max())
 
 
 def main(n_per_kind=800, seed=0):
     rng = np.random.default_rng(seed)
-    total = failed = solvable = negative = 0
+    total = failed = solvable = negative = outside = 0
     worst = 0.0
     deepest_negative = 0.0  # largest h among the cases with U < 0
     examples = []
     start = time.perf_counter()
     for kind in KINDS:
-        kind_failed = kind_solvable = 0
+        kind_failed = kind_solvable = kind_outside = 0
         for _ in range(n_per_kind):
             speed, height, inputs = draw(rng, kind)
             total += 1
             try:
                 abl = EkmanABL.from_reference_wind(speed, height, **inputs)
-            except ValueError:
+            except ValueError as refusal:
+                if "physical domain" in str(refusal):  # solved, then refused for what it implies
+                    kind_outside += 1
+                    continue
                 kind_failed += 1
                 if solution_exists(speed, height, inputs):
                     kind_solvable += 1
@@ -95,9 +105,11 @@ def main(n_per_kind=800, seed=0):
                     examples.append(("U < 0", speed, height, inputs))
         failed += kind_failed
         solvable += kind_solvable
+        outside += kind_outside
         print(f"{kind:20s} inputs {n_per_kind}: from_reference_wind failures {kind_failed} "
-              f"(with a solution: {kind_solvable})")
+              f"(with a solution: {kind_solvable}), outside the physical domain {kind_outside}")
     print(f"all kinds: inputs {total}, failures {failed}, of which solvable {solvable}; "
+          f"outside the physical domain {outside}; "
           f"hub-aligned U < 0 near the ground in {negative} solved cases (min U/G {worst:.3g}, "
           f"largest h among them {deepest_negative:.3g} m); "
           f"{time.perf_counter() - start:.0f} s")

@@ -189,7 +189,13 @@ def real_array(name: str, value, valid: str = "finite") -> np.ndarray:
             f"{name} must be a real number or an array of real numbers ({valid}); got "
             f"{_describe(value)}{_yaml_hint(value)}"
         )
-    return np.asarray(value, dtype=float)
+    try:
+        return np.asarray(value, dtype=float)
+    except ValueError:  # ragged nesting: lists of different lengths
+        raise ValueError(
+            f"{name} must be a real number or an array of real numbers of one shape ({valid}); "
+            f"got lists of different lengths: {value!r}"
+        ) from None
 
 
 def _yaml_hint(value) -> str:

@@ -445,3 +445,29 @@ def test_gauss_and_ekman_veer_run_on_the_shipped_convective_day():
     # front row (x = 0: turbines 0-2) unwaked; back rows relative to the front
     ratio = lambda p: p[:, 6:].sum(axis=1) / p[:, :3].sum(axis=1)  # noqa: E731
     assert np.all(ratio(day) > ratio(night_like))
+
+
+def test_rotor_shear_above_neutral_comes_from_the_neutral_defect_of_a_shallow_mixed_layer():
+    """3 m/s at 90 m, latitude 50, z0 = 1 mm (docs/atmosphere.md#rotor-layer-shear-in-a-shallow-mixed-layer):
+    with the default z_i (the neutral height, 172-219 m here) U(153)/U(27) rises from 1.254
+    (CNBL) to 1.324 at L = -5 m, because above 0.2 z_i the model keeps the paper's Ekman-layer
+    velocity defect (U_g - U)/u* at each z/h, identical to the CNBL's, while U_g/u* falls with
+    instability (A grows): the same defect is a larger part of a smaller wind. With the rotor
+    inside the surface layer (z_i = 1500 m, 0.2 z_i = 300 m) instability flattens the shear,
+    1.254 -> 1.139."""
+    site = dict(latitude=50.0, roughness_length=1e-3)
+    lengths = np.array([np.inf, -1000.0, -100.0, -20.0, -5.0])
+    shallow = EkmanABL.from_reference_wind(3.0, 90.0, obukhov_length=lengths, **site)
+    shear = shallow.speed(153.0) / shallow.speed(27.0)
+    np.testing.assert_allclose(shear[[0, -1]], [1.2543, 1.3239], atol=1e-4)
+    assert np.all(np.diff(shear) > 0) and np.all(0.2 * shallow.boundary_layer_height < 153.0)
+    eta = np.array([0.3, 0.5, 0.8])[:, None]
+    defect = (shallow.geostrophic_components[0] - shallow.velocity(
+        eta * shallow.boundary_layer_height)[0]) / shallow.friction_velocity
+    np.testing.assert_allclose(defect, defect[:, :1] * np.ones(len(lengths)), rtol=1e-10)
+    assert np.all(np.diff(shallow.geostrophic_components[0] / shallow.friction_velocity) < 0)
+    deep = EkmanABL.from_reference_wind(3.0, 90.0, obukhov_length=lengths,
+                                        mixed_layer_height=1500.0, **site)
+    deep_shear = deep.speed(153.0) / deep.speed(27.0)
+    np.testing.assert_allclose(deep_shear[[0, -1]], [1.2543, 1.1393], atol=1e-4)
+    assert np.all(np.diff(deep_shear) < 0)

@@ -196,6 +196,21 @@ def test_thrust_limit_warning_once_per_run_naming_the_speeds():
         "C_T cos^2(yaw) > 0.96")
 
 
+def test_thrust_limit_warning_once_per_study_over_wind_roses():
+    """The stock NREL 5 MW's own table exceeds C_T = 0.96 below about 4 m/s, so every wind rose
+    meets the limit: one warning for the study, not one per wind rose (before: one per new set
+    of speeds)."""
+    fmodel = FlorisModel(FARM)
+    with caught() as records:
+        for speeds in ([3.0, 8.0], [3.5, 10.0], [4.0, 3.2, 12.0]):
+            fmodel.set(wind_speeds=speeds, wind_directions=[270.0] * len(speeds),
+                       turbulence_intensities=[0.06] * len(speeds))
+            fmodel.run()
+    (record,) = of(records, floris_ekman_veer.ThrustLimitWarning)
+    assert str(record.message).startswith("turbine wakes in 1 of 2 conditions (wind speeds 3 m/s")
+    assert str(record.message).endswith("said once per study")
+
+
 @pytest.fixture
 def restore_setting():
     before = os.environ.get(package_warnings.ENVIRONMENT_VARIABLE)

@@ -6,6 +6,8 @@ directions in radians, vectorised simple inputs."""
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, fit_site
 from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
@@ -132,16 +134,17 @@ def test_directions_in_radians_are_refused():
 
 def test_one_record_in_radians_is_fitted_with_a_warning():
     """One record cannot be refused as radians (a northerly wind veering a few degrees looks
-    alike), but its fitted veer in "degrees" is a few hundredths: DirectionUnitsWarning, once,
-    at the user's line, naming the record; the same record in degrees fits without one."""
+    alike), but its turning in "degrees" is a few tenths (12 deg of veer is 0.21 rad):
+    DirectionUnitsWarning, once (an either-sign fit is two fits), at the user's line, naming the
+    record; the same record in degrees fits without one."""
     import warnings
 
     from floris_ekman_veer import DirectionUnitsWarning
 
     s, d = model_record()
     with pytest.warns(DirectionUnitsWarning,
-                      match=r"directions of 1 record\(s\) \(0\) all lie within 0 to 2 pi .* "
-                            r"veer is only 0\.\d+ deg") as seen:
+                      match=r"directions of 1 record\(s\) \(0\) all lie within 0 to 2 pi and "
+                            r"turn by only 0\.21 deg between their vanes") as seen:
         EkmanABL.fit_profile(Z, s, np.radians(d), **SITE)
     assert len(seen) == 1 and seen[0].filename == __file__
     # among records in degrees, the one in radians is named
@@ -222,13 +225,12 @@ def test_chunks_do_not_change_the_fits():
 MAST = (40.0, 60.0, 80.0)
 
 
+@st.composite
 def _mast_record(draw):
     """One real-looking 10-minute record of a 40-60-80 m mast: a power-law speed profile
     (shear exponent -0.1..0.6) from calm to 30 m/s at 80 m, veering or backing up to 20 deg
     per 40 m, with cup and vane noise, and perhaps a spike, a kinked cup, a stuck vane, NaN
     or a zero reading."""
-    from hypothesis import strategies as st
-
     z = np.asarray(MAST)
     hub = draw(st.one_of(st.floats(0.2, 2.0), st.floats(2.0, 30.0)))
     shear = draw(st.floats(-0.1, 0.6))
@@ -255,11 +257,10 @@ def _mast_record(draw):
     return list(speeds) + list(np.mod(directions, 360.0))
 
 
-def _records(draw):
-    from hypothesis import strategies as st
-
-    rows = draw(st.lists(st.builds(lambda: None).flatmap(lambda _: st.composite(
-        lambda d: _mast_record(d))()), min_size=1, max_size=8))
+@st.composite
+def _physical_records(draw):
+    """A batch of 1-5 drawn records after the anchor, as fit_site's table."""
+    rows = draw(st.lists(_mast_record(), min_size=1, max_size=5))
     anchor = list(8.0 * (np.asarray(MAST) / 80.0) ** 0.14) + [265.0, 266.0, 267.0]
     table = np.array([anchor] + rows)
     columns = ([f"speed_{h:.0f}m" for h in MAST] + [f"direction_{h:.0f}m" for h in MAST])
@@ -267,12 +268,6 @@ def _records(draw):
     frame.insert(0, "time", pd.date_range("2026-01-01", periods=len(frame), freq="10min")
                  .strftime("%Y-%m-%d %H:%M"))
     return frame
-
-
-def _physical_records():
-    from hypothesis import strategies as st
-
-    return st.composite(lambda draw: _records(draw))()
 
 
 def _check_site(records):
@@ -330,6 +325,15 @@ def test_the_issues_records_that_aborted_a_site_are_fitted_or_named():
                                    stability=stability).profile_fit
         assert np.isfinite(fit.misfit)
         assert -300.0 <= float(fit.abl.sensible_heat_flux) <= 800.0
+    # A well-mixed 16.6 m/s record (once L = -0.084 m, 4.6e7 W/m^2, I_u(90 m) = 7.05): a
+    # convective state on the 800 W/m^2 bound, L = -122 m, I_u(90 m) 0.157.
+    mixed = EkmanABL.fit_profile(np.array([30.0, 70.0, 110.0, 150.0]),
+                                 [16.2, 16.5, 16.6, 16.6], [270.0, 270.2, 270.1, 270.3],
+                                 latitude=52.0, roughness_length=0.05).profile_fit
+    assert mixed.fits and mixed.stability_class == "convective"
+    assert 799.0 < float(mixed.abl.sensible_heat_flux) <= 800.0
+    assert mixed.obukhov_length == pytest.approx(-122.0, abs=1.0)
+    assert float(mixed.abl.turbulence_intensity(90.0)) == pytest.approx(0.157, abs=0.002)
     # An infinite reading is removed (the record keeps its other data) and named by its time
     # stamp (docs/measurements.md#a-real-mast).
     bad = calm.copy()
@@ -347,6 +351,4 @@ def test_random_real_looking_records_never_abort_a_site_and_stay_physical():
     kinks, stuck vanes, NaN, zero readings) through fit_site(..., stability="either",
     on_misfit="drop"): it returns, every record is fitted or named with a reason, every
     fitted state lies inside the physical domain and is accepted as the atmosphere's input."""
-    from hypothesis import given
-
     given(_physical_records())(lambda records: _check_site(records) and None)()

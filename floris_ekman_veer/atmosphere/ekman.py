@@ -91,8 +91,8 @@ MIN_COOLING_RATE = -10.0
 #: would be 2 m deep); shallower solutions raise ValueError (docs/atmosphere.md#shallow-boundary-layer).
 MIN_BOUNDARY_LAYER_HEIGHT = 10.0
 #: The deepest convective mixed layer accepted [m]: afternoon layers over land reach 1-2 km, over
-#: deserts 4-5 km (Stull 1988, An Introduction to Boundary Layer Meteorology, Sect. 1.5; Garratt
-#: 1992, The Atmospheric Boundary Layer, Sect. 6.1); a z_i in feet or above the troposphere's
+#: deserts 4-5 km (Stull 1988, An Introduction to Boundary Layer Meteorology; Garratt
+#: 1992, The Atmospheric Boundary Layer); a z_i in feet or above the troposphere's
 #: lower half is refused (docs/atmosphere.md#physical-domain).
 MAX_MIXED_LAYER_HEIGHT = 5000.0
 #: The strongest geostrophic wind accepted [m/s]: above the 50-60 m/s of the deepest
@@ -1159,10 +1159,16 @@ def _turbulence_constants(**constants):
     if unknown:
         raise ValueError(f"unknown constant(s) {unknown}; the constants are "
                          f"{sorted(TURBULENCE_CONSTANTS)}")
-    return {name: float(_checked(
-        name, value, lambda v: (np.ndim(v) == 0) & (v > 0),
-        f"one number > 0 (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
-        for name, value in constants.items()}
+    # the model block's ranges (docs/user_guide.md#valid-input-ranges): B1 may be 0, n >= 1
+    lowest = {"B1": (0.0, ">="), "n": (1.0, ">=")}
+    checked = {}
+    for name, value in constants.items():
+        low, sign = lowest.get(name, (0.0, ">"))
+        checked[name] = float(_checked(
+            name, value,
+            lambda v: (np.ndim(v) == 0) & ((v >= low) if sign == ">=" else (v > low)),
+            f"one number {sign} {low:g} (the paper's {TURBULENCE_CONSTANTS[name]:g})"))
+    return checked
 
 
 #: The tightest tolerance of the reference-wind solve (in ln speed): a few times the spacing of

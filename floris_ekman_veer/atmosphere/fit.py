@@ -51,6 +51,7 @@ class in (imports point one way, docs/coupling.md#registry).
 
 from __future__ import annotations
 
+import contextvars
 import difflib
 import importlib
 import inspect
@@ -415,8 +416,14 @@ class ProfileFit:
                 and _hidden_top(self.heights[i : i + 1], self.speeds[i : i + 1], directions,
                                 depth, _record_sigma(self.speeds[i : i + 1], self.speed_noise),
                                 np.hypot(self.direction_noise, self.direction_model_error))[0]):
-            return "no top", _hidden_top_reason(self.heights[i], self.speeds[i], directions,
-                                                depth[0], None, self.direction_noise)
+            kind, text = "no top", _hidden_top_reason(self.heights[i], self.speeds[i],
+                                                      directions, depth[0], None,
+                                                      self.direction_noise)
+            if self.stability == "either":
+                # (the convective fit was tried too, and missed as well)
+                text = text.replace('stability="either" fits convective layers too',
+                                    "its convective fit misses the data too")
+            return kind, text
         return misfit_reason(self.heights[i], self.speeds[i],
                              None if self.directions is None else self.directions[i],
                              _record_sigma(self.speeds[i], self.speed_noise),
@@ -736,6 +743,11 @@ def _stacked_solve(a, rhs):
     finite = np.all(np.isfinite(a), axis=(1, 2)) & np.all(np.isfinite(rhs), axis=1)
     a = np.where(finite[:, None, None], a, np.eye(a.shape[-1]))
     rhs = np.where(finite[:, None], rhs, 0.0)
+    try:
+        # (the stack at once where no system is singular: the usual case, and the cheapest)
+        return np.linalg.solve(a, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        pass
     singular_values = np.linalg.svd(a, compute_uv=False)
     regular = singular_values[:, -1] > 1e-13 * singular_values[:, 0]
     x = np.zeros_like(rhs)
@@ -826,41 +838,40 @@ def _check_option_names(abl_class, fixed_inputs):
             f"{valid[len(FIT_OPTIONS):]}")
 
 
-#: [deg] A fitted veer between a record's lowest and highest vane below this, with every one
-#: of its directions within 0 to 2 pi, is what directions in radians look like: a warning.
+#: [deg] A record whose directions all lie within 0 to 2 pi and spread over less than this
+#: between its vanes (a veer and a vane noise of a few hundredths of a "degree") looks like
+#: directions in radians: a warning.
 RADIANS_VEER = 0.5
+#: True inside the two fits of one ``stability="either"`` fit (which warns once, on its own).
+_ONE_OF_TWO_SIGNS = contextvars.ContextVar("one_of_two_signs", default=False)
 
 
 def _warn_if_radians(fit):
     """:class:`DirectionUnitsWarning`, once, naming the records whose directions all lie within
-    0 to 2 pi and whose fitted veer between their lowest and highest vane is below
-    :data:`RADIANS_VEER` (a real veer of a few degrees given in radians is a few hundredths
-    of a "degree"). Two records or more all in radians are refused (`_check_degrees`)."""
+    0 to 2 pi and turn by less than :data:`RADIANS_VEER` between their vanes: a real veer of a
+    few degrees and a vane's noise, given in radians, are a few hundredths of a "degree" (in
+    degrees a vane's noise alone spreads them wider). Two records or more all in radians are
+    refused (`_check_degrees`); a northerly wind within 6.3 deg of north, steady to 0.5 deg, is
+    warned about too."""
     if fit.directions is None:
         return
     d = np.atleast_2d(fit.directions)
-    z = np.where(np.isfinite(d), np.atleast_2d(fit.heights), np.nan)
     measured = np.sum(np.isfinite(d), axis=1) >= 2
-    within = np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1) & measured
+    within = measured & np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1)
     if not np.any(within):
         return
     rows = np.flatnonzero(within)
-    # (every record's lowest and highest vane: the fit's profiles are evaluated all at once)
-    anywhere = np.where(measured[:, None], z, np.atleast_2d(fit.heights)[:, :1])
-    ends = np.stack([np.nanmin(anywhere, axis=1), np.nanmax(anywhere, axis=1)], axis=1)
-    direction = np.reshape(fit.direction(ends[0] if fit.single else ends), (-1, 2))[rows]
-    low, high = ends[rows, 0], ends[rows, 1]
-    veer = np.abs(_wrap(direction[:, 1] - direction[:, 0]))
-    small = veer < RADIANS_VEER
+    spread = np.nanmax(d[rows], axis=1) - np.nanmin(d[rows], axis=1)
+    small = spread < RADIANS_VEER
     if not np.any(small):
         return
     labels = [fit.labels[i] for i in rows[small]]
     shown = ", ".join(str(k) for k in labels[:5]) + (", ..." if len(labels) > 5 else "")
     warn(f"fit_profile: the directions of {len(labels)} record(s) ({shown}) all lie within 0 to "
-         f"2 pi and their fitted veer is only {float(veer[small][0]):.2g} deg between "
-         f"{low[small][0]:.4g} and {high[small][0]:.4g} m, as directions in radians would: "
-         "give degrees (np.degrees); a northerly wind in degrees can be given as 360 + "
-         "direction", DirectionUnitsWarning, items=[str(k) for k in labels])
+         f"2 pi and turn by only {float(spread[small][0]):.2g} deg between their vanes, as "
+         "directions in radians would: give degrees (np.degrees); a northerly wind in degrees "
+         "can be given as 360 + direction", DirectionUnitsWarning,
+         items=[str(k) for k in labels])
 
 
 def _check_degrees(directions):
@@ -1297,7 +1308,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         stability=stability, bound=shape(bound),
     )
     abl.profile_fit = fit
-    _warn_if_radians(fit)
+    if not _ONE_OF_TWO_SIGNS.get():
+        _warn_if_radians(fit)
     return abl
 
 
@@ -1316,11 +1328,15 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     """``fit_profile(stability="either")``: the stable and the convective fits of every record,
     each record keeping the one with the smaller misfit; refused (``on_misfit="raise"``) where
     neither passes the chi-square test, the message naming both misfits."""
-    fits = [
-        fit_profile(abl_class, heights, speeds, directions, on_misfit="flag", labels=labels,
-                    stability=sign, **options).profile_fit
-        for sign in ("stable", "convective")
-    ]
+    inner = _ONE_OF_TWO_SIGNS.set(True)
+    try:
+        fits = [
+            fit_profile(abl_class, heights, speeds, directions, on_misfit="flag", labels=labels,
+                        stability=sign, **options).profile_fit
+            for sign in ("stable", "convective")
+        ]
+    finally:
+        _ONE_OF_TWO_SIGNS.reset(inner)
     stable, convective = fits
     passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
     # Convective where it misses the data less; among equally good fits (data that do not tell
@@ -1378,6 +1394,7 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
     fit.abl = abl
     fit.boundary_layer_height = np.asarray(abl.boundary_layer_height)
     abl.profile_fit = fit
+    _warn_if_radians(fit)
     return abl
 
 

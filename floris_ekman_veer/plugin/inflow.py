@@ -773,13 +773,17 @@ def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
 def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
     """At build: the shallow-boundary-layer policy ``raise`` (plugin/shallow.py; ``warn``
     counts them at the first run instead, :func:`warn_shallow`), hubs in the roughness
-    sublayer, and a heterogeneous map given with the atmosphere (warned)."""
+    sublayer, a heterogeneous map given with the atmosphere (warned), and FLORIS's turbulence
+    intensities the ekman_veer model does not read (said)."""
+    from floris_ekman_veer.plugin import input_checks
+
     flow_field = core.flow_field
     height = _reference_height(core)
     if height is None:
         return  # FLORIS refuses it
     abl = solve(spec, flow_field.wind_speeds, height)
     _check_shallow(core, abl, height, "build")
+    input_checks.notice_unused_turbulence(core, abl, spec)
     sublayer = np.max(np.where(abl.at_rest, 0.0, np.reshape(abl.roughness_sublayer_height, -1)))
     low = np.flatnonzero(np.asarray(core.farm.hub_heights, dtype=float) < sublayer)
     if low.size:

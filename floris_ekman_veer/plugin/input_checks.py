@@ -75,10 +75,7 @@ def warn_ignored_flow_inputs(core, atmosphere) -> None:
     package, docs/user_guide.md#floris-inputs-the-atmosphere-replaces): one
     :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per value per study, so that a
     value the user set is never silently without effect. Zero (the shipped inputs') is silent.
-    ``flow_field.turbulence_intensities``, which FLORIS requires, is not the ekman_veer wake
-    model's ambient turbulence either (it takes I_u from the atmosphere): said once per study
-    where the TI given vary (over conditions or set() calls; one value throughout is FLORIS's
-    required placeholder)."""
+    FLORIS's ``turbulence_intensities``: :func:`notice_unused_turbulence`."""
     if atmosphere is None:
         return
     flow_field = core.flow_field
@@ -89,24 +86,6 @@ def warn_ignored_flow_inputs(core, atmosphere) -> None:
             "gives the inflow's shear; set wind_shear: 0.0 to say so "
             "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
             package_warnings.ModelSettingsWarning, items=(("wind_shear", shear),))
-    intensities = np.asarray(flow_field.turbulence_intensities, dtype=float).ravel()
-    velocity_model = str(core.wake.model_strings.get("velocity_model", "")).lower()
-    # FLORIS requires a TI: one value throughout is taken as that placeholder; TIs that vary
-    # within the study, on one atmosphere, are values the user means, which this model does not
-    # read.
-    seen = (package_warnings.values_seen(f"turbulence_intensities on {atmosphere!r}",
-                                         np.unique(intensities))
-            if velocity_model == VELOCITY_MODEL_NAME and intensities.size else ())
-    if len(seen) > 1:
-        package_warnings.warn(
-            "flow_field.turbulence_intensities "
-            f"({package_warnings.range_text(seen, '').strip()}) are not used as the "
-            f"ambient turbulence by the {VELOCITY_MODEL_NAME} wake model: it takes I_u at hub "
-            f"height from the atmosphere ({ATMOSPHERE_PATH}; per condition in validity_report's "
-            "turbulence_intensity). FLORIS's gauss and other models read them: for a comparison "
-            "on the same inflow give them the atmosphere's I_u "
-            "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
-            package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
     if veer != 0.0 and uses_wake_models(core):
         package_warnings.warn(
             f"flow_field.wind_veer = {veer:g} deg is not used by the "
@@ -114,6 +93,37 @@ def warn_ignored_flow_inputs(core, atmosphere) -> None:
             "wind_veer: 0.0 to say so (FLORIS's gauss models read it, "
             "docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
             package_warnings.ModelSettingsWarning, items=(("wind_veer", veer),))
+
+
+def notice_unused_turbulence(core, abl, atmosphere) -> None:
+    """``flow_field.turbulence_intensities``, which FLORIS requires, is not the ekman_veer wake
+    model's ambient turbulence (it takes I_u at hub height from the solved atmosphere ``abl``):
+    said once per study and atmosphere where the TI given vary (over conditions or set() calls;
+    one value throughout is FLORIS's required placeholder), unless they are the atmosphere's own
+    I_u at a hub height, as the package's comparisons give them (studies/comparison.py)."""
+    if str(core.wake.model_strings.get("velocity_model", "")).lower() != VELOCITY_MODEL_NAME:
+        return
+    given = np.asarray(core.flow_field.turbulence_intensities, dtype=float).ravel()
+    moving = ~np.asarray(abl.at_rest, dtype=bool).ravel()
+    if not np.any(moving):
+        return
+    for hub in np.unique(np.asarray(core.farm.hub_heights, dtype=float)):
+        if hub >= np.max(abl.roughness_length):
+            own = np.ravel(abl.turbulence_intensity(hub, reference_height=hub))
+            if np.allclose(given[moving], own[moving], rtol=1e-6, atol=0.0):
+                return
+    seen = package_warnings.values_seen(f"turbulence_intensities on {atmosphere!r}",
+                                        np.unique(given))
+    if len(seen) > 1:
+        package_warnings.warn(
+            "flow_field.turbulence_intensities "
+            f"({package_warnings.range_text(seen, '').strip()}) are not used as the ambient "
+            f"turbulence by the {VELOCITY_MODEL_NAME} wake model: it takes I_u at hub height from "
+            f"the atmosphere ({ATMOSPHERE_PATH}; per condition in validity_report's "
+            "turbulence_intensity). FLORIS's gauss and other models read them: for a comparison "
+            "on the same inflow give them the atmosphere's I_u "
+            "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
+            package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
 
 
 def _check_layout(farm) -> None:

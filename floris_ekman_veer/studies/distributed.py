@@ -26,6 +26,8 @@ from __future__ import annotations
 import contextlib
 import copy
 
+import numpy as np
+
 from floris.par_floris_model import ParFlorisModel as _FlorisParFlorisModel
 
 import floris_ekman_veer.warnings as package_warnings
@@ -121,6 +123,12 @@ class ParFlorisModel(_FlorisParFlorisModel):
         print_timings: bool = False,
         client=None,
     ):
+        for name, value in (("max_workers", max_workers),
+                            ("n_wind_condition_splits", n_wind_condition_splits)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or (
+                    value < 1 and value != -1):
+                raise ValueError(f"ParFlorisModel {name} must be a positive integer or -1 (the "
+                                 f"default); got {value!r}")
         if interface != DASK:
             if client is not None:
                 raise ValueError(

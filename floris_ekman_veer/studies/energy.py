@@ -68,6 +68,7 @@ from floris_ekman_veer.plugin.inflow import (
     set_atmosphere,
 )
 from floris_ekman_veer.plugin.names import VELOCITY_MODEL_NAME as MODEL_NAME
+from floris_ekman_veer._validation import require_floris_model
 from floris_ekman_veer.studies.optimization import (
     check_optimizer_options,
     optimize_yaw,
@@ -312,6 +313,7 @@ def annual_energy(
             FlorisModel.
         **optimizer_kwargs: Options of ``optimizer_class`` (checked before any run).
     """
+    require_floris_model(fmodel, "annual energy")
     classes = stability_classes(stability, wind_data, records)
     study = _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensities,
                          chunk_size, optimizer_kwargs, client, steering_chunk_size)

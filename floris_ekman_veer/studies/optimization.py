@@ -29,7 +29,7 @@ from floris.core import FlowField, TurbineCubatureGrid, TurbineGrid, WakeModelMa
 from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimization
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-from floris_ekman_veer._validation import require_floris_model
+from floris_ekman_veer._validation import real_array, require_floris_model
 from floris_ekman_veer.plugin.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
@@ -149,6 +149,8 @@ def optimize_yaw(
             "optimize_yaw: the model has no conditions (n_findex = 0): give at least one wind "
             "direction, wind speed and turbulence intensity with fmodel.set(...)"
         )
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise TypeError(f"optimize_yaw: progress must be True, False or None; got {progress!r}")
     optimizer_kwargs = with_default_yaw_bounds(optimizer_class, optimizer_kwargs)
     check_optimizer_options(optimizer_class, optimizer_kwargs, n_findex, n_turbines)
     if search not in SEARCHES:
@@ -758,9 +760,10 @@ def check_optimizer_options(optimizer_class, options: Mapping, n_findex: int, n_
 
     def angles(option, default):
         value = options.get(option, default)
-        array = np.asarray(value, dtype=float) if value is not None else None
-        if array is None:
+        if value is None:
             return None
+        array = real_array(f"optimize_yaw: {name} option {option}", value,
+                           "a number, a list of one per turbine or an (n_findex, n_turbines) array")
         if array.shape not in ((), (n_turbines,), (n_findex, n_turbines)) or not np.all(
             np.isfinite(array)
         ):

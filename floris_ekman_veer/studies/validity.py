@@ -164,7 +164,8 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     bounds = real_array("validity_report: rossby_range", rossby_range, valid)
     if bounds.shape != (2,) or not (0 < bounds[0] < bounds[1] < np.inf):
         raise ValueError(
-            f"validity_report: rossby_range must be {valid}; got {tuple(np.ravel(bounds))!r}"
+            f"validity_report: rossby_range must be {valid}; got "
+            f"{tuple(float(v) for v in np.ravel(bounds))!r}"
         )
     low, high = (float(v) for v in bounds)
     core = fmodel.core
