@@ -33,7 +33,7 @@ def main() -> None:
     site = floris_ekman_veer.fit_site(records, 90.0, on_misfit="drop", **SITE)
     fit_seconds = time.perf_counter() - start
     cpu_seconds = time.process_time()
-    summary = site.summary()
+    summary = site.summary().exclusions
     print(f"fit_site on {len(records)} records: {fit_seconds:.1f} s ({cpu_seconds:.1f} s of CPU "
           "with the imports)")
     print(summary.drop(columns="example").to_string())

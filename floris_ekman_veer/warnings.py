@@ -237,11 +237,12 @@ def values_seen(key: str, values) -> set:
 
 
 def speeds_text(speeds) -> str:
-    """The distinct wind speeds of a list, as text: '8, 9 and 11 m/s'."""
-    values = sorted({round(float(s), 6) for s in speeds})
-    shown = [f"{v:g}" for v in values[:8]]
+    """The distinct wind speeds of a list to 0.01 m/s, as text: '8, 9 and 11 m/s'; more than
+    eight as their range: '0.27 to 11.4 m/s (1,204 distinct)'."""
+    values = sorted({round(float(s), 2) for s in speeds})
     if len(values) > 8:
-        shown.append(f"{len(values) - 8} more")
+        return f"{values[0]:g} to {values[-1]:g} m/s ({len(values):,} distinct)"
+    shown = [f"{v:g}" for v in values]
     text = shown[0] if len(shown) == 1 else ", ".join(shown[:-1]) + " and " + shown[-1]
     return f"{text} m/s"
 
@@ -250,6 +251,39 @@ def range_text(values, unit: str) -> str:
     """'90.1 to 125 m', or '125 m' for one value."""
     low, high = float(min(values)), float(max(values))
     return f"{low:.4g} {unit}" if f"{low:.4g}" == f"{high:.4g}" else f"{low:.4g} to {high:.4g} {unit}"
+
+
+def _conditions_text(count, total, runs):
+    """'3 of 8 conditions', or over a study's runs '30 of 80 conditions evaluated in its 10 FLORIS
+    runs' (a condition run by several models or optimiser steps counts each time)."""
+    if runs > 1:
+        return f"{count:,} of {total:,} conditions evaluated in the study's {runs:,} FLORIS runs"
+    return f"{count} of {total} conditions"
+
+
+def warn_shallow(count, total, speeds, heights, top, hub, hub_above, reference_height,
+                 policy_path, runs=1) -> None:
+    """The ShallowBoundaryLayerWarning of ``count`` of ``total`` conditions (their wind speeds
+    and ABL heights ``heights``; the highest rotor's ``top`` and ``hub``; ``hub_above`` of them
+    with h at or below the hub; over ``runs`` FLORIS runs); in a study or a worker, recorded for
+    its one summary."""
+    records = _COLLECTING.get()
+    if records is not None:
+        records.append(("shallow", int(count), int(total), [float(v) for v in speeds],
+                        [float(v) for v in heights], float(top), float(hub), int(hub_above),
+                        float(reference_height), policy_path))
+        return
+    warn(
+        f"{_conditions_text(count, total, runs)} (wind speeds {speeds_text(speeds)} at "
+        f"{reference_height:.6g} m; h = {range_text(heights, 'm')}) have a boundary layer "
+        f"shallower than the rotor top ({top:.6g} m; hub {hub:.6g} m, {hub_above} of them with "
+        "h at or below the hub), outside the paper's validated range: above h the inflow is the "
+        "geostrophic wind and the wake expansion falls continuously to its floor "
+        f"(docs/atmosphere.md#shallow-boundary-layer). Set {policy_path}: raise to refuse "
+        "them, or ignore (or call floris_ekman_veer.silence_warnings()) to silence this.",
+        ShallowBoundaryLayerWarning,
+        items=[(round(float(s), 6), round(float(d), 3)) for s, d in zip(speeds, heights)],
+    )
 
 
 # ------------------------------------------------------------------------------ once per run
@@ -315,10 +349,10 @@ def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
         _warn_thrust_limit(limit, *_flagged(conditions, wind_speeds), reference_height)
 
 
-def _warn_thrust_limit(limit, flagged, total, reference_height) -> None:
+def _warn_thrust_limit(limit, flagged, total, reference_height, runs=1) -> None:
     where = ""
     if flagged is not None:
-        where = (f" in {len(flagged)} of {total} conditions (wind speeds "
+        where = (f" in {_conditions_text(len(flagged), total, runs)} (wind speeds "
                  f"{speeds_text(flagged)} at {float(reference_height):g} m)")
     # The loading comes from the turbines' own thrust tables (C_T cos^2(yaw) only falls with
     # yaw), so a stock turbine above the limit near cut-in meets it in every wind rose: said once
@@ -347,6 +381,35 @@ def in_worker_process() -> bool:
     import multiprocessing
 
     return multiprocessing.parent_process() is not None
+
+
+@contextlib.contextmanager
+def study_scope():
+    """Record the package's warnings during a study (many FLORIS runs: chunks, models, an
+    optimiser's runs) and issue one summary per warning class at its end, at the user's line
+    (:func:`report_from_workers`). Nested in a study or a worker: nothing of its own."""
+    if _COLLECTING.get() is not None:
+        yield
+        return
+    records: list = []
+    token = _COLLECTING.set(records)
+    try:
+        yield
+    finally:
+        _COLLECTING.reset(token)
+    _ARRIVED.append(records)
+    report_from_workers()
+
+
+@contextlib.contextmanager
+def discarding():
+    """Drop the package's warnings of an auxiliary computation whose results the user sees
+    through another call (which warns for itself)."""
+    token = _COLLECTING.set([])
+    try:
+        yield
+    finally:
+        _COLLECTING.reset(token)
 
 
 @contextlib.contextmanager
@@ -419,9 +482,16 @@ def report_from_workers(n_conditions: int | None = None) -> None:
     arrived = [record for records in _ARRIVED for record in records]
     _ARRIVED.clear()
     thrust: dict = {}
+    shallow: dict = {}
     for record in arrived:
         if record[0] == "warn":
             warn(*record[1:])
+            continue
+        if record[0] == "shallow":
+            # (one summary per rotor and reference height: the counts, speeds and depths add)
+            entry = shallow.setdefault(record[5:7] + record[8:], [0, 0, [], [], 0, 0])
+            for k, value in enumerate((record[1], record[2], record[3], record[4], record[7], 1)):
+                entry[k] += value
             continue
         _, limit, flagged, total, reference_height = record
         entry = thrust.setdefault(limit, [[], 0, reference_height, True])
@@ -430,6 +500,10 @@ def report_from_workers(n_conditions: int | None = None) -> None:
         else:
             entry[0].extend(flagged)
             entry[1] += total
+    for (top, hub, reference_height, policy_path), (count, total, speeds, heights, hub_above,
+                                                    runs) in shallow.items():
+        warn_shallow(count, total, speeds, heights, top, hub, hub_above, reference_height,
+                     policy_path, runs)
     for limit, (flagged, total, reference_height, counted) in thrust.items():
         if counted:
             _warn_thrust_limit(limit, flagged, n_conditions or total, reference_height)

@@ -357,6 +357,14 @@ SCRIPT_NUMBERS = [
      ("examples/site_year.py",),
      r"zero reading\s+(\d+) .*?calm\s+(\d+) .*?backing\s+(\d+) .*?no top\s+(\d+) .*?"
      r"misfit\s+(\d+) .*?physical bound\s+(\d+) .*?fitted\s+(\d+) "),
+    ("docs/measurements.md", r"It keeps [\d,]+ of the 8,760 records, ([\d.]+) % of the records the "
+                             r"generator made not calm .*? the fitted class is the generator's for "
+                             r"([\d.]+) % of them .*? the vane offsets found are ([\-+][\d.]+) \+- "
+                             r"[\d.]+ and ([\-+][\d.]+) \+-",
+     ("examples/site_report.py", "--no-energy"),
+     r"against the generator's truth: ([\d.]+) % of the non-calm records "
+     r"kept; fitted class the generator's for ([\d.]+) %.*?38 m ([\-+][\d.]+) .*?58 m "
+     r"([\-+][\d.]+) "),
     ("docs/measurements.md", r"\| convective \| no \| (\d+) \| (\d+) \| (\d+) \| (\d+) \| ([\d.]+) % "
                              r"\| (\d+) of 200 \| (\d+) of 200 \|",
      ("benchmarks/fit_stability_classes.py",),

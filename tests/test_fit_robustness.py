@@ -334,14 +334,15 @@ def test_the_issues_records_that_aborted_a_site_are_fitted_or_named():
     assert 799.0 < float(mixed.abl.sensible_heat_flux) <= 800.0
     assert mixed.obukhov_length == pytest.approx(-122.0, abs=1.0)
     assert float(mixed.abl.turbulence_intensity(90.0)) == pytest.approx(0.157, abs=0.002)
+    # An infinite reading is removed (the record keeps its other data) and named by its time
+    # stamp (docs/measurements.md#a-real-mast).
     bad = calm.copy()
     bad.loc[1, "speed_60m"] = np.inf
+    bad.loc[0, "direction_60m"] = np.inf
     site = _check_site(bad)
-    assert list(site.excluded["kind"]) == ["infinite reading"]
-    assert list(site.excluded["time"]) == ["2016-10-21 03:00"]
-    with pytest.raises(ValueError, match=r"record 2016-10-21 03:00 cannot be fitted: an infinite "
-                                         r"speed or direction reading"):
-        fit_site(bad, 80.0, latitude=53.3, roughness_length=0.05)
+    assert list(site.flags["kind"]) == ["infinite reading"] * 2
+    assert list(site.flags["time"]) == ["2016-10-21 02:00", "2016-10-21 03:00"]
+    assert list(site.excluded["kind"]) == ["calm"] and site.labels == ["2016-10-21 02:00"]
 
 
 def test_random_real_looking_records_never_abort_a_site_and_stay_physical():

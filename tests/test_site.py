@@ -127,8 +127,8 @@ def test_bad_tables_are_refused():
     records, _ = records_of([8.0], [200.0], [270.0])
     with pytest.raises(ValueError, match=r"speed columns at two heights or more"):
         fit_site(records[["time", "speed_30m"]], 90.0, **SITE)
-    with pytest.raises(ValueError, match=r"direction columns at heights \[30.0\] m do not match"):
-        fit_site(records[["time", "speed_30m", "speed_50m", "direction_30m"]], 90.0, **SITE)
+    with pytest.raises(ValueError, match=r"columns \['speed_-30m'\] are named like measurements"):
+        fit_site(records.rename(columns={"speed_30m": "speed_-30m"}), 90.0, **SITE)
     with pytest.raises(ValueError, match=r"must be a pandas DataFrame"):
         fit_site(records.to_numpy(), 90.0, **SITE)
     with pytest.raises(ValueError, match=r"reference_height must be a number > 0"):

@@ -95,7 +95,7 @@ def test_one_call_fits_every_fittable_record_and_names_the_others(records, site)
 
 
 def test_summary_counts_what_was_left_out_and_why(site):
-    summary = site.summary()
+    summary = site.summary().exclusions
     counts = site.excluded["kind"].value_counts()
     assert summary.loc["fitted", "records"] == len(site.labels)
     for kind, n in counts.items():

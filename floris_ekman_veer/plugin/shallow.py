@@ -86,16 +86,6 @@ def check_rotor_inside(
             f"{index.size} of {h.size} conditions have a boundary layer shallower than the rotor "
             f"(rotor top above h), refused by {POLICY_PATH} = 'raise': {listed}{more}"
         )
-    package_warnings.warn(
-        f"{index.size} of {h.size} conditions (wind speeds "
-        f"{package_warnings.speeds_text(speeds[index])} at {reference_height:.6g} m; h = "
-        f"{package_warnings.range_text(h[index], 'm')}) have a boundary layer shallower than "
-        f"the rotor top ({top:.6g} m; hub {hub:.6g} m, {hub_above} of them with h at or below "
-        "the hub), outside the paper's validated range: above h the inflow is the geostrophic "
-        "wind and the wake expansion falls continuously to its floor "
-        f"(docs/atmosphere.md#shallow-boundary-layer). Set {POLICY_PATH}: raise to refuse "
-        "them, or ignore (or call floris_ekman_veer.silence_warnings()) to silence this.",
-        ShallowBoundaryLayerWarning,
-        items=[(round(float(s), 6), round(float(d), 3)) for s, d in zip(speeds[index], h[index])],
-    )
+    package_warnings.warn_shallow(index.size, h.size, speeds[index], h[index], top, hub,
+                                  hub_above, reference_height, POLICY_PATH)
     return affected

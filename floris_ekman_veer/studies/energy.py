@@ -53,6 +53,7 @@ import pandas as pd
 from floris.optimization.yaw_optimization.yaw_optimizer_scipy import YawOptimizationScipy
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 from floris.wind_data import TimeSeries, WindRose
+import floris_ekman_veer.warnings as package_warnings
 
 from floris_ekman_veer.studies.comparison import (
     BUILTIN_WAKES,
@@ -231,6 +232,9 @@ class AnnualEnergy:
     #: wind data), columns ``stability``, ``frequency``, ``farm_power_baseline`` and
     #: ``farm_power_steered`` [W] (NaN without an optimiser).
     conditions: dict = attrs.field(factory=dict)
+    #: A fitted year's energy per month (``SiteAtmosphere.annual_energy``): one row per model
+    #: and month, the columns of ``table`` with ``period`` for ``stability``; else None.
+    by_month: pd.DataFrame | None = None
 
     def plot(self, ax=None):
         """Bar chart of the AEP per class and model, baseline and steered; returns the Axes."""
@@ -339,13 +343,16 @@ def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Seque
                   optimizer_class=None, *, models: Sequence[str] = (MODEL_NAME, "gch"),
                   turbulence_intensities: str = "atmosphere", progress: bool | None = None,
                   chunk_size: int = DEFAULT_CHUNK_SIZE, steering_chunk_size: int | None = None,
-                  client=None, **optimizer_kwargs) -> AnnualEnergy:
+                  client=None, classes: Sequence[str] | None = None,
+                  **optimizer_kwargs) -> AnnualEnergy:
     """:func:`annual_energy` of a ``TimeSeries`` whose records each have their own atmosphere
     (``atmosphere``: the block with one value per record, as ``SiteAtmosphere.atmosphere``).
 
     One class per distinct atmosphere, named by the label of its first record (as
     ``SiteAtmosphere.stability``); the numbers are those of ``annual_energy`` with these
-    classes and records, without a class mapping per record.
+    classes and records, without a class mapping per record. ``classes``: instead, a class
+    name per record (e.g. the fitted "convective", "neutral", "stable"), each record still run
+    with its own atmosphere; the classes in the order of their first record.
     """
     study = _check_study(fmodel, series, optimizer_class, models, turbulence_intensities,
                          chunk_size, optimizer_kwargs, client, steering_chunk_size)
@@ -354,7 +361,14 @@ def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Seque
     spec = AtmosphereSpec.from_mapping(atmosphere)
     spec.check_conditions(n)
     per_record = sorted(k for k, v in spec.inputs.items() if not isinstance(v, float))
-    if per_record:
+    if classes is not None:
+        if len(classes) != n:
+            raise ValueError(f"annual energy: classes must name the {n} records' classes; got "
+                             f"{len(classes)}")
+        _, first, owner = np.unique(np.asarray(classes, dtype=str), return_index=True,
+                                    return_inverse=True)
+        owner, labels = owner.reshape(-1), [str(c) for c in classes]
+    elif per_record:
         rows = np.stack([spec.inputs[k].reshape(-1) for k in per_record], axis=1)
         _, first, owner = np.unique(rows, axis=0, return_index=True, return_inverse=True)
         owner = owner.reshape(-1)
@@ -467,8 +481,10 @@ def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_clas
     n_classes = len(names)
     total = sum(c.wind_index.size for c in conditions)
     per_model = {}
-    with tqdm(total=total * len(study["models"]), desc="annual energy", unit="condition",
-              disable=not (progress if progress is not None else steered)) as bar:
+    # One summary per warning class for the whole study, not one per chunk and model.
+    with package_warnings.study_scope(), tqdm(
+            total=total * len(study["models"]), desc="annual energy", unit="condition",
+            disable=not (progress if progress is not None else steered)) as bar:
         for model in study["models"]:
             bar.set_postfix_str(model)
             template = fmodel.copy() if model == MODEL_NAME else builtin_model(fmodel, model)
@@ -527,6 +543,26 @@ def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_clas
     }
     return AnnualEnergy(table=table[list(COLUMNS)], optima=optima, inflow=inflow,
                         conditions=per_condition)
+
+
+def energy_by_period(energy: AnnualEnergy, periods) -> pd.DataFrame:
+    """The study's energy per model and period (``periods``: a name per condition of the wind
+    data, e.g. its month), as :func:`annual_energy`'s table: the periods sum to the year."""
+    rows = []
+    for model, conditions in energy.conditions.items():
+        period = np.asarray(periods, dtype=object)[conditions.index.to_numpy()]
+        for name in pd.unique(period):
+            these = conditions[period == name]
+            baseline = _aep(these["frequency"], these["farm_power_baseline"])
+            steered = (_aep(these["frequency"], these["farm_power_steered"])
+                       if these["farm_power_steered"].notna().any() else np.nan)
+            rows.append({"model": model, "period": name, "frequency": these["frequency"].sum(),
+                         "n_conditions": len(these), "aep_baseline_gwh": baseline,
+                         "aep_steered_gwh": steered,
+                         "gain_percent": 100.0 * (steered / baseline - 1.0)})
+    from floris_ekman_veer.studies.tables import FullTable
+
+    return FullTable(pd.DataFrame(rows))
 
 
 def _aep(freq, farm_power) -> float:

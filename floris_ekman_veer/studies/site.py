@@ -3,65 +3,117 @@
 
 Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with columns
 ``speed_<height>m`` [m/s] and ``direction_<height>m`` [deg, meteorological] (e.g. ``speed_90m``,
-``direction_90m``; NaN for a missing value) and optionally a ``time`` column naming the records.
+``direction_90m``; NaN for a missing value), or a real mast's cups on booms, their standard
+deviations and vanes at their own heights (studies/mast.py, docs/measurements.md#a-real-mast),
+and optionally a ``time`` column naming the records.
 :func:`fit_site` fits every record (``EkmanABL.fit_profile``, one vectorised call) and gives, per
 record, FLORIS's inputs at the reference height: the wind speed and direction of the fitted
 profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and the atmosphere
 block with one entry per record. Driven by those wind speeds, the block gives back the fitted
-ABLs (checked when it is made).
+ABLs (checked when it is made). ``SiteAtmosphere.summary()`` reports the site.
 """
 
 from __future__ import annotations
-
-import re
 
 import attrs
 import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.studies.energy import record_energy
+from floris_ekman_veer.atmosphere.fit import FIT_OPTIONS
+from floris_ekman_veer.studies.mast import (OFFSET_MIN_RECORDS, SHADOW_HALF_WIDTH, mast_columns,
+                                            measured_turbulence, read_instruments,
+                                            strong_wind_rows, with_offsets_from)
+from floris_ekman_veer.studies.energy import energy_by_period, record_energy
 from floris_ekman_veer.plugin.inflow import set_atmosphere
 
-#: Column names of the measured speeds and directions: the height in metres is in the name.
-SPEED_COLUMN = re.compile(r"^speed_(\d+(?:\.\d+)?)m$")
-DIRECTION_COLUMN = re.compile(r"^direction_(\d+(?:\.\d+)?)m$")
 #: Fractions of the rotor radius at which :func:`atmosphere_from_shear_and_veer` samples the
 #: power law: bottom tip, half way, hub, half way, top tip.
 ROTOR_SAMPLES = (-1.0, -0.5, 0.0, 0.5, 1.0)
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")
+#: The reference height may lie at most this many times above the highest measurement: the
+#: fitted profile is not extrapolated further than the mast's own height again.
+MAX_EXTRAPOLATION = 2.0
 
 
-def mast_profiles(records: pd.DataFrame):
-    """(heights [m], speeds (n_records, n_heights), directions or None) from the
-    ``speed_<h>m`` and ``direction_<h>m`` columns of ``records`` (heights sorted)."""
-    if not isinstance(records, pd.DataFrame):
-        raise ValueError(f"records must be a pandas DataFrame; got {type(records).__name__}")
-    speeds = {float(m[1]): c for c in records.columns if (m := SPEED_COLUMN.match(str(c)))}
-    directions = {float(m[1]): c for c in records.columns
-                  if (m := DIRECTION_COLUMN.match(str(c)))}
-    if len(speeds) < 2:
-        raise ValueError(
-            "records need speed columns at two heights or more, named speed_<height>m (e.g. "
-            f"speed_90m); got columns {list(records.columns)}"
-        )
-    if directions and set(directions) != set(speeds):
-        raise ValueError(
-            f"records: direction columns at heights {sorted(directions)} m do not match the "
-            f"speed columns at {sorted(speeds)} m (give both at every height; NaN: missing)"
-        )
-    heights = np.array(sorted(speeds))
+#: The fitted records' classes, by their Obukhov length (ProfileFit.stability_class).
+STABILITY_CLASSES = ("convective", "neutral", "stable")
 
-    def table(columns):
-        frame = records[[columns[h] for h in heights]]
-        bad = [c for c in frame.columns if not pd.api.types.is_numeric_dtype(frame[c])]
-        if bad:
-            raise ValueError(f"records: columns {bad} must be numbers (NaN: missing)")
-        return frame.to_numpy(dtype=float)
 
-    return heights, table(speeds), table(directions) if directions else None
+@attrs.frozen(eq=False)
+class SiteSummary:
+    """What :func:`fit_site` made of a site, as a site report reads it (``print`` shows it all).
+
+    Attributes:
+        exclusions: per kind of record left out (:data:`EXCLUSION_KINDS`) the number of
+            records, the first and last time stamps and one reason as written; and the number
+            fitted (kind ``fitted``).
+        records, fitted: the numbers of records given and fitted.
+        kept_fraction: fitted / given; kept_fraction_not_calm: fitted / (given - calm).
+        classes: fitted records per class (convective, neutral, stable).
+        class_by_hour: fitted records per hour of day (rows 0-23) and class (None when the
+            records' names are no time stamps).
+        offsets: the vane offsets applied [deg] (reading minus true direction, relative to the
+            reference vane), their standard errors, the records they come from, and the source.
+        cup_pairs: each redundant cup pair's median ratio where neither is in the mast's wake,
+            its standard error and whether the pair disagrees.
+        flags: the instruments' values removed, per kind and column: the count, the first time
+            stamp and one reason.
+    """
+
+    exclusions: pd.DataFrame
+    records: int
+    fitted: int
+    kept_fraction: float
+    kept_fraction_not_calm: float
+    classes: pd.Series
+    class_by_hour: pd.DataFrame | None
+    offsets: pd.DataFrame | None
+    cup_pairs: pd.DataFrame | None
+    flags: pd.DataFrame
+
+    def plot_class_by_hour(self, ax=None):
+        """Stacked bars of the fitted classes' fractions per hour of day; returns the Axes."""
+        import matplotlib.pyplot as plt
+
+        if self.class_by_hour is None:
+            raise ValueError("the records' names are no time stamps: no hour of day to plot by")
+        if ax is None:
+            _, ax = plt.subplots(figsize=(7.0, 3.5))
+        counts = self.class_by_hour
+        share = counts.div(counts.sum(axis=1).replace(0, 1), axis=0)
+        bottom = np.zeros(len(share))
+        colours = {"convective": "tab:orange", "neutral": "tab:green", "stable": "tab:blue"}
+        for name in share.columns:
+            ax.bar(share.index, share[name], bottom=bottom, label=name, color=colours[name])
+            bottom += share[name].to_numpy()
+        ax.set_xlabel("hour of day")
+        ax.set_ylabel("fraction of fitted records")
+        ax.set_xticks(range(0, 24, 3))
+        ax.set_ylim(0.0, 1.0)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        return ax
+
+    def __str__(self) -> str:
+        parts = [f"records {self.records}, fitted {self.fitted} ({100 * self.kept_fraction:.1f} "
+                 f"%; {100 * self.kept_fraction_not_calm:.1f} % of those not calm)",
+                 "classes: " + ", ".join(f"{k} {int(v)}" for k, v in self.classes.items()),
+                 "left out:\n" + self.exclusions.drop(columns="example").to_string()]
+        if self.offsets is not None and len(self.offsets):
+            parts.append("vane offsets applied [deg] (reading minus true, relative to the "
+                         "reference vane):\n" + self.offsets.to_string(float_format="{:.2f}".format))
+        if self.cup_pairs is not None and len(self.cup_pairs):
+            parts.append("cup pairs:\n" + self.cup_pairs.to_string(float_format="{:.4f}".format))
+        if len(self.flags):
+            parts.append("values removed:\n" + self.flags.drop(columns="example").to_string())
+        if self.class_by_hour is not None:
+            parts.append("class mix by hour of day (records):\n" + self.class_by_hour.T.to_string())
+        return "\n\n".join(parts)
+
+    __repr__ = __str__
 
 
 @attrs.frozen(eq=False)
@@ -91,11 +143,32 @@ class SiteAtmosphere:
     dropped: list
     excluded: pd.DataFrame = attrs.field(
         factory=lambda: pd.DataFrame({"time": [], "kind": [], "reason": []}))
+    #: Per fitted record its row in the records, and the count of records given.
+    rows: np.ndarray | None = None
+    n_records: int | None = None
+    #: What the mast's instruments gave (studies/mast.py): the vane offsets applied, the cup
+    #: pairs' agreement, and the values removed (``row``, ``time``, ``column``, ``kind``,
+    #: ``reason``).
+    offsets: pd.DataFrame | None = None
+    cup_pairs: pd.DataFrame | None = None
+    flags: pd.DataFrame | None = None
 
-    def summary(self) -> pd.DataFrame:
-        """What was left out and why: per kind of record (:data:`EXCLUSION_KINDS`), the number
-        of records, the first and last time stamps, and one reason as written; and the number
-        fitted (kind ``fitted``)."""
+    @property
+    def stability_classes(self) -> np.ndarray:
+        """Per fitted record its class: "convective", "neutral" or "stable"."""
+        return np.atleast_1d(np.asarray(self.profile_fit.stability_class)).astype(str)
+
+    def timestamps(self) -> pd.DatetimeIndex | None:
+        """The fitted records' labels as times (None where they do not read as times)."""
+        try:
+            return pd.DatetimeIndex(pd.to_datetime(pd.Series(self.labels), errors="raise"))
+        except (ValueError, TypeError):
+            return None
+
+    def summary(self) -> SiteSummary:
+        """What the fit made of the site (:class:`SiteSummary`): what was left out and why,
+        the fraction kept, the vane offsets applied, the cup pairs, the values removed, and the
+        class mix by hour of day."""
         rows = []
         for kind in EXCLUSION_KINDS:
             some = self.excluded[self.excluded["kind"] == kind]
@@ -104,7 +177,29 @@ class SiteAtmosphere:
                              "last": some["time"].iloc[-1], "example": some["reason"].iloc[0]})
         rows.append({"kind": "fitted", "records": len(self.labels), "first": self.labels[0],
                      "last": self.labels[-1], "example": ""})
-        return pd.DataFrame(rows).set_index("kind")
+        exclusions = pd.DataFrame(rows).set_index("kind")
+        total = self.n_records if self.n_records is not None else len(self.labels) + len(
+            self.excluded)
+        calm = int((self.excluded["kind"] == "calm").sum())
+        times = self.timestamps()
+        classes = pd.Categorical(self.stability_classes, categories=STABILITY_CLASSES)
+        by_hour = None
+        if times is not None:
+            by_hour = pd.crosstab(np.asarray(times.hour), np.asarray(classes, dtype=str),
+                                  rownames=["hour"], colnames=["class"])
+            by_hour = by_hour.reindex(index=pd.RangeIndex(24, name="hour"),
+                                      columns=pd.Index(STABILITY_CLASSES, name="class"),
+                                      fill_value=0)
+        flags = self.flags if self.flags is not None else pd.DataFrame(
+            columns=["row", "time", "column", "kind", "reason"])
+        return SiteSummary(
+            exclusions=exclusions, records=total, fitted=len(self.labels),
+            kept_fraction=len(self.labels) / total,
+            kept_fraction_not_calm=len(self.labels) / max(total - calm, 1),
+            classes=pd.Series(classes).value_counts().reindex(list(STABILITY_CLASSES)),
+            class_by_hour=by_hour, offsets=self.offsets, cup_pairs=self.cup_pairs,
+            flags=flags.groupby(["kind", "column"]).agg(
+                records=("row", "size"), first=("time", "first"), example=("reason", "first")))
 
     @property
     def profile_fit(self):
@@ -154,19 +249,35 @@ class SiteAtmosphere:
         """:func:`~floris_ekman_veer.annual_energy` of ``fmodel`` for these records, each record
         with its fitted atmosphere (``options``: annual_energy's and the optimiser's;
         ``client=`` a ``dask.distributed.Client`` runs the chunks on its cluster, bitwise the
-        serial numbers, docs/coupling.md#annual-energy).
+        serial numbers, docs/coupling.md#annual-energy), as a site report gives it: ``table``
+        by fitted stability class (convective, neutral, stable) and the year, ``by_month``
+        the energy per month of the records' time stamps (None when the records' names are no
+        time stamps).
 
-        The classes are those of :meth:`stability`; the records run as chunks of one vectorised
-        FLORIS model each, with the per-record atmosphere block (as :meth:`apply`), never a
-        model per class."""
-        return record_energy(fmodel, self.time_series(), self.atmosphere,
-                             [str(label) for label in self.labels], optimizer_class, **options)
+        The records run as chunks of one vectorised FLORIS model each, with the per-record
+        atmosphere block (as :meth:`apply`), never a model per class."""
+        energy = record_energy(fmodel, self.time_series(), self.atmosphere,
+                               [str(label) for label in self.labels], optimizer_class,
+                               classes=list(self.stability_classes), **options)
+        times = self.timestamps()
+        if times is not None:
+            energy = attrs.evolve(energy, by_month=energy_by_period(energy,
+                                                                    times.strftime("%Y-%m")))
+        return energy
 
 
 def fit_site(records: pd.DataFrame, reference_height: float, *,
              stability_input: str = "stability_parameter", on_misfit: str = "raise",
-             time_column: str = "time", **fit_options_and_inputs) -> SiteAtmosphere:
+             time_column: str | None = None, booms: dict | None = None,
+             direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
+             **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
+
+    The mast's instruments are read first (studies/mast.py, docs/measurements.md#a-real-mast):
+    vanes at their own heights, their offsets estimated and removed, stuck vanes and bad or
+    disagreeing readings removed and named, redundant cups chosen out of the mast's wake, and
+    the cups' standard deviations (``speed_<h>m_std``) given to the fit as the measured
+    turbulence intensity at the cup height nearest ``reference_height``.
 
     Records a mast logs that no atmosphere of the model describes (docs/measurements.md#a-year-of-records)
     are named by their time stamp and a reason: a zero (or negative) speed reading, too few
@@ -176,28 +287,44 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     stamp, or a fitted state the atmosphere block cannot give back. One record never aborts the others' fits.
 
     Args:
-        records: DataFrame with ``speed_<h>m``, ``direction_<h>m`` and optionally ``time``.
-        reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually).
+        records: DataFrame with ``speed_<h>m`` (or ``speed_<h>m_<boom>``), optionally
+            ``speed_<h>m[_<boom>]_std``, ``direction_<h>m`` and a time column.
+        reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually),
+            above 10 roughness lengths and at most twice the highest measurement.
         stability_input: the stability input of the atmosphere block (``stability_parameter``,
             ``obukhov_length`` or ``cooling_rate``; the block is checked to give back the fit).
         on_misfit: ``"raise"`` (ValueError naming the first such record, its time stamp and
             why) or ``"drop"`` (leave such records out: ``dropped`` lists them,
             ``excluded`` gives each one's reason and ``summary()`` the counts).
-        time_column: the column naming the records in messages and classes.
+        time_column: the column naming the records in messages and classes (default: ``time``
+            where the records have it, else their index).
+        booms: ``{boom: orientation_deg}`` of cups named ``speed_<h>m_<boom>``: the direction
+            from the mast to the cup, clockwise from north.
+        direction_offsets: ``"estimate"`` (default: each vane's offset relative to the vane
+            nearest ``reference_height``, from the strong-wind records), ``{vane height:
+            offset_deg}`` (the reading minus the true direction; vanes not named: 0), or None.
+        shadow_half_width: [deg] half-width of a cup's mast-wake sector (default 30).
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
     """
     if on_misfit not in MISFIT_POLICIES:
         raise ValueError(f"fit_site: on_misfit must be one of {list(MISFIT_POLICIES)}; got "
                          f"{on_misfit!r}")
-    if "on_misfit" in fit_options_and_inputs or "labels" in fit_options_and_inputs:
-        raise ValueError("fit_site sets fit_profile's on_misfit and labels itself (from its "
-                         "own on_misfit and the time column)")
-    if (isinstance(reference_height, bool) or not np.isscalar(reference_height)
+    if {"on_misfit", "labels", "direction_heights"} & set(fit_options_and_inputs):
+        raise ValueError("fit_site sets fit_profile's on_misfit, labels and direction_heights "
+                         "itself (from its own on_misfit, the time column and the vanes' "
+                         "columns)")
+    if (isinstance(reference_height, (bool, np.bool_))
+            or not isinstance(reference_height, (int, float, np.integer, np.floating))
             or not np.isfinite(reference_height) or reference_height <= 0):
-        raise ValueError(f"fit_site: reference_height must be a number > 0 m; got "
-                         f"{reference_height!r}")
-    heights, speeds, directions = mast_profiles(records)
+        raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
+                         f"got {reference_height!r}")
+    columns = mast_columns(records, booms)
+    if time_column is not None and time_column not in records.columns:
+        raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
+                         f"(columns: {list(records.columns)}); give None to name the records "
+                         "by their index")
+    time_column = "time" if time_column is None else time_column
     labels = (records[time_column].astype(str).tolist() if time_column in records.columns
               else [str(i) for i in records.index])
     if len(records) == 0:
@@ -207,7 +334,21 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         raise ValueError(f"fit_site: reference_height must be > 10 roughness lengths "
                          f"(roughness_length {z0:g} m: above the roughness sublayer, where the "
                          f"fitted profile is a wind a turbine meets); got {reference_height!r} m")
-    excluded = _screen(records, labels, heights, speeds, directions,
+    top = max(columns.cup_heights.max(), columns.vane_heights.max(initial=0.0))
+    if reference_height > MAX_EXTRAPOLATION * top:
+        raise ValueError(f"fit_site: reference_height must be at most {MAX_EXTRAPOLATION:g} "
+                         f"times the highest measurement ({top:g} m: the fitted profile is not "
+                         f"extrapolated further); got {reference_height!r} m")
+    instruments = read_instruments(
+        records, columns, float(reference_height), _neutral_turning(fit_options_and_inputs),
+        booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width,
+        labels=labels)
+    if (isinstance(direction_offsets, str)
+            and (instruments.offsets["source"] == "estimated").any()):
+        instruments = _offsets_from_neutral_fits(instruments, float(reference_height),
+                                                 fit_options_and_inputs)
+    heights, speeds, directions, speed_columns = _fit_heights(instruments, columns)
+    excluded = _screen(speed_columns, labels, heights, speeds, directions,
                        3 if fit_options_and_inputs.get("fit_roughness") else 2)
     if on_misfit == "raise" and excluded:
         row, (kind, text) = next(iter(sorted(excluded.items())))
@@ -217,7 +358,10 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     fit_inputs = dict(fit_options_and_inputs)
     # (a measured turbulence intensity is a pair (height, value), each one number or a column)
     turbulence = fit_inputs.pop("turbulence_intensity", None)
-    per_record = {k: v for k, v in fit_inputs.items() if np.ndim(v) == 1}
+    if turbulence is None and instruments.speed_std is not None:
+        turbulence = measured_turbulence(instruments, float(reference_height))
+    # (fixed inputs may be one per record; the fit's options, a noise pair say, are not)
+    per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
     candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
     if candidates.size == 0:
         raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
@@ -226,7 +370,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         inputs["turbulence_intensity"] = tuple(
             np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
     abl = EkmanABL.fit_profile(
-        heights, speeds[candidates], None if directions is None else directions[candidates],
+        **_fit_data(instruments, candidates),
         on_misfit="raise" if on_misfit == "raise" else "flag",
         labels=[labels[i] for i in candidates], **inputs,
     )
@@ -258,6 +402,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                           "kind": [excluded[i][0] for i in rows],
                           "reason": [excluded[i][1] for i in rows]},
                          index=pd.Index(rows, name="row"))
+    flags = instruments.flags
+    flags.insert(1, "time", [labels[i] for i in flags["row"]])
     return SiteAtmosphere(
         labels=list(fit.labels),
         abl=abl,
@@ -268,6 +414,11 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         atmosphere=fit.atmosphere(stability_input),
         dropped=list(table["time"]),
         excluded=table,
+        rows=candidates[kept],
+        n_records=len(records),
+        offsets=instruments.offsets,
+        cup_pairs=instruments.cup_pairs,
+        flags=flags,
     )
 
 
@@ -278,12 +429,83 @@ EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "infinite reading",
                    "physical bound", "two states")
 
 
-def _screen(records, labels, heights, speeds, directions, unknowns):
+def _fit_heights(instruments, columns):
+    """(heights, speeds, directions, speed column names per height) as the fit takes them:
+    vanes at heights other than the cups' give their directions at their own heights (the
+    speeds there missing, and the directions missing at the cups' heights)."""
+    cups, vanes = instruments.cup_heights, instruments.vane_heights
+    names = {h: ", ".join(c for _, c, _ in columns.cups[h]) for h in cups}
+    directions = instruments.directions
+    if directions is None or (cups.size == vanes.size and np.allclose(cups, vanes)):
+        return cups, instruments.speeds, directions, [names[h] for h in cups]
+    heights = np.union1d(cups, vanes)
+    n = instruments.speeds.shape[0]
+    speeds = np.full((n, heights.size), np.nan)
+    speeds[:, np.searchsorted(heights, cups)] = instruments.speeds
+    at_heights = np.full((n, heights.size), np.nan)
+    at_heights[:, np.searchsorted(heights, vanes)] = directions
+    return heights, speeds, at_heights, [names.get(h, f"(no cup at {h:g} m)") for h in heights]
+
+
+def _offsets_from_neutral_fits(instruments, reference_height, fit_options_and_inputs):
+    """The vane offsets again from the strong-wind records the fit (either sign, the offsets of
+    the first estimate applied) finds neutral: a strong wind of a stable night turns with height
+    more than a neutral one, and would move the median (docs/measurements.md#vane-offsets)."""
+    rows = strong_wind_rows(instruments, reference_height)
+    speeds = instruments.speeds[rows]
+    rows = rows[~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)]
+    if rows.size < OFFSET_MIN_RECORDS:
+        return instruments
+    inputs = {k: (np.asarray(v)[rows] if k not in FIT_OPTIONS and np.ndim(v) == 1 else v)
+              for k, v in fit_options_and_inputs.items() if k not in ("stability",)}
+    if "turbulence_intensity" in inputs:
+        inputs["turbulence_intensity"] = tuple(
+            np.asarray(v, float)[rows] if np.ndim(v) == 1 else v
+            for v in inputs["turbulence_intensity"])
+    elif instruments.speed_std is not None:
+        height, intensity = measured_turbulence(instruments, reference_height)
+        inputs["turbulence_intensity"] = (height, intensity[rows])
+    # (the records are fitted again, and warned about, by fit_site's own fit)
+    with package_warnings.discarding():
+        fit = EkmanABL.fit_profile(**_fit_data(instruments, rows), on_misfit="flag",
+                                   stability="either", **inputs).profile_fit
+    neutral = rows[np.asarray(fit.fits) & (np.asarray(fit.stability_class) == "neutral")]
+    if neutral.size < OFFSET_MIN_RECORDS:
+        return instruments
+    return with_offsets_from(instruments, neutral, reference_height,
+                             _neutral_turning(fit_options_and_inputs))
+
+
+def _fit_data(instruments, rows):
+    """``fit_profile``'s data of the records ``rows``: the cups' heights and speeds, and the
+    vanes' directions with their own heights (``direction_heights``) where those differ."""
+    cups, vanes = instruments.cup_heights, instruments.vane_heights
+    data = {"heights": cups, "speeds": instruments.speeds[rows], "directions": None}
+    if instruments.directions is not None:
+        data["directions"] = instruments.directions[rows]
+        if not (cups.size == vanes.size and np.allclose(cups, vanes)):
+            data["direction_heights"] = vanes
+    return data
+
+
+def _neutral_turning(fit_options_and_inputs):
+    """The model's neutral turning between heights (for the vane offsets): the direction at
+    ``heights`` minus that at ``height`` [deg, meteorological] per speed at ``height``."""
+    fixed = {k: (float(np.median(v)) if np.ndim(v) else v)
+             for k, v in fit_options_and_inputs.items() if k not in FIT_OPTIONS}
+
+    def turning(speed, height, heights):
+        abl = EkmanABL.from_reference_wind(speed, height, obukhov_length=np.inf, **fixed)
+        angle = np.asarray(abl.wind_angle(np.asarray(heights, float)[:, None]), float)
+        return -(angle - np.asarray(abl.wind_angle(height), float)[None, :]).T
+
+    return turning
+
+
+def _screen(speed_columns, labels, heights, speeds, directions, unknowns):
     """{row: (kind, text)} of the records no fit should see: repeated time stamps, zero or
     negative speed readings, too few data."""
     excluded = {}
-    by_height = {float(m[1]): str(c) for c in records.columns if (m := SPEED_COLUMN.match(str(c)))}
-    speed_columns = [by_height[h] for h in heights]
     stamps = pd.Series(labels)
     repeated = stamps.duplicated(keep=False)
     if repeated.any():

@@ -1,0 +1,508 @@
+"""A met mast's instruments, read as wind-resource practice reads them, before the fit
+(docs/measurements.md#a-real-mast).
+
+Columns of the records (the names carry the measurement point's height, as the IEA Wind Task 43
+data model's measurement points carry ``height_m``, and the boom as its ``boom_orientation_deg``):
+
+* ``speed_<h>m``: the mean speed [m/s] of the one cup at ``h`` m; or ``speed_<h>m_<boom>``, one
+  per boom at that height (e.g. ``speed_80m_a``, ``speed_80m_b``), the booms' orientations given
+  as ``booms={"a": 135.0, "b": 315.0}`` [deg, from the mast to the cup, clockwise from north];
+* ``speed_<h>m_std`` or ``speed_<h>m_<boom>_std``: the cup's standard deviation [m/s] over the
+  record (Task 43's statistic ``sd``): the measured turbulence intensity sigma_u / U;
+* ``direction_<h>m``: a vane's mean direction [deg, meteorological] at its own height;
+* ``..._min``, ``..._max`` (and a vane's ``_std``): other statistics, left alone.
+
+What :func:`read_instruments` makes of them:
+
+* readings that are no number a cup or vane gives (inf) are removed, named ("infinite reading");
+* redundant cups: the cup in the mast's wake (the wind from its boom's orientation + 180 deg,
+  within ``shadow_half_width``; IEC 61400-12-1 Annex G) is not used, the other one is; both are
+  averaged where neither is in the wake; a cup in the wake alone is not used. The wake's ratio
+  against the direction is measured from the records (Annex G's two-cup ratio). A pair that
+  disagrees beyond the cups' uncertainty (clear cups) or beyond the wake's measured ratio (a cup
+  in the wake) in a record is removed at that height and named ("cups disagree"); a pair whose
+  median ratio over the year departs from 1 by more than :data:`PAIR_TOLERANCE` is named in
+  ``cup_pairs``;
+* stuck vanes (icing): a vane repeating its reading for :data:`STUCK_RECORDS` records or more
+  while another vane turns is removed there and named ("stuck vane");
+* vane offsets: what a vane reads minus the true direction, relative to a reference vane (the
+  one nearest the reference height: only relative offsets show in a profile), estimated from
+  the records themselves as the median turning from the reference vane in strong-wind records
+  (near-neutral) minus the model's own neutral turning between those heights, with the median's
+  standard error; or given (``direction_offsets={38: -4.1}``); subtracted from the readings.
+"""
+
+from __future__ import annotations
+
+import re
+
+import attrs
+import numpy as np
+import pandas as pd
+
+#: Column names: the height in metres, a cup's boom, a cup's standard deviation.
+_NUMBER = r"(\d+(?:\.\d+)?)"
+#: Statistics of a record other than the mean (Task 43's statistic types): the cups' ``std`` is
+#: read; ``min`` and ``max`` and the vanes' statistics are left alone.
+STATISTICS = ("std", "min", "max")
+_STATISTIC = "|".join(STATISTICS)
+SPEED_COLUMN = re.compile(
+    rf"^speed_{_NUMBER}m(?:_(?!(?:{_STATISTIC})$)([A-Za-z][A-Za-z0-9]*))?(?:_({_STATISTIC}))?$")
+DIRECTION_COLUMN = re.compile(rf"^direction_{_NUMBER}m(?:_({_STATISTIC}))?$")
+#: Half-width [deg] of the sector around boom orientation + 180 deg in which a cup is in the
+#: mast's wake (IEC 61400-12-1 Annex G: a lattice mast's wake reaches about +-20-30 deg).
+SHADOW_HALF_WIDTH = 30.0
+#: A cup's standard uncertainty of a record's mean speed, relative: calibration, mounting and
+#: the 10-minute sampling of a class-1 cup (IEC 61400-12-1 Annex E, 1-2 %).
+CUP_UNCERTAINTY = 0.015
+#: Bins [deg] of the angle from the mast wake's centre in which the records give its ratio, and
+#: the records a bin needs.
+WAKE_BIN = 5.0
+WAKE_MIN_RECORDS = 20
+#: A pair of cups disagrees in a record beyond this many standard deviations of their
+#: difference (plus 0.2 m/s: the cups' resolution and starting threshold).
+PAIR_SIGMAS = 5.0
+#: The largest mast-wake deficit a cup in the wake shows (IEC 61400-12-1 Annex G: up to
+#: 20-40 % behind a lattice mast): the span of a wake bin the records do not measure.
+MAX_SHADOW_DEFICIT = 0.4
+#: Median ratio of a pair beyond 1 +- this: the pair disagrees (two class-1 calibrations, 1 %
+#: each, at two standard deviations of their ratio).
+PAIR_TOLERANCE = 0.03
+#: A vane repeating its reading (within its 0.1 deg resolution) this many records in a row
+#: while another vane turns by more than :data:`STUCK_TURN` is stuck.
+STUCK_RECORDS = 4
+STUCK_TURN = 2.0
+#: Records from which vane offsets are estimated: the speed at the reference height from this
+#: [m/s] (near-neutral: mechanical mixing), at least :data:`OFFSET_MIN_RECORDS` of them.
+OFFSET_MIN_SPEED = 12.0
+OFFSET_MIN_RECORDS = 20
+#: What is named per value removed.
+FLAG_KINDS = ("infinite reading", "cups disagree", "stuck vane")
+
+
+@attrs.frozen(eq=False)
+class MastColumns:
+    """The instruments of the records: per cup height the (boom, speed column, std column or
+    None) of its cups, per vane height its column."""
+
+    cups: dict
+    vanes: dict
+
+    @property
+    def cup_heights(self):
+        return np.array(sorted(self.cups))
+
+    @property
+    def vane_heights(self):
+        return np.array(sorted(self.vanes))
+
+    @property
+    def has_std(self):
+        return any(std is not None for cups in self.cups.values() for _, _, std in cups)
+
+
+def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
+    """The instruments in ``records``' columns (module docstring); ValueError naming a column
+    that begins like one but is none, a boom without its orientation, or too few heights."""
+    if not isinstance(records, pd.DataFrame):
+        raise ValueError(f"records must be a pandas DataFrame; got {type(records).__name__}")
+    booms = {} if booms is None else dict(booms)
+    for name, orientation in booms.items():
+        if (isinstance(orientation, (bool, np.bool_))
+                or not isinstance(orientation, (int, float, np.integer, np.floating))
+                or not np.isfinite(orientation)):
+            raise ValueError(f"fit_site: booms[{name!r}] must be the boom's orientation in deg "
+                             f"(from the mast to the cup, clockwise from north); got "
+                             f"{orientation!r}")
+    cups, stds, vanes, unknown = {}, {}, {}, []
+    for column in map(str, records.columns):
+        if (m := SPEED_COLUMN.match(column)):
+            where = (float(m[1]), m[2])
+            if m[3] is None:
+                cups[where] = column
+            elif m[3] == "std":
+                stds[where] = column
+        elif (m := DIRECTION_COLUMN.match(column)):
+            if m[2] is None:
+                vanes[float(m[1])] = column
+        elif column.startswith(("speed_", "direction_")):
+            unknown.append(column)
+    if unknown:
+        raise ValueError(
+            f"records: columns {unknown} are named like measurements but read as none: name "
+            "them speed_<height>m, speed_<height>m_<boom>, speed_<height>m[_<boom>]_std (or _min, "
+            "_max) or direction_<height>m with the height a number >= 0 in metres (e.g. "
+            "speed_80m_a)")
+    lone = sorted(set(stds) - set(cups))
+    if lone:
+        raise ValueError(f"records: standard-deviation columns {[stds[k] for k in lone]} have "
+                         "no mean-speed column of their cup")
+    by_height = {}
+    for (height, boom), column in sorted(cups.items(), key=lambda kv: (kv[0][0], kv[0][1] or "")):
+        by_height.setdefault(height, []).append((boom, column, stds.get((height, boom))))
+    for height, group in by_height.items():
+        named = [boom for boom, _, _ in group if boom is not None]
+        if named and len(named) < len(group):
+            raise ValueError(f"records: at {height:g} m the cups {[c for _, c, _ in group]} mix "
+                             "a cup without a boom and cups with one: name every cup's boom")
+        missing = [c for boom, c, _ in group if boom is not None and boom not in booms]
+        if missing:
+            raise ValueError(f"records: columns {missing} name booms without an orientation: "
+                             f"give fit_site(..., booms={{name: orientation_deg}}) (got booms="
+                             f"{booms})")
+    if len(by_height) < 2:
+        raise ValueError(
+            "records need speed columns at two heights or more, named speed_<height>m (e.g. "
+            f"speed_90m); got columns {list(records.columns)}")
+    return MastColumns(cups=by_height, vanes=vanes)
+
+
+@attrs.frozen(eq=False)
+class Instruments:
+    """The records as the fit reads them (:func:`read_instruments`).
+
+    Attributes:
+        cup_heights, speeds, speed_std: per record (rows) and cup height (columns) the speed and
+            its standard deviation [m/s] (NaN: none usable);
+        vane_heights, directions: the vanes' directions with their offsets removed [deg];
+        offsets: per vane height (index) ``offset_deg`` (reading minus true direction, relative
+            to the reference vane), ``uncertainty_deg`` (standard error), ``records`` and
+            ``source`` ("reference", "estimated", "given", or "not estimated");
+        cup_pairs: per cup height with two cups or more: the cups, their median ratio over the
+            records where none is in the mast's wake, its standard error, the records, and
+            whether they disagree;
+        flags: the values removed, one row each: ``row`` (in the records), ``column``,
+            ``kind`` (:data:`FLAG_KINDS`) and ``reason``.
+    """
+
+    cup_heights: np.ndarray
+    speeds: np.ndarray
+    speed_std: np.ndarray | None
+    vane_heights: np.ndarray
+    directions: np.ndarray | None
+    offsets: pd.DataFrame
+    cup_pairs: pd.DataFrame
+    flags: pd.DataFrame
+
+
+def _numbers(records, columns):
+    frame = records[list(columns)]
+    bad = [c for c in frame.columns if not pd.api.types.is_numeric_dtype(frame[c])]
+    if bad:
+        raise ValueError(f"records: columns {bad} must be numbers (NaN: missing)")
+    return frame.to_numpy(dtype=float)
+
+
+def _angle(a):
+    """Angle wrapped to [-180, 180) deg."""
+    return (np.asarray(a, float) + 180.0) % 360.0 - 180.0
+
+
+class _Flags:
+    def __init__(self):
+        self.rows = []
+
+    def add(self, rows, column, kind, reason):
+        self.rows.extend({"row": int(r), "column": column, "kind": kind,
+                          "reason": reason(int(r)) if callable(reason) else reason} for r in rows)
+
+    def table(self):
+        table = pd.DataFrame(self.rows, columns=["row", "column", "kind", "reason"])
+        return table.sort_values("row", kind="stable").reset_index(drop=True)
+
+
+def _remove_bad(values, columns, flags):
+    bad = np.isinf(values)
+    for j in np.flatnonzero(bad.any(axis=0)):
+        flags.add(np.flatnonzero(bad[:, j]), columns[j], "infinite reading",
+                  lambda r, v=values[:, j]: f"{v[r]} is no reading an instrument gives: removed")
+    return np.where(bad, np.nan, values)
+
+
+def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_height: float,
+                     neutral_turning, *, booms=None, direction_offsets="estimate",
+                     shadow_half_width: float = SHADOW_HALF_WIDTH,
+                     labels=None) -> Instruments:
+    """The records' speeds, turbulence and directions as the fit reads them (module
+    docstring). ``neutral_turning(speeds, height, heights)``: the model's neutral direction at
+    ``heights`` minus that at ``height`` [deg, meteorological] for the speeds [m/s] there;
+    ``labels``: the records' names (time stamps) in the reasons (default: their rows)."""
+    labels = [str(i) for i in range(len(records))] if labels is None else list(labels)
+    booms = {} if booms is None else dict(booms)
+    if (isinstance(shadow_half_width, (bool, np.bool_))
+            or not isinstance(shadow_half_width, (int, float, np.integer, np.floating))
+            or not 0 <= shadow_half_width < 90):
+        raise ValueError(f"fit_site: shadow_half_width must be a number in [0, 90) deg; got "
+                         f"{shadow_half_width!r}")
+    flags = _Flags()
+    vane_heights = columns.vane_heights
+    directions = None
+    if vane_heights.size:
+        vane_columns = [columns.vanes[h] for h in vane_heights]
+        directions = _remove_bad(_numbers(records, vane_columns), vane_columns, flags)
+        directions = _unstick(directions, vane_columns, flags, labels)
+    offsets = _offsets_given(direction_offsets, vane_heights)
+    if directions is not None:
+        directions = directions - offsets["offset_deg"].to_numpy()[None, :]  # given ones
+    cup_heights = columns.cup_heights
+    cup_flags = _Flags()
+    speeds, speed_std, pairs = _combine_cups(records, columns, directions, vane_heights, booms,
+                                             shadow_half_width, cup_flags)
+    instruments = Instruments(cup_heights=cup_heights, speeds=speeds,
+                              speed_std=speed_std if columns.has_std else None,
+                              vane_heights=vane_heights, directions=directions, offsets=offsets,
+                              cup_pairs=pairs, flags=flags.table())
+    if isinstance(direction_offsets, str) and directions is not None and vane_heights.size > 1:
+        instruments = with_offsets_from(instruments, strong_wind_rows(instruments,
+                                                                      reference_height),
+                                        reference_height, neutral_turning)
+        # The mast's wake again with the vanes' offsets removed: its sector and its ratio
+        # against the direction are sharper (a vane 4 deg off moves the wake's centre 4 deg).
+        cup_flags = _Flags()
+        speeds, speed_std, pairs = _combine_cups(records, columns, instruments.directions,
+                                                 vane_heights, booms, shadow_half_width,
+                                                 cup_flags)
+        instruments = attrs.evolve(instruments, speeds=speeds, cup_pairs=pairs,
+                                   speed_std=speed_std if columns.has_std else None)
+    flags.rows.extend(cup_flags.rows)
+    return attrs.evolve(instruments, flags=flags.table())
+
+
+def strong_wind_rows(instruments: Instruments, reference_height: float) -> np.ndarray:
+    """The records whose speed at the cup height nearest the reference height is at least
+    :data:`OFFSET_MIN_SPEED` (the vane offsets' records, near-neutral by their wind)."""
+    speed = instruments.speeds[:, reference_index(instruments.cup_heights, reference_height)]
+    return np.flatnonzero(np.isfinite(speed) & (speed >= OFFSET_MIN_SPEED))
+
+
+def with_offsets_from(instruments: Instruments, rows, reference_height: float,
+                      neutral_turning) -> Instruments:
+    """``instruments`` with its vanes' offsets estimated from the records ``rows`` (module
+    docstring) in place of those it has."""
+    applied = instruments.offsets["offset_deg"].to_numpy()
+    readings = instruments.directions + applied[None, :]
+    offsets = _estimate_offsets(readings, instruments.vane_heights, instruments.speeds,
+                                instruments.cup_heights, reference_height, neutral_turning,
+                                np.asarray(rows, dtype=int))
+    return attrs.evolve(instruments, offsets=offsets,
+                        directions=readings - offsets["offset_deg"].to_numpy()[None, :])
+
+
+def _offsets_given(direction_offsets, vane_heights):
+    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
+                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
+    if direction_offsets is None or isinstance(direction_offsets, str):
+        if isinstance(direction_offsets, str) and direction_offsets != "estimate":
+            raise ValueError(f"fit_site: direction_offsets must be 'estimate', None or "
+                             f"{{vane height: offset deg}}; got {direction_offsets!r}")
+        return table
+    if not isinstance(direction_offsets, dict):
+        raise ValueError(f"fit_site: direction_offsets must be 'estimate', None or "
+                         f"{{vane height: offset deg}}; got {direction_offsets!r}")
+    for height, offset in direction_offsets.items():
+        match = np.flatnonzero(np.isclose(vane_heights, float(height)))
+        if match.size != 1:
+            raise ValueError(f"fit_site: direction_offsets names a vane at {height!r} m; the "
+                             f"records' vanes are at {vane_heights.tolist()} m")
+        if isinstance(offset, bool) or not np.isscalar(offset) or not np.isfinite(offset):
+            raise ValueError(f"fit_site: direction_offsets[{height!r}] must be a number of "
+                             f"degrees; got {offset!r}")
+        table.iloc[match[0], :] = [float(offset), np.nan, 0, "given"]
+    return table
+
+
+def _unstick(directions, vane_columns, flags, labels):
+    """Readings of vanes that repeat for STUCK_RECORDS records or more while another vane turns
+    by more than STUCK_TURN (icing): removed and named."""
+    n, m = directions.shape
+    if n < STUCK_RECORDS:
+        return directions
+    same = np.zeros((n, m), bool)
+    same[1:] = np.abs(_angle(directions[1:] - directions[:-1])) < 0.05
+    out = directions.copy()
+    for j in range(m):
+        # Runs of equal readings: starts where a reading differs from the one before.
+        start = np.flatnonzero(~same[:, j])
+        stop = np.append(start[1:], n)
+        for a, b in zip(start[(stop - start) >= STUCK_RECORDS], stop[(stop - start) >= STUCK_RECORDS]):
+            others = [k for k in range(m) if k != j]
+            turns = [np.nanmax(np.abs(_angle(directions[a:b, k] - directions[a, k])), initial=0.0)
+                     for k in others if np.isfinite(directions[a, k])]
+            if others and not (turns and max(turns) > STUCK_TURN):
+                continue
+            if not np.isfinite(directions[a, j]):
+                continue
+            rows = np.arange(a, b)
+            out[rows, j] = np.nan
+            flags.add(rows, vane_columns[j], "stuck vane",
+                      f"the vane reads {directions[a, j]:g} deg in {b - a} records in a row "
+                      f"({labels[a]} to {labels[b - 1]}) while the other vanes turn (icing): removed")
+    return out
+
+
+def _combine_cups(records, columns, directions, vane_heights, booms, half_width, flags):
+    """Per cup height the speed and standard deviation from its cups (module docstring), and
+    the pairs' agreement."""
+    n = len(records)
+    heights = columns.cup_heights
+    speeds = np.full((n, heights.size), np.nan)
+    variance = np.full((n, heights.size), np.nan)
+    pairs = []
+    for i, height in enumerate(heights):
+        group = columns.cups[height]
+        names = [c for _, c, _ in group]
+        values = _remove_bad(_numbers(records, names), names, flags)
+        std_names = [s for _, _, s in group]
+        stds = np.column_stack([
+            _remove_bad(_numbers(records, [s]), [s], flags)[:, 0] if s else np.full(n, np.nan)
+            for s in std_names])
+        if len(group) == 1:
+            speeds[:, i], variance[:, i] = values[:, 0], stds[:, 0] ** 2
+            continue
+        wind = _direction_near(directions, vane_heights, height, n)
+        orientation = np.array([booms[b] for b, _, _ in group])
+        # Each cup's angle from its wake's centre: the wind from its boom's orientation + 180.
+        offset = _angle(wind[:, None] - orientation[None, :] - 180.0)
+        shadowed = np.abs(offset) < half_width
+        finite = np.isfinite(values)
+        # A cup in the wake is never used (with its partner missing, the height is missing);
+        # where the wind is unknown (no vane reading), every cup.
+        clear = np.where(np.isfinite(wind)[:, None], finite & ~shadowed, finite)
+        used = np.where(clear, values, np.nan)
+        mean = _row_mean(values, clear)
+        # The pair test: clear cups within the cups' uncertainty; a cup in the wake as much
+        # below the clear one as the wake's own ratio at that angle, measured from the records.
+        allowance = PAIR_SIGMAS * np.sqrt(2.0) * CUP_UNCERTAINTY * mean + 0.2
+        wake = np.where(finite & ~clear, values, np.nan)
+        expected, spread, deficit = _wake_ratio(np.abs(offset), wake, mean, half_width)
+        with np.errstate(invalid="ignore"):
+            high = np.fmax.reduce(used, axis=1) - np.fmin.reduce(used, axis=1) > allowance
+            # (the wake ratio's spread holds both cups' uncertainty already)
+            low = np.any(np.abs(wake - expected * mean[:, None])
+                         > PAIR_SIGMAS * spread * mean[:, None] + 0.2, axis=1)
+        disagree = np.flatnonzero(high | low)
+        for r in disagree:
+            shown = ", ".join(f"{c} {values[r, k]:g}" for k, c in enumerate(names))
+            waked = [names[k] for k in np.flatnonzero(np.isfinite(wake[r]))]
+            flags.add([r], ", ".join(names), "cups disagree",
+                      f"the cups at {height:g} m read {shown} m/s, beyond their uncertainty"
+                      + (f" and the mast wake's ratio at that direction ({', '.join(waked)} in "
+                         "it)" if waked else "") + " (a spike or a stalled cup): the height's "
+                      "speed is removed")
+        mean_var = _row_mean(stds**2, clear & np.isfinite(stds))
+        mean[disagree] = np.nan
+        mean_var[disagree] = np.nan
+        speeds[:, i], variance[:, i] = mean, mean_var
+        both = np.all(np.isfinite(values) & ~shadowed, axis=1)
+        both[disagree] = False
+        ratio = values[both, 1:] / values[both, :1]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = ratio[np.all(np.isfinite(ratio), axis=1)]
+        for k in range(1, len(group)):
+            median, error = _median_and_error(ratio[:, k - 1]) if len(ratio) else (np.nan, np.nan)
+            pairs.append({"height": height, "cups": f"{names[k]} / {names[0]}",
+                          "median_ratio": median, "uncertainty": error, "records": len(ratio),
+                          "disagree": bool(abs(median - 1.0) > PAIR_TOLERANCE),
+                          "wake_deficit": deficit})
+    pairs = pd.DataFrame(pairs, columns=["height", "cups", "median_ratio", "uncertainty",
+                                         "records", "disagree", "wake_deficit"])
+    return speeds, np.sqrt(variance), pairs
+
+
+def _wake_ratio(angle, wake, clear_mean, half_width):
+    """The mast wake as the records show it (IEC 61400-12-1 Annex G: the ratio of the two cups
+    against the direction): per record and cup, the median ratio of a cup in the wake to the
+    clear cups' mean at its angle from the wake's centre (bins of :data:`WAKE_BIN` deg, both
+    sides and all cups together) and its robust spread; where a bin holds fewer than
+    :data:`WAKE_MIN_RECORDS`, (1 - MAX_SHADOW_DEFICIT / 2) +- MAX_SHADOW_DEFICIT / 2 spans every
+    deficit up to MAX_SHADOW_DEFICIT. Also the largest median deficit (NaN: none measured)."""
+    edges = np.arange(0.0, half_width + WAKE_BIN, WAKE_BIN)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = wake / clear_mean[:, None]
+    where = np.clip(np.searchsorted(edges, angle, side="right") - 1, 0, edges.size - 1)
+    expected = np.full(ratio.shape, 1.0 - 0.5 * MAX_SHADOW_DEFICIT)
+    spread = np.full(ratio.shape, 0.5 * MAX_SHADOW_DEFICIT / PAIR_SIGMAS)
+    deficit = np.nan
+    measured = np.isfinite(ratio)
+    for b in range(edges.size - 1):
+        in_bin = measured & (where == b)
+        if np.count_nonzero(in_bin) < WAKE_MIN_RECORDS:
+            continue
+        median = float(np.median(ratio[in_bin]))
+        sigma = max(1.4826 * float(np.median(np.abs(ratio[in_bin] - median))),
+                    np.sqrt(2.0) * CUP_UNCERTAINTY)
+        expected[where == b], spread[where == b] = median, sigma
+        deficit = np.nanmax([deficit, 1.0 - median])
+    return expected, spread, deficit
+
+
+def _row_mean(values, use):
+    """Per row the mean of ``values`` where ``use`` (NaN where none)."""
+    count = np.sum(use, axis=1)
+    total = np.sum(np.where(use, values, 0.0), axis=1)
+    return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def _direction_near(directions, vane_heights, height, n):
+    """Per record the direction of the vane nearest ``height`` that reads (NaN: none)."""
+    if directions is None:
+        return np.full(n, np.nan)
+    order = np.argsort(np.abs(vane_heights - height), kind="stable")
+    wind = np.full(directions.shape[0], np.nan)
+    for k in order[::-1]:
+        wind = np.where(np.isfinite(directions[:, k]), directions[:, k], wind)
+    return wind
+
+
+def _median_and_error(values):
+    """The median and its standard error (1.2533 sigma / sqrt(n), sigma from the MAD)."""
+    values = np.asarray(values, float)
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return np.nan, np.nan
+    median = float(np.median(values))
+    sigma = 1.4826 * float(np.median(np.abs(values - median)))
+    return median, 1.2533 * sigma / np.sqrt(values.size)
+
+
+def reference_index(heights, reference_height):
+    """Index of the height nearest the reference height (the higher one on a tie)."""
+    heights = np.asarray(heights, float)
+    distance = np.abs(heights - reference_height)
+    return int(np.flatnonzero(distance == distance.min())[-1])
+
+
+def _estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_height,
+                      neutral_turning, rows):
+    """Vane offsets relative to the vane nearest the reference height from the records
+    ``rows`` (module docstring)."""
+    ref = reference_index(vane_heights, reference_height)
+    cup = reference_index(cup_heights, reference_height)
+    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
+                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
+    strong = np.zeros(directions.shape[0], dtype=bool)
+    strong[rows] = True
+    strong &= np.isfinite(speeds[:, cup]) & np.isfinite(directions[:, ref])
+    for k, height in enumerate(vane_heights):
+        if k == ref:
+            continue
+        rows = np.flatnonzero(strong & np.isfinite(directions[:, k]))
+        if rows.size < OFFSET_MIN_RECORDS:
+            table.loc[height, ["records", "source"]] = [rows.size, "not estimated"]
+            continue
+        model = neutral_turning(speeds[rows, cup], cup_heights[cup],
+                                np.array([height, vane_heights[ref]]))
+        turning = _angle(directions[rows, k] - directions[rows, ref])
+        median, error = _median_and_error(_angle(turning - (model[:, 0] - model[:, 1])))
+        table.loc[height, :] = [median, error, rows.size, "estimated"]
+    return table
+
+
+def measured_turbulence(instruments: Instruments, reference_height: float):
+    """The fit's ``turbulence_intensity=(height, values)``: sigma_u / U of the cups at the cup
+    height nearest the reference height (NaN where a record has none)."""
+    k = reference_index(instruments.cup_heights, reference_height)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        intensity = instruments.speed_std[:, k] / instruments.speeds[:, k]
+    intensity = np.where(np.isfinite(intensity) & (intensity > 0), intensity, np.nan)
+    return float(instruments.cup_heights[k]), intensity
