@@ -90,22 +90,18 @@ def run_example(reduced: bool = False, models=("ekman_veer",)) -> dict:
         energy = site.annual_energy(fmodel, YawOptimizationSR, models=models,
                                     progress=False, **YAW)
     return dict(site=site, table=table, energy=energy, fmodel=fmodel, fit_seconds=fit_seconds,
-                by_class=energy_by_class(energy.table, table))
+                by_class=energy_by_class(energy.table))
 
 
-def energy_by_class(energy, table) -> pd.DataFrame:
-    """The annual energy per model and fitted stability class (convective, neutral, stable):
-    the records' own classes of ``annual_energy`` (one per record, named by its time) summed
-    over the records of each class, and the steering gain of that part of the year."""
-    per_record = energy[energy["stability"] != "all"]
-    classes = dict(zip(table["time"].astype(str), table["class"]))
-    grouped = per_record.assign(fitted_class=per_record["stability"].astype(str).map(classes))
-    summed = grouped.groupby(["model", "fitted_class"], sort=False)[
-        ["aep_baseline_gwh", "aep_steered_gwh"]].sum()
-    summed["hours"] = grouped.groupby(["model", "fitted_class"], sort=False).size() * 365
-    summed["gain_percent"] = 100.0 * (summed["aep_steered_gwh"] / summed["aep_baseline_gwh"] - 1.0)
+def energy_by_class(energy) -> pd.DataFrame:
+    """The annual energy per model and fitted stability class (convective, neutral, stable), as
+    ``annual_energy`` of a fitted site gives it, with the hours a year of each class (365 per
+    record) and the steering gain of that part of the year."""
+    by_class = energy[energy["stability"] != "all"].rename(columns={"stability": "fitted_class"})
+    by_class = by_class.assign(hours=by_class["n_conditions"] * 365)
     order = {"convective": 0, "neutral": 1, "stable": 2}
-    return summed.reset_index().sort_values(
+    return by_class[["model", "fitted_class", "aep_baseline_gwh", "aep_steered_gwh", "hours",
+                     "gain_percent"]].sort_values(
         ["model", "fitted_class"], key=lambda c: c.map(order) if c.name == "fitted_class" else c)
 
 
