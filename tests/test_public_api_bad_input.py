@@ -150,3 +150,22 @@ def test_every_public_name_refuses_bad_input_naming_it(name, fmodel):
         assert re.search(named, str(refusal.value)), (name, named, str(refusal.value))
         assert "ufunc" not in str(refusal.value) and "broadcast" not in str(refusal.value).replace(
             "do not broadcast together", "")
+
+
+@pytest.mark.parametrize("inputs, named", [
+    (dict(speed_tolerance=-1.0), r"speed_tolerance must be in \(0, 1\).*got -1"),
+    (dict(speed_tolerance="x"), r"speed_tolerance"),
+    (dict(veer_tolerance=0.0), r"veer_tolerance must be > 0 deg; got 0"),
+    (dict(hub_speed=[8.0, 9.0], shear_exponent=[0.1, 0.2, 0.3]),
+     r"one length .*hub_speed \(2,\).*shear_exponent \(3,\)"),
+])
+def test_shear_and_veer_refuses_bad_tolerances_and_ragged_conditions_naming_them(inputs, named):
+    """The tolerances are this function's inputs, named as such (not as the fit's speed_noise
+    they become), and conditions of different lengths are named with their shapes."""
+    from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
+
+    call = dict(hub_speed=8.0, hub_height=90.0, rotor_diameter=126.0, shear_exponent=0.2,
+                latitude=52.0)
+    call.update(inputs)
+    with pytest.raises(ValueError, match=named):
+        atmosphere_from_shear_and_veer(**call)

@@ -591,19 +591,32 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
             ("hub_height", hub_height, lambda v: v > 0, "> 0 m"),
             ("rotor_diameter", rotor_diameter, lambda v: v > 0, "> 0 m"),
             ("shear_exponent", shear_exponent, lambda v: np.isfinite(v), "finite"),
-            ("veer", veer, lambda v: np.isfinite(v), "finite [deg]")):
+            ("veer", veer, lambda v: np.isfinite(v), "finite [deg]"),
+            ("speed_tolerance", speed_tolerance, lambda v: (v > 0) & (v < 1),
+             "in (0, 1): a fraction of the hub speed"),
+            ("veer_tolerance", veer_tolerance, lambda v: v > 0, "> 0 deg")):
         if value is None:
             continue
         array = real_array(f"atmosphere_from_shear_and_veer: {name}", value, valid)
         require_at(np.isfinite(array) & ok(array), f"atmosphere_from_shear_and_veer: {name}",
                    valid, array)
+    for name in ("speed_tolerance", "veer_tolerance"):
+        if np.ndim(locals()[name]) != 0:
+            raise ValueError(f"atmosphere_from_shear_and_veer: {name} must be one number; got "
+                             f"an array of shape {np.shape(locals()[name])}")
     single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
                                            shear_exponent, veer))
     hub_speed, hub_height, rotor_diameter = (
         np.atleast_1d(np.asarray(v, dtype=float)) for v in (hub_speed, hub_height, rotor_diameter)
     )
-    n = np.broadcast_shapes(hub_speed.shape, hub_height.shape, rotor_diameter.shape,
-                            *(np.shape(v) for v in (shear_exponent, veer) if v is not None))
+    given = {"hub_speed": hub_speed, "hub_height": hub_height, "rotor_diameter": rotor_diameter,
+             "shear_exponent": shear_exponent, "veer": veer}
+    try:
+        n = np.broadcast_shapes(*(np.shape(v) for v in given.values() if v is not None))
+    except ValueError:
+        shapes = ", ".join(f"{k} {np.shape(v)}" for k, v in given.items() if v is not None)
+        raise ValueError("atmosphere_from_shear_and_veer: the inputs must be numbers or 1-D "
+                         f"arrays of one length (one per condition); got shapes {shapes}") from None
     if len(n) != 1:
         raise ValueError("atmosphere_from_shear_and_veer: inputs must be numbers or 1-D arrays")
     radius = 0.5 * np.broadcast_to(rotor_diameter, n)[:, None]
