@@ -600,10 +600,11 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
         array = real_array(f"atmosphere_from_shear_and_veer: {name}", value, valid)
         require_at(np.isfinite(array) & ok(array), f"atmosphere_from_shear_and_veer: {name}",
                    valid, array)
-    for name in ("speed_tolerance", "veer_tolerance"):
-        if np.ndim(locals()[name]) != 0:
+    for name, tolerance in (("speed_tolerance", speed_tolerance),
+                            ("veer_tolerance", veer_tolerance)):
+        if np.ndim(tolerance) != 0:
             raise ValueError(f"atmosphere_from_shear_and_veer: {name} must be one number; got "
-                             f"an array of shape {np.shape(locals()[name])}")
+                             f"an array of shape {np.shape(tolerance)}")
     single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
                                            shear_exponent, veer))
     hub_speed, hub_height, rotor_diameter = (
