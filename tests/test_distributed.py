@@ -325,3 +325,27 @@ def test_other_interfaces_are_floris_parflorismodel():
     par.run()
     assert par.client is None and par.interface is None
     assert np.all(np.isfinite(par.get_turbine_powers()))
+
+
+class _BatchedGreetingDistributed:
+    """A stand-in for the distributed module whose Client fails its handshake ``failures`` times."""
+
+    def __init__(self, failures):
+        self.failures = failures
+        self.attempts = 0
+
+    def Client(self, address, set_as_default):  # noqa: N802 - distributed's name
+        self.attempts += 1
+        if self.attempts <= self.failures:
+            raise AssertionError  # what distributed's handshake raises on a batched greeting
+        return ("client of", address, set_as_default)
+
+
+def test_scheduler_address_handshake_is_retried_then_reported():
+    recovering = _BatchedGreetingDistributed(failures=cluster_module.HANDSHAKE_ATTEMPTS - 1)
+    assert cluster_module._connect(recovering, "tcp://s:8786") == ("client of", "tcp://s:8786", False)
+    assert recovering.attempts == cluster_module.HANDSHAKE_ATTEMPTS
+    broken = _BatchedGreetingDistributed(failures=cluster_module.HANDSHAKE_ATTEMPTS)
+    with pytest.raises(AssertionError):
+        cluster_module._connect(broken, "tcp://s:8786")
+    assert broken.attempts == cluster_module.HANDSHAKE_ATTEMPTS

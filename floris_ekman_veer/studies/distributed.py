@@ -75,13 +75,33 @@ def _check_workers(client) -> None:
             )
 
 
+HANDSHAKE_ATTEMPTS = 3
+
+
+def _connect(distributed, address: str):
+    """A Client of the scheduler at ``address``, retried when the greeting arrives batched.
+
+    distributed's Client asserts that the scheduler's first reply holds one message; a scheduler
+    busy with other clients can batch its greeting with a broadcast, and the connection then fails
+    with a bare AssertionError although the scheduler is healthy (seen on a loaded 2-core machine).
+    A fresh connection succeeds, so the handshake is tried again, at most ``HANDSHAKE_ATTEMPTS``
+    times.
+    """
+    for attempt in range(1, HANDSHAKE_ATTEMPTS + 1):
+        try:
+            return distributed.Client(address, set_as_default=False)
+        except AssertionError:
+            if attempt == HANDSHAKE_ATTEMPTS:
+                raise
+
+
 def _resolve_client(client):
     """A ``distributed.Client`` from a Client, a scheduler address, or None (the default one)."""
     distributed = _import_distributed()
     if isinstance(client, distributed.Client):
         return client
     if isinstance(client, str):
-        return distributed.Client(client, set_as_default=False)
+        return _connect(distributed, client)
     if client is None:
         try:
             return distributed.default_client()
