@@ -32,6 +32,7 @@ import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import finite_real, real_array, require_at
+from floris_ekman_veer.atmosphere.stability_inputs import STABILITY_INPUTS
 from floris_ekman_veer.atmosphere.turbulence import (
     ALPHA_PRIME,
     MERGE_EXPONENT,
@@ -166,10 +167,6 @@ VALID_RANGES = {
     "matching_fraction": "in (0, 1)",
 }
 
-_STABILITY_INPUTS = (
-    "stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
-    "sensible_heat_flux",
-)
 _SOLVER_TOLERANCE = 1e-14
 _SOLVER_MAX_ITERATIONS = 200
 
@@ -599,7 +596,7 @@ class EkmanABL:
         given = {
             name: value
             for name, value in zip(
-                _STABILITY_INPUTS, (mu, cooling_rate, heat_flux, obukhov_length, sensible)
+                STABILITY_INPUTS, (mu, cooling_rate, heat_flux, obukhov_length, sensible)
             )
             if value is not None
         }

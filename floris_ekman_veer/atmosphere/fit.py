@@ -59,6 +59,7 @@ import inspect
 import attrs
 import numpy as np
 
+from floris_ekman_veer.atmosphere.stability_inputs import STABILITY_INPUTS
 from floris_ekman_veer._validation import real_array, require_at
 from floris_ekman_veer.warnings import DirectionUnitsWarning, warn
 
@@ -72,9 +73,6 @@ FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_proba
 DEFAULT_TURBULENCE_NOISE = 0.1
 #: Records iterated together by default: the work arrays stay below about 100 MB.
 DEFAULT_CHUNK_SIZE = 4096
-#: Stability inputs the fit determines (refused as fixed inputs).
-STABILITY_INPUTS = ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
-                    "sensible_heat_flux")
 #: The signs of 1/L a fit may take (``stability``): 1/L >= 0 (stable or neutral), 1/L <= 0
 #: (convective or neutral), or either, chosen per record by the smaller misfit.
 STABILITY_CHOICES = ("stable", "convective", "either")

@@ -121,6 +121,7 @@ _check_floris_version(floris.__version__)
 from floris.core import Core, FlowField, TurbineGrid  # noqa: E402  (only after the version check)
 from floris.floris_model import FlorisModel  # noqa: E402
 
+from floris_ekman_veer.atmosphere.stability_inputs import STABILITY_INPUTS  # noqa: E402
 import floris_ekman_veer.warnings as package_warnings  # noqa: E402
 from floris_ekman_veer.plugin.rotor import (  # noqa: E402
     TURBINE_MOMENTS,
@@ -137,8 +138,7 @@ CONFIG_PATH = f"wake.wake_velocity_parameters.{PARAMETER_BLOCK}.{ATMOSPHERE_KEY}
 # Inputs of which at most one may be given (EkmanABL's contract).
 EXCLUSIVE_INPUTS = (
     ("coriolis_parameter", "latitude"),
-    ("stability_parameter", "cooling_rate", "surface_heat_flux", "obukhov_length",
-     "sensible_heat_flux"),
+    STABILITY_INPUTS,
     ("brunt_vaisala_frequency", "lapse_rate"),
 )
 
