@@ -54,21 +54,41 @@ def settings_warnings(config, repeat=2, intensities=(0.06, 0.06), turbulence_not
 
 def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
     """ekman_veer takes I_u from the atmosphere: FLORIS's TI changes none of its powers (0.02,
-    0.06, 0.15), and where the TI given vary one ModelSettingsWarning per study says so, with
-    the values given (one TI throughout, FLORIS's required placeholder, is silent); gauss on the
-    same inflow reads them, silently."""
-    assert settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), turbulence_notice=True) == []
+    0.06, 0.15), and one ModelSettingsWarning per study says so at the run, one constant TI
+    included, with the values given and the atmosphere's own I_u; TI that are the atmosphere's
+    I_u to three decimals are silent, and so are gauss on the same inflow and a shipped input's
+    build."""
+    constant = settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), turbulence_notice=True)
+    assert len(constant) == 1
+    assert constant[0].startswith("flow_field.turbulence_intensities (0.06) are not used as the "
+                                  "ambient turbulence by the ekman_veer wake model: it takes I_u")
+    own = re.search(r"its I_u at hub height here: ([\d.]+) to ([\d.]+)\)", constant[0])
     found = settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), intensities=(0.02, 0.15),
                               turbulence_notice=True)
     assert len(found) == 1
-    assert found[0].startswith("flow_field.turbulence_intensities (0.02 to 0.15) are not used as "
-                               "the ambient turbulence by the ekman_veer wake model: it takes I_u")
+    assert found[0].startswith("flow_field.turbulence_intensities (0.02 to 0.15) are not used")
+    # The atmosphere's own I_u at 8 and 9 m/s (the notice's range), to three decimals: silent.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        probe = FlorisModel(defaults(wind_shear=0.0, wind_veer=0.0))
+        probe.set(wind_speeds=[8.0, 9.0], wind_directions=[270.0] * 2,
+                  turbulence_intensities=[0.06, 0.06])
+        probe.run()
+    intensities = np.round(np.asarray(floris_ekman_veer.validity_report(probe)
+                                      .turbulence_intensity, dtype=float), 3)
+    np.testing.assert_allclose(sorted(intensities), [float(own[1]), float(own[2])], atol=6e-4)
+    assert settings_warnings(defaults(wind_shear=0.0, wind_veer=0.0), intensities=intensities,
+                             turbulence_notice=True) == []
     assert settings_warnings(defaults("gauss", "gauss", wind_shear=0.0, wind_veer=0.0),
                              turbulence_notice=True) == []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        FlorisModel(floris_ekman_veer.example_input("farm_night"))  # placeholder TI 0.06
+    assert not [w for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
     powers = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        for ti in (0.02, 0.06, 0.15):  # one study: said once, at the second value
+        for ti in (0.02, 0.06, 0.15):  # one study: said once, at the first run
             fmodel = FlorisModel(defaults(wind_shear=0.0, wind_veer=0.0))
             fmodel.set(layout_x=[0.0, 630.0], layout_y=[0.0, 0.0], wind_speeds=[8.0],
                        wind_directions=[270.0], turbulence_intensities=[ti])
@@ -76,7 +96,7 @@ def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
             powers.append(fmodel.get_turbine_powers())
     notices = [str(w.message) for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
     assert len(notices) == 1 and notices[0].startswith(
-        "flow_field.turbulence_intensities (0.02 to 0.06) are not used")
+        "flow_field.turbulence_intensities (0.02) are not used")
     np.testing.assert_array_equal(powers[0], powers[1])
     np.testing.assert_array_equal(powers[0], powers[2])
 

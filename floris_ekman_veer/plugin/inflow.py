@@ -761,20 +761,25 @@ def warn_shallow(core: Core, spec: AtmosphereSpec | None = None) -> None:
     :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` (plugin/shallow.py), at
     the user's run: every Core solve, the ParFlorisModel parent before its workers (sent with
     the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
-    Core's atmosphere, if known (else read)."""
+    Core's atmosphere, if known (else read). FLORIS's turbulence intensities that the ekman_veer
+    model does not read are said there too (at the run, as the shallow layers: a shipped input's
+    placeholder condition is not the user's)."""
     spec = atmosphere_of(core) if spec is None else spec
     if spec is None or not core.flow_field.n_findex:
         return
     height = _reference_height(core)
     if height is not None:
-        _check_shallow(core, solve(spec, core.flow_field.wind_speeds, height), height, "run")
+        abl = solve(spec, core.flow_field.wind_speeds, height)
+        _check_shallow(core, abl, height, "run")
+        from floris_ekman_veer.plugin import input_checks
+
+        input_checks.notice_unused_turbulence(core, abl, spec)
 
 
 def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
     """At build: the shallow-boundary-layer policy ``raise`` (plugin/shallow.py; ``warn``
     counts them at the first run instead, :func:`warn_shallow`), hubs in the roughness
-    sublayer, a heterogeneous map given with the atmosphere (warned), and FLORIS's turbulence
-    intensities the ekman_veer model does not read (said)."""
+    sublayer and a heterogeneous map given with the atmosphere (warned)."""
     from floris_ekman_veer.plugin import input_checks
 
     flow_field = core.flow_field
@@ -783,7 +788,6 @@ def _check_solved_conditions(core: Core, spec: AtmosphereSpec) -> None:
         return  # FLORIS refuses it
     abl = solve(spec, flow_field.wind_speeds, height)
     _check_shallow(core, abl, height, "build")
-    input_checks.notice_unused_turbulence(core, abl, spec)
     sublayer = np.max(np.where(abl.at_rest, 0.0, np.reshape(abl.roughness_sublayer_height, -1)))
     low = np.flatnonzero(np.asarray(core.farm.hub_heights, dtype=float) < sublayer)
     if low.size:

@@ -104,35 +104,50 @@ def warn_ignored_flow_inputs(core, atmosphere) -> None:
             package_warnings.ModelSettingsWarning, items=(("wind_veer", veer),))
 
 
+#: TI given within this of the atmosphere's I_u at hub height are taken as its own (I_u written
+#: to the three decimals a TI is usually given to; a gauss run on them sees the same turbulence).
+OWN_TURBULENCE_MATCH = 5e-4 + 1e-12
+
+
 def notice_unused_turbulence(core, abl, atmosphere) -> None:
     """``flow_field.turbulence_intensities``, which FLORIS requires, is not the ekman_veer wake
     model's ambient turbulence (it takes I_u at hub height from the solved atmosphere ``abl``):
-    said once per study and atmosphere where the TI given vary (over conditions or set() calls;
-    one value throughout is FLORIS's required placeholder), unless they are the atmosphere's own
-    I_u at a hub height, as the package's comparisons give them (studies/comparison.py)."""
+    said once per study and atmosphere, as the unused ``wind_shear`` is, whatever TI are given
+    (one constant value too: a gauss run beside it reads that value, so a comparison on "the same
+    inflow" would differ in its turbulence unknowingly), unless they are the atmosphere's own I_u
+    at a hub height, as the package's comparisons give them (studies/comparison.py)."""
     if str(core.wake.model_strings.get("velocity_model", "")).lower() != VELOCITY_MODEL_NAME:
         return
     given = np.asarray(core.flow_field.turbulence_intensities, dtype=float).ravel()
     moving = ~np.asarray(abl.at_rest, dtype=bool).ravel()
     if not np.any(moving):
         return
+    own_by_hub = []
     for hub in np.unique(np.asarray(core.farm.hub_heights, dtype=float)):
         if hub >= np.max(abl.roughness_length):
             own = np.ravel(abl.turbulence_intensity(hub, reference_height=hub))
-            if np.allclose(given[moving], own[moving], rtol=1e-6, atol=0.0):
+            if np.all(np.abs(given[moving] - own[moving]) <= OWN_TURBULENCE_MATCH):
                 return
+            own_by_hub.append(own[moving])
     seen = package_warnings.values_seen(f"turbulence_intensities on {atmosphere!r}",
-                                        np.unique(given))
-    if len(seen) > 1:
-        package_warnings.warn(
-            "flow_field.turbulence_intensities "
-            f"({package_warnings.range_text(seen, '').strip()}) are not used as the ambient "
-            f"turbulence by the {VELOCITY_MODEL_NAME} wake model: it takes I_u at hub height from "
-            f"the atmosphere ({ATMOSPHERE_PATH}; per condition in validity_report's "
-            "turbulence_intensity). FLORIS's gauss and other models read them: for a comparison "
-            "on the same inflow give them the atmosphere's I_u "
-            "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
-            package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
+                                        np.unique(given[moving]))
+    own_text = (f" (its I_u at hub height here: "
+                f"{package_warnings.range_text(np.concatenate(own_by_hub), '').strip()})"
+                if own_by_hub else "")
+    added_text = ("; only FLORIS's wake-added turbulence model reads them (wake_expansion: "
+                  f"{core.wake.velocity_model.wake_expansion})"
+                  if getattr(core.wake.velocity_model, "wake_expansion", "ambient") != "ambient"
+                  else "")
+    package_warnings.warn(
+        "flow_field.turbulence_intensities "
+        f"({package_warnings.range_text(seen, '').strip()}) are not used as the ambient "
+        f"turbulence by the {VELOCITY_MODEL_NAME} wake model: it takes I_u at hub height from "
+        f"the atmosphere ({ATMOSPHERE_PATH}; per condition in validity_report's "
+        f"turbulence_intensity){own_text}{added_text}. FLORIS's gauss and other models read "
+        "them as the ambient turbulence: for a "
+        "comparison on the same inflow give them the atmosphere's I_u "
+        "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
+        package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
 
 
 def warn_deficit_superposition(core) -> None:
