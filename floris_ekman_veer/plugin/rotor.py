@@ -50,6 +50,7 @@ import numexpr as ne
 import numpy as np
 
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.fused import program
 
 #: The moment m of the rotor average that each turbine's power and thrust take: FLORIS's power
 #: curves take the cubic mean (m = 3) of the turbine grid; the actuator disk takes the plain
@@ -131,9 +132,14 @@ class RotorCells:
         return np.count_nonzero(self.weight > 0.0, axis=1)
 
     @functools.cached_property
-    def row_start(self) -> np.ndarray:
-        """(rows,) position of each row's first sub-point among the sub-points with weight."""
-        return np.concatenate([[0], np.cumsum(self.row_width)[:-1]])
+    def sub_y_columns(self) -> np.ndarray:
+        """(columns, rows) :attr:`sub_y` column-major (the wakes' sub-points, rotor_cell_deficit)."""
+        return np.ascontiguousarray(self.sub_y.T)
+
+    @functools.cached_property
+    def weight_columns(self) -> np.ndarray:
+        """(columns, rows) :attr:`weight` column-major."""
+        return np.ascontiguousarray(self.weight.T)
 
     @functools.cached_property
     def row_cells(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -270,6 +276,22 @@ def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
     return np.add.reduceat(weighted, start, axis=-1)
 
 
+def column_sums(values: np.ndarray) -> np.ndarray:
+    """The sums of the columns of ``values`` (w, entries), bit for bit numpy's ``np.sum`` of
+    each entry's w values held in a row (its pairwise sum: eight running sums from eight
+    values on, combined pairwise, the rest added in turn), at the cost of w adds of rows."""
+    w = values.shape[0]
+    if w < 8:
+        return functools.reduce(np.add, values, np.zeros(values.shape[1]))
+    sums = list(values[:8])
+    start = 8
+    while start < w - w % 8:
+        sums = [total + value for total, value in zip(sums, values[start:start + 8])]
+        start += 8
+    total = ((sums[0] + sums[1]) + (sums[2] + sums[3])) + ((sums[4] + sums[5]) + (sums[6] + sums[7]))
+    return functools.reduce(np.add, values[start:], total)
+
+
 #: Conditions per piece of :func:`cell_mean`: the piece's gathered rows (a few hundred (cell,
 #: row) pairs each) stay in cache.
 _CELL_PIECE = 128
@@ -329,9 +351,14 @@ WAKE_OVERLAP_VELOCITY = 0.05
 
 _SUPERPOSED = {"sosfs": "sqrt(old**2 + du**2)", "fls": "old + du",
                "max": "where(du > old, du, old)", None: "du"}
-# weight (u_old^m - u_new^m) with u = U - wake: the moment the new wake removes at a sub-point.
-_REMOVED = ("where(U > 0, weight * where(m > 2, (new - old) * ((U - old)**2 + (U - old) * "
-            "(U - new) + (U - new)**2), new - old), 0)")
+#: The same rules in numpy, for the stored combination (the same bits as numexpr's).
+_SUPERPOSE = {"sosfs": lambda old, du: np.sqrt(old**2 + du**2), "fls": np.add,
+              "max": lambda old, du: np.where(du > old, du, old)}
+# weight (u_old^m - u_new^m) with u = U - wake: the moment the new wake removes at a sub-point,
+# per rule with the combined wake ``new`` written out (one pass over the sub-points).
+_REMOVED = {rule: ("where(U > 0, weight * where(m > 2, (new - old) * ((U - old)**2 + (U - old) * "
+                   "(U - new) + (U - new)**2), new - old), 0)").replace("new", f"({combined})")
+            for rule, combined in _SUPERPOSED.items()}
 
 
 @attrs.define(eq=False)
@@ -351,8 +378,9 @@ class RotorWakes:
         cells: the rotor cells.
         rule: "sosfs", "fls", "max" (FLORIS's combination model), or None: unknown, each call
             returns its own wake's cell deficits.
-        combined: (n_findex * n_turbines * sub-points with weight,) combined wake velocity
-            [m/s] at the sub-points, row by row (RotorCells.row_start).
+        combined: (columns, n_findex * n_turbines * rows) combined wake velocity [m/s] at the
+            sub-points, column-major: one column of blocks per rotor and row (RotorCells.sub_y's
+            columns).
         removed: (n_findex * n_turbines, n^2) n^2 sum_{s in k} w_s (U_s^m - u_s^m) of the
             combined wakes.
         wake: (n_findex * n_turbines, n^2) the wake velocity U_k d_k FLORIS holds at each point.
@@ -381,7 +409,8 @@ class RotorWakes:
         pairs = n_findex * n_turbines
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
-        combined = np.zeros(pairs * int(cells.row_width.sum()) if rule else 0, dtype=np.float32)
+        combined = np.zeros((cells.sub_y.shape[1], pairs * cells.rows if rule else 0),
+                            dtype=np.float32)
         turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
                                      (n_findex, n_turbines)).copy()
         return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
@@ -394,27 +423,27 @@ class RotorWakes:
         the zero-weight padding), ``ambient_u`` (entries, 1) U at
         the row (0 where there is no flow), ``moment`` (entries, 1). Returns (entries, w) the
         moment the wake removes at each sub-point, weight (u_before^m - u_after^m)."""
+        return self.superpose_columns(pair, row, du.T, np.transpose(ambient_u),
+                                      np.transpose(moment)).T
+
+    def superpose_columns(self, pair, row, du, ambient_u, moment) -> np.ndarray:
+        """:meth:`superpose` with the sub-points column-major: ``du`` (w, entries),
+        ``ambient_u`` and ``moment`` (1, entries); returns (w, entries)."""
         cells = self.cells
-        width = du.shape[1]
+        width = du.shape[0]
         if self.rule is None:
             old = np.zeros_like(du)
         else:
-            columns = np.arange(width)
-            flat = (pair * int(cells.row_width.sum()) + cells.row_start[row])[:, None] + columns
-            # Rows narrower than ``width`` (padding with zero weight) keep their storage.
-            used = columns < cells.row_width[row][:, None]
-            if used.all():
-                old = self.combined[flat].astype(float)
-            else:
-                flat = flat[used]
-                old = np.zeros(du.shape)
-                old[used] = self.combined[flat]
-        new = ne.evaluate(_SUPERPOSED[self.rule], local_dict={"old": old, "du": du})
+            # The rows' stored blocks, padding included: a padding sub-point's weight is 0, so
+            # what it holds never reaches a cell.
+            index = pair * cells.rows + row
+            old = np.take(self.combined[:width], index, axis=1).astype(float)
+        removed = program(_REMOVED[self.rule])(old=old, du=du, U=ambient_u,
+                                               weight=cells.weight_columns[:width, row],
+                                               m=moment)
         if self.rule is not None:
-            self.combined[flat] = new if used.all() else new[used]
-        return ne.evaluate(_REMOVED, local_dict={
-            "old": old, "new": new, "U": ambient_u, "weight": cells.weight[row, :width],
-            "m": moment})
+            self.combined[:width, index] = _SUPERPOSE[self.rule](old, du)
+        return removed
 
     def cell_returns(self, pair, removed, u_cell, moment) -> np.ndarray:
         """What the velocity model returns at the cells of rotors ``pair`` (flat indices, each
@@ -789,18 +818,20 @@ def rotor_cell_deficit(
 
     def integrate(piece):
         """Superpose the wake on one piece of (pair, row) entries: pieces touch disjoint
-        entries and sub-points, so they run at once (:func:`map_pieces`)."""
+        entries and sub-points, so they run at once (:func:`map_pieces`). The sub-points are
+        held column-major, (width, entries): the per-entry factors then run along numexpr's
+        inner loop without being copied out to every sub-point."""
         chunk, width = piece
         pe, re = p[chunk], r[chunk]
         fe = f[pe]
-        pair = {k: v[pe][:, None] for k, v in per_pair.items()}
-        u_rows = rotor.kind_u[fe, kind[pe], re][:, None]
-        v_rows = rotor.kind_v[fe, kind[pe], re][:, None]
-        dy = lateral[pe, re][:, None] + radius_j[pe] * cells.sub_y[re, :width]
+        pair = {k: v[pe][None, :] for k, v in per_pair.items()}
+        u_rows = rotor.kind_u[fe, kind[pe], re][None, :]
+        v_rows = rotor.kind_v[fe, kind[pe], re][None, :]
+        dy = lateral[pe, re][None, :] + radius_j[pe, 0][None, :] * cells.sub_y_columns[:width, re]
         wake = TurbineWake(
-            dx=x_pair[pe][:, None],
+            dx=x_pair[pe][None, :],
             dy=dy,
-            dz=dz[pe, re][:, None],
+            dz=dz[pe, re][None, :],
             yaw=pair["yaw"],
             ct=pair["ct"],
             radius=pair["radius"],
@@ -813,21 +844,20 @@ def rotor_cell_deficit(
         # No flow (at and below z0): no wake.
         ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
         du = model.sub_point_deficit(
-            wake, {k: v[pe][:, None] for k, v in wake_parameters.items()},
+            wake, {k: v[pe][None, :] for k, v in wake_parameters.items()},
         ) * (pair["hub_speed"] * pair["speed_fraction"])
-        removed = wakes.superpose(flat[pe], re, du, ambient_u, moment[pe][:, None])
-        # Each stretch's nodes added in turn: numpy's sum of fewer than 8 numbers, at less
-        # cost than a reduction along a short axis.
-        stretch = removed[:, ::nodes]
+        removed = wakes.superpose_columns(flat[pe], re, du, ambient_u, moment[pe][None, :])
+        # Each stretch's nodes added in turn.
+        stretch = removed[::nodes]
         for node in range(1, nodes):
-            stretch = stretch + removed[:, node::nodes]
-        stretches[chunk, :width // nodes] = stretch
+            stretch = stretch + removed[node::nodes]
+        stretches[chunk, :width // nodes] = stretch.T
         if track:
             # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
             # rotor laterally, here as the area of the disk where it holds.
             inside = (du > WAKE_OVERLAP_VELOCITY) & (
-                np.abs(dy + centre[pe, re][:, None]) < 4.0 * pair["radius"])
-            row_overlap[chunk] = np.sum(cells.weight[re, :width] * inside, axis=1)
+                np.abs(dy + centre[pe, re][None, :]) < 4.0 * pair["radius"])
+            row_overlap[chunk] = column_sums(cells.weight_columns[:width, re] * inside)
 
     map_pieces(integrate, pieces)
     removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
