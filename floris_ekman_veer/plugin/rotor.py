@@ -348,6 +348,9 @@ COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
 #: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
 #: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
 WAKE_OVERLAP_VELOCITY = 0.05
+# The area weight of a sub-point in the wake's overlap (rotor_cell_deficit): velocity above
+# WAKE_OVERLAP_VELOCITY, within ``reach`` (2 D) of the wake's rotor laterally.
+_OVERLAP = (f"where((du > {WAKE_OVERLAP_VELOCITY!r}) & (abs(dy + centre) < reach), weight, 0)")
 
 _SUPERPOSED = {"sosfs": "sqrt(old**2 + du**2)", "fls": "old + du",
                "max": "where(du > old, du, old)", None: "du"}
@@ -378,9 +381,8 @@ class RotorWakes:
         cells: the rotor cells.
         rule: "sosfs", "fls", "max" (FLORIS's combination model), or None: unknown, each call
             returns its own wake's cell deficits.
-        combined: (columns, n_findex * n_turbines * rows) combined wake velocity [m/s] at the
-            sub-points, column-major: one column of blocks per rotor and row (RotorCells.sub_y's
-            columns).
+        combined: (n_findex * n_turbines * rows, columns) combined wake velocity [m/s] at the
+            sub-points, one block per rotor and row (RotorCells.sub_y's).
         removed: (n_findex * n_turbines, n^2) n^2 sum_{s in k} w_s (U_s^m - u_s^m) of the
             combined wakes.
         wake: (n_findex * n_turbines, n^2) the wake velocity U_k d_k FLORIS holds at each point.
@@ -409,7 +411,7 @@ class RotorWakes:
         pairs = n_findex * n_turbines
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
-        combined = np.zeros((cells.sub_y.shape[1], pairs * cells.rows if rule else 0),
+        combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),
                             dtype=np.float32)
         turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
                                      (n_findex, n_turbines)).copy()
@@ -436,13 +438,14 @@ class RotorWakes:
         else:
             # The rows' stored blocks, padding included: a padding sub-point's weight is 0, so
             # what it holds never reaches a cell.
+            # (Stored row-major: each block's values are together in memory.)
             index = pair * cells.rows + row
-            old = np.take(self.combined[:width], index, axis=1).astype(float)
+            old = np.take(self.combined, index, axis=0)[:, :width].T.astype(float, order="C")
         removed = program(_REMOVED[self.rule])(old=old, du=du, U=ambient_u,
                                                weight=cells.weight_columns[:width, row],
                                                m=moment)
         if self.rule is not None:
-            self.combined[:width, index] = _SUPERPOSE[self.rule](old, du)
+            self.combined[index, :width] = _SUPERPOSE[self.rule](old, du).T
         return removed
 
     def cell_returns(self, pair, removed, u_cell, moment) -> np.ndarray:
@@ -855,9 +858,9 @@ def rotor_cell_deficit(
         if track:
             # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
             # rotor laterally, here as the area of the disk where it holds.
-            inside = (du > WAKE_OVERLAP_VELOCITY) & (
-                np.abs(dy + centre[pe, re][None, :]) < 4.0 * pair["radius"])
-            row_overlap[chunk] = column_sums(cells.weight_columns[:width, re] * inside)
+            row_overlap[chunk] = column_sums(program(_OVERLAP)(
+                du=du, dy=dy, centre=centre[pe, re][None, :], reach=4.0 * pair["radius"],
+                weight=cells.weight_columns[:width, re]))
 
     map_pieces(integrate, pieces)
     removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
