@@ -20,6 +20,7 @@ import numpy as np
 from floris_ekman_veer.plugin.rotor_cells import RotorCells
 from floris_ekman_veer.wake.fused import program
 
+
 def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
     """d_k of each cell from the cell's removed moment n^2 sum_{s in k} w_s (U_s^m - u_s^m)
     (m = 3: power; m = 1: the velocity deficit itself): U_k^m (1 - (1 - d_k)^m) = removed.
