@@ -1,5 +1,5 @@
 """A converged reference of turbine powers where several wakes overlap, independent of the
-rotor cells that ship (plugin/rotor.py); used by tests/test_multiwake.py and
+rotor cells that ship (plugin/rotor_cells.py); used by tests/test_multiwake.py and
 benchmarks/bench_rotor_average.py (docs/coupling.md#rotor-average).
 
 FLORIS's own sequential solver runs on a fine grid of point values in the slot of its

@@ -7,7 +7,7 @@ into chunks over all conditions together, and each chunk's rows added into the c
 a condition alone (one group) summed its rows in another order than inside a batch (6 of 40
 conditions differed in the last bits, <= 1.3e-15 relative). Now each row's stretches are summed
 per row and added into the cells in row order (plugin/rotor.py), and the inflow's cell means
-are segment sums, not a BLAS matrix product (plugin/rotor.py).
+are segment sums, not a BLAS matrix product (plugin/rotor_cells.py).
 """
 
 from __future__ import annotations

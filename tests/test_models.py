@@ -1051,7 +1051,7 @@ def test_added_turbulence_and_incoming_speed_by_hand():
     cells' mean waked over ambient speed, 1 without a wake."""
     from types import SimpleNamespace
 
-    from floris_ekman_veer.plugin.rotor import RotorWakes
+    from floris_ekman_veer.plugin.rotor_wakes import RotorWakes
 
     for rule, expected in (("quadrature", math.sqrt(0.05**2 + 0.1**2 + 0.08**2)),
                            ("max", math.hypot(0.1, 0.05))):

@@ -1,4 +1,4 @@
-"""Rotor averages where several wakes overlap (plugin/rotor.py ``RotorWakes``,
+"""Rotor averages where several wakes overlap (plugin/rotor_wakes.py ``RotorWakes``,
 docs/coupling.md#rotor-average).
 
 1. The superposition: point-wise at the cells' sub-points by FLORIS's rule, and the increment
@@ -17,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from floris_ekman_veer.plugin.rotor import RotorWakes, rotor_cells
+from floris_ekman_veer.plugin.rotor_cells import rotor_cells
+from floris_ekman_veer.plugin.rotor_wakes import RotorWakes
 from multiwake_reference import (
     extrapolated_powers,
     farm_config,

@@ -1,4 +1,4 @@
-"""The rotor average (plugin/rotor.py, docs/coupling.md#rotor-average).
+"""The rotor average (plugin/rotor_cells.py, plugin/rotor.py, docs/coupling.md#rotor-average).
 
 1. The cells: equal areas 1/n^2 partitioning the disk, each holding its FLORIS point.
 2. Convergence: for single wakes (the paper's disk in CNBL, SBL-4, SBL-6 and the NREL 5 MW
@@ -24,7 +24,7 @@ from floris import FlorisModel
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
-from floris_ekman_veer.plugin.rotor import grid_offsets, rotor_cells
+from floris_ekman_veer.plugin.rotor_cells import grid_offsets, rotor_cells
 from floris_ekman_veer.wake.deficit import normalised_deficit
 from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
 
@@ -195,15 +195,16 @@ def test_cell_mean_by_height_is_row_cell_sums_bit_for_bit():
     """The inflow's cell means, summed with the conditions innermost and a piece of conditions
     at a time, are the per-condition segment sums of row_cell_sums exactly, for m = 3 and 1,
     with rows gathered from distinct heights."""
-    from floris_ekman_veer.plugin import rotor
+    from floris_ekman_veer.plugin import rotor_cells as cells_module
 
-    cells = rotor.rotor_cells(3, rotor.AMBIENT_ROWS, rotor.AMBIENT_NODES)
+    cells = cells_module.rotor_cells(3, cells_module.AMBIENT_ROWS, cells_module.AMBIENT_NODES)
     rng = np.random.default_rng(5)
-    heights_u = rng.uniform(4.0, 12.0, (cells.rows + 7, 3 * rotor._CELL_PIECE + 5))
+    heights_u = rng.uniform(4.0, 12.0, (cells.rows + 7, 3 * cells_module._CELL_PIECE + 5))
     index = rng.permutation(cells.rows + 7)[:cells.rows]
     u_rows = heights_u[index].T  # (n_findex, rows)
     for moment in (3.0, 1.0):
         powers = u_rows**3 if moment == 3.0 else u_rows
-        mean = rotor.row_cell_sums(powers, cells) / cells.area
+        mean = cells_module.row_cell_sums(powers, cells) / cells.area
         expected = np.cbrt(mean) if moment == 3.0 else mean
-        np.testing.assert_array_equal(rotor.cell_mean(heights_u, index, moment, cells), expected)
+        np.testing.assert_array_equal(cells_module.cell_mean(heights_u, index, moment, cells),
+                                      expected)

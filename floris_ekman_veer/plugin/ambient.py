@@ -16,7 +16,7 @@ from floris.core import FlowField, Grid, TurbineCubatureGrid, TurbineGrid
 from floris.utilities import rotate_coordinates_rel_west
 
 from floris_ekman_veer.plugin.inflow import ambient_velocity, solved_atmosphere
-from floris_ekman_veer.plugin.rotor import (
+from floris_ekman_veer.plugin.rotor_cells import (
     RotorCells,
     rotor_cells,
     rotor_geometry,

@@ -123,7 +123,7 @@ from floris.floris_model import FlorisModel  # noqa: E402
 
 from floris_ekman_veer.atmosphere.stability_inputs import STABILITY_INPUTS  # noqa: E402
 import floris_ekman_veer.warnings as package_warnings  # noqa: E402
-from floris_ekman_veer.plugin.rotor import (  # noqa: E402
+from floris_ekman_veer.plugin.rotor_cells import (  # noqa: E402
     TURBINE_MOMENTS,
     WAKE_MODELS,
     turbine_grid_inflow,

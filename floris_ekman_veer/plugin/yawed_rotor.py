@@ -52,7 +52,7 @@ from floris_ekman_veer.plugin.crossflow import (
     normal_squares,
     veer_ratio,
 )
-from floris_ekman_veer.plugin.rotor import (
+from floris_ekman_veer.plugin.rotor_cells import (
     AMBIENT_NODES,
     AMBIENT_ROWS,
     rotor_cells,

@@ -10,6 +10,8 @@ tests/test_rotor_average.py checks it against ``normalised_deficit`` to round-of
 
 from __future__ import annotations
 
+import threading
+
 import numexpr as ne
 import numpy as np
 
@@ -23,6 +25,41 @@ from .deficit import (
 )
 
 
+class Program:
+    """A numexpr expression compiled once, for float64 operands (``ne.evaluate`` without its
+    per-call parsing, validation and cache look-up: the same compiled program, the same bits).
+    Call it with the operands by name; they broadcast as in ``ne.evaluate``."""
+
+    #: ``ne.evaluate``'s context in a module without ``from __future__ import division``.
+    CONTEXT = {"optimization": "aggressive", "truediv": False}
+
+    def __init__(self, expression: str):
+        self.names, self.uses_vml = ne.necompiler.getExprNames(expression, self.CONTEXT)
+        self.compiled = ne.NumExpr(expression, [(name, np.double) for name in self.names],
+                                   **self.CONTEXT)
+
+    def __call__(self, **operands) -> np.ndarray:
+        return self.compiled(*(np.asarray(operands[name], dtype=float) for name in self.names),
+                             out=None, order="K", casting="same_kind",
+                             ex_uses_vml=self.uses_vml)
+
+
+#: The compiled programs of each thread: a compiled numexpr program holds its temporaries, so
+#: threads never share one (as numexpr's own cache).
+_PROGRAMS = threading.local()
+
+
+def program(expression: str) -> Program:
+    """The compiled :class:`Program` of ``expression`` (compiled once per thread)."""
+    programs = getattr(_PROGRAMS, "programs", None)
+    if programs is None:
+        programs = _PROGRAMS.programs = {}
+    compiled = programs.get(expression)
+    if compiled is None:
+        compiled = programs[expression] = Program(expression)
+    return compiled
+
+
 def curl_coefficients(t_hat, alpha=CURL_ALPHA):
     """(a2, a3, a4) with xi_hat = 1 - (a2 cos 2theta + a3 cos 3theta + a4 cos 4theta), Eq. (xi_emp):
 
@@ -30,8 +67,8 @@ def curl_coefficients(t_hat, alpha=CURL_ALPHA):
     a4 = 7 alpha/48 tanh(t^4/16alpha).
     """
     t = np.asarray(t_hat, dtype=float)
-    tanh2, tanh3, tanh4 = (ne.evaluate(f"tanh(t**{k} / ({2.0**k} * alpha))",
-                                       local_dict={"t": t, "alpha": alpha}) for k in (2, 3, 4))
+    tanh2, tanh3, tanh4 = (program(f"tanh(t**{k} / ({2.0**k} * alpha))")(t=t, alpha=alpha)
+                           for k in (2, 3, 4))
     return (
         alpha * (0.5 * tanh2 - 5.0 / 48.0 * tanh4),
         -0.25 * alpha * tanh3,
@@ -92,5 +129,5 @@ def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
 def deficit_on_rows(dy, dz, parameters):
     """Delta u / U_h of Eq. (du_model) at points (dy, dz) from the factors of
     :func:`rows_deficit_parameters` (two numexpr passes: cos(theta), then the deficit)."""
-    c = ne.evaluate(_COSINE, local_dict={"dy": dy, "dz": dz})
-    return ne.evaluate(_DEFICIT, local_dict={"dy": dy, "dz": dz, "c": c, **parameters})
+    c = program(_COSINE)(dy=dy, dz=dz)
+    return program(_DEFICIT)(dy=dy, dz=dz, c=c, **parameters)
