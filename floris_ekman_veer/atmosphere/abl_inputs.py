@@ -8,7 +8,11 @@ from __future__ import annotations
 import numpy as np
 
 from floris_ekman_veer._validation import real_array, require_at
-from floris_ekman_veer.atmosphere.constants import GRAVITY, PAPER_BRUNT_VAISALA_FREQUENCY, air_heat_capacity
+from floris_ekman_veer.atmosphere.constants import (
+    GRAVITY,
+    PAPER_BRUNT_VAISALA_FREQUENCY,
+    air_heat_capacity,
+)
 from floris_ekman_veer.atmosphere.input_ranges import (
     MAX_CORIOLIS_PARAMETER,
     MAX_LAPSE_RATE,
@@ -28,7 +32,8 @@ def checked_model_constants(**constants) -> dict:
     for name, value in constants.items():
         ok = (lambda v: (v > 0) & (v < 1)) if name == "matching_fraction" else (lambda v: v > 0)
         if np.ndim(checked(name, value, ok)) != 0:
-            raise ValueError(f"{name} must be a single number ({VALID_RANGES[name]}); got {value!r}")
+            raise ValueError(
+                f"{name} must be a single number ({VALID_RANGES[name]}); got {value!r}")
     return {name: float(value) for name, value in constants.items()}
 
 

@@ -225,7 +225,6 @@ class EkmanABL(WindProfile):
         abl = cls.check_inputs(**inputs)
         abl.geostrophic_wind = np.asarray(geostrophic_wind, dtype=float)
         params, shape = abl.condition_parameters(abl.geostrophic_wind, np.shape(log_u_star))
-        abl._params = params
         abl.set_state(np.broadcast_to(np.asarray(log_u_star, dtype=float), shape), params)
         return abl
 
@@ -269,8 +268,11 @@ class EkmanABL(WindProfile):
         return np.where(value > 0, stability_closures.stability_from_heat_flux(
             heat_flux, u_star, f, theta0), cooling)
 
-    def state_at(self, log_u_star, p):
-        """ABL state for trial ln u* and condition parameters p: (u*, mu, h_hat, A, B, ln Ro - A)."""
+    def state_at(self, log_u_star, p) -> DragLawState:
+        """The `DragLawState` (u*, mu, h_hat, A, B, ln Ro - A) at trial ln u* for the condition
+        parameters ``p`` (`condition_parameters`): explicit in u* for the stability closure, so
+        G = (u*/kappa) sqrt((ln Ro - A)^2 + B^2) needs no inner solve
+        (docs/atmosphere.md#the-solvers-interface). Arrays broadcast together."""
         u_star = np.exp(log_u_star)
         mu = self._closure_mu(u_star, p)
         h_hat = np.where(
@@ -283,7 +285,7 @@ class EkmanABL(WindProfile):
             mu, p["mu_n"], h_hat, rossby, self.von_karman, self.c_g,
             self.stress_decay, self.matching_fraction, self.businger_dyer_gamma,
         )
-        return u_star, mu, h_hat, a, b, np.log(rossby) - a
+        return DragLawState(u_star, mu, h_hat, a, b, np.log(rossby) - a)
 
     def _residual(self, log_u_star, p):
         """ln(|(U_g, V_g)| / G): zero at the GDL solution, increasing on the physical branch
@@ -310,7 +312,10 @@ class EkmanABL(WindProfile):
         return ValueError(f"{lead} ({reason}) for inputs {details}")
 
     def condition_parameters(self, geostrophic_wind, shape=()):
-        """The per-condition parameters of the solve, broadcast together (and to ``shape``)."""
+        """(parameters, shape): the per-condition parameters of the solve by name (``g`` the
+        geostrophic wind, ``f`` |f_c|, ``z0``, ``value`` the stability input's, ``mu_n``,
+        ``theta0``, ``zi`` z_i or NaN), broadcast together and to ``shape``, and that shape: what
+        `state_at` and `set_state` take (docs/atmosphere.md#the-solvers-interface)."""
         params = dict(
             g=geostrophic_wind, f=self.coriolis_magnitude, z0=self.roughness_length,
             value=self.stability_value, mu_n=self.zilitinkevich_number,
@@ -353,8 +358,7 @@ class EkmanABL(WindProfile):
                 "matching height matching_fraction * h at or below roughness_length z0: "
                 "the stable boundary layer collapses",
             )
-        self._params = {k: v.reshape(shape) for k, v in flat.items()}
-        self.set_state(x.reshape(shape), self._params)
+        self.set_state(x.reshape(shape), {k: v.reshape(shape) for k, v in flat.items()})
         self.require_depth(lambda mask: self._failure(
             mask, f"the stable boundary layer collapses: h below {MIN_BOUNDARY_LAYER_HEIGHT:g} m, "
             "the shallowest the model accepts (docs/atmosphere.md#shallow-boundary-layer)",
@@ -391,6 +395,10 @@ class EkmanABL(WindProfile):
             raise error(np.atleast_1d(shallow).reshape(np.shape(shallow) or (1,)))
 
     def set_state(self, log_u_star, p):
+        """Set the solved attributes (``friction_velocity``, ``stability_parameter``,
+        ``boundary_layer_height``, ``geostrophic_components``, ``cross_isobaric_angle``, ...)
+        at the root ln u* of the conditions' parameters ``p`` (`condition_parameters`); the
+        caller vouches that it is a model state (docs/atmosphere.md#the-solvers-interface)."""
         # The state of one condition is computed as an array of one, not as numpy scalars:
         # ``**`` on a numpy scalar takes C's pow, whose last bit can differ from numpy's array
         # loop, and a condition must give the same bits alone as in a batch.

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import difflib
 import inspect
+from typing import NamedTuple
 
 import numpy as np
 
@@ -194,3 +195,146 @@ def checked_data(name, value, shape=None):
                          f"{array.shape}")
     require_at(~np.isinf(array), name, "finite (NaN: missing)", array)
     return array
+
+
+class FitData(NamedTuple):
+    """The profile fit's data and fixed inputs as checked (`checked_fit_data`)."""
+
+    #: [m] (n_records, n_heights)
+    heights: np.ndarray
+    #: [m/s] (n_records, n_heights), NaN missing
+    speeds: np.ndarray
+    #: [deg] (n_records, n_heights) or None
+    directions: np.ndarray | None
+    #: one record given as 1-D data
+    single: bool
+    labels: list
+    #: a number [m/s] or (absolute [m/s], relative)
+    speed_noise: float | tuple
+    #: the fixed EkmanABL inputs but the roughness length: numbers or one per record
+    fixed: dict
+    #: [m] the roughness length (the starting value where fitted)
+    z0: np.ndarray
+    #: (heights, values, relative noise) of a measured turbulence intensity, or None
+    turbulence: tuple | None
+    #: per record: the speeds measured, the unknowns, the data (speeds, direction changes, I_u)
+    valid_speeds: np.ndarray
+    n_unknowns: int
+    observations: np.ndarray
+
+
+def checked_fit_data(abl_class, heights, speeds, directions, *, labels, speed_noise,
+                     direction_noise, refusal_probability, direction_model_error, on_misfit,
+                     fit_roughness, fit_mixed_layer_height, max_iterations, chunk_size,
+                     turbulence_intensity, turbulence_noise, fixed_inputs) -> FitData:
+    """``fit_profile``'s data, options and fixed inputs checked (ValueError naming what is
+    wrong, the record and the value) and shaped as the fit takes them."""
+    speeds = checked_data("speeds", speeds)
+    single = speeds.ndim == 1
+    speeds = np.atleast_2d(speeds)
+    if speeds.ndim != 2:
+        raise ValueError(f"fit_profile: speeds must be (n_records, n_heights) or (n_heights,); "
+                         f"got shape {speeds.shape}")
+    n, m = speeds.shape
+    if n == 0 or m == 0:
+        raise ValueError(f"fit_profile: speeds hold no records (shape {speeds.shape}); give "
+                         "(n_records, n_heights) with at least one record and one height")
+    if (isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer))
+            or max_iterations < 1):
+        raise ValueError(f"fit_profile: max_iterations must be an integer >= 1; got "
+                         f"{max_iterations!r}")
+    if (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
+            or chunk_size < 1):
+        raise ValueError(f"fit_profile: chunk_size must be an integer >= 1; got {chunk_size!r}")
+    heights = real_array("heights", heights, "> 0 m")
+    require_at(np.isfinite(heights) & (heights > 0), "heights", "finite and > 0 m", heights)
+    if heights.shape not in ((m,), (n, m)):
+        raise ValueError(f"fit_profile: heights must be (n_heights,) = ({m},) or (n_records, "
+                         f"n_heights) = ({n}, {m}); got shape {heights.shape}")
+    heights = np.broadcast_to(heights, (n, m)).astype(float)
+    if directions is not None:
+        directions = np.atleast_2d(checked_data("directions", directions,
+                                                 np.shape(speeds[0] if single else speeds)))
+    labels = list(range(n)) if labels is None else list(labels)
+    if len(labels) != n:
+        raise ValueError(f"fit_profile: labels must name the {n} records; got {len(labels)}")
+    bad = ~(np.isnan(speeds) | (speeds > 0))
+    if np.any(bad):
+        i, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"fit_profile: speeds must be > 0 m/s (NaN: missing); record {labels[i]} has "
+            f"{speeds[i, j]:g} m/s at {heights[i, j]:g} m"
+            + (f" ({int(bad.sum()) - 1} more value(s) in {int(bad.any(axis=1).sum())} "
+               "record(s))" if bad.sum() > 1 else "")
+            + ": a zero reading is a calm or a stalled anemometer; give NaN (missing) there")
+    if directions is not None:
+        check_degrees(directions)
+    speed_noise = checked_speed_noise(speed_noise)
+    for name, value in (("direction_noise", direction_noise),
+                        ("refusal_probability", refusal_probability)):
+        upper = 1.0 if name == "refusal_probability" else np.inf
+        if (isinstance(value, bool) or not np.isscalar(value) or not np.isfinite(value)
+                or not 0 < value < upper):
+            valid = "in (0, 1)" if name == "refusal_probability" else "> 0"
+            raise ValueError(f"fit_profile: {name} must be a number {valid}; got {value!r}")
+    if (isinstance(direction_model_error, bool)
+            or not isinstance(direction_model_error, (int, float, np.integer, np.floating))
+            or not np.isfinite(direction_model_error) or direction_model_error < 0):
+        raise ValueError(f"fit_profile: direction_model_error must be a number >= 0 [deg]; got "
+                         f"{direction_model_error!r}")
+    if on_misfit not in ("raise", "flag"):
+        raise ValueError(f"fit_profile: on_misfit must be 'raise' or 'flag'; got {on_misfit!r}")
+    if not isinstance(fit_roughness, bool):
+        raise ValueError(f"fit_profile: fit_roughness must be True or False; got {fit_roughness!r}")
+    if not isinstance(fit_mixed_layer_height, bool):
+        raise ValueError(f"fit_profile: fit_mixed_layer_height must be True or False; got "
+                         f"{fit_mixed_layer_height!r}")
+
+    given = sorted(k for k in fixed_inputs if k in STABILITY_INPUTS or k == "geostrophic_wind")
+    if given:
+        raise ValueError(
+            f"fit_profile fits the wind and the stability; {given} cannot be fixed inputs (an "
+            "atmosphere from a known wind and stability is EkmanABL.from_reference_wind(speed, "
+            "height, obukhov_length=..., ...), docs/measurements.md#simpler-site-inputs)"
+        )
+    if "latitude" not in fixed_inputs and "coriolis_parameter" not in fixed_inputs:
+        raise ValueError("fit_profile needs the site's latitude [deg] or coriolis_parameter "
+                         "[1/s] as a fixed input")
+    z0 = fixed_inputs.pop("roughness_length", DEFAULT_ROUGHNESS_START if fit_roughness else None)
+    if z0 is None:
+        raise ValueError("fit_profile needs roughness_length [m] as a fixed input (or "
+                         "fit_roughness=True, where it is the starting value)")
+    fixed = {}
+    for k, v in fixed_inputs.items():
+        array = real_array(k, v)
+        if array.ndim > 1 or (array.ndim == 1 and array.size != n):
+            raise ValueError(f"fit_profile: fixed input {k} must be a number or one per record "
+                             f"({n}); got shape {array.shape}")
+        fixed[k] = float(array) if array.ndim == 0 else array
+    z0_array = real_array("roughness_length", z0, "> 0 m")
+    if z0_array.ndim > 1 or (z0_array.ndim == 1 and z0_array.size != n):
+        raise ValueError(f"fit_profile: roughness_length must be a number or one per record "
+                         f"({n}); got shape {z0_array.shape}")
+    abl_class.check_inputs(roughness_length=z0_array, **fixed)  # ranges, named as EkmanABL names them
+    if not fit_roughness:
+        low = heights <= np.reshape(z0_array, (-1, 1))
+        require_at(~low, "heights", "> roughness_length z0", heights)
+
+    turbulence = checked_turbulence(turbulence_intensity, turbulence_noise, n, z0_array,
+                                     fit_roughness)
+    valid_speeds = np.sum(np.isfinite(speeds), axis=1)
+    n_unknowns = 3 if fit_roughness else 2
+    observations = valid_speeds + (0 if directions is None
+                                   else np.maximum(np.sum(np.isfinite(directions), axis=1) - 1, 0))
+    if turbulence is not None:
+        observations = observations + np.isfinite(turbulence[1])
+    short = (valid_speeds < 1) | (observations < n_unknowns)
+    if np.any(short):
+        i = int(np.argmax(short))
+        raise ValueError(
+            f"fit_profile: record {labels[i]} has {valid_speeds[i]} speeds and "
+            f"{observations[i] - valid_speeds[i]} direction changes; the fit needs a speed and "
+            f"{n_unknowns} data in all ({n_unknowns} unknowns)"
+        )
+    return FitData(heights, speeds, directions, single, labels, speed_noise, fixed, z0_array,
+                   turbulence, valid_speeds, n_unknowns, observations)

@@ -7,7 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from floris_ekman_veer.atmosphere.fit_model import LENGTH_SCALE, DefaultDepth, ProfileModel, SubsetModel
+from floris_ekman_veer.atmosphere.fit_model import (
+    LENGTH_SCALE,
+    DefaultDepth,
+    ProfileModel,
+    SubsetModel,
+)
 from floris_ekman_veer.atmosphere.fit_residuals import CONFIDENCE_CHI_SQUARE
 from floris_ekman_veer.atmosphere.least_squares import levenberg_marquardt
 from floris_ekman_veer.atmosphere.misfit import hidden_top

@@ -30,6 +30,9 @@ What :func:`read_instruments` makes of them:
   the records themselves as the median turning from the reference vane in strong-wind records
   (near-neutral) minus the model's own neutral turning between those heights, with the median's
   standard error; or given (``direction_offsets={38: -4.1}``); subtracted from the readings.
+
+The vanes' part (stuck vanes, the offsets) is ``studies/vanes.py``; this module reads the columns
+and the cups and puts the instruments together.
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
-"""The atmosphere of FLORIS's simpler inflow inputs (docs/measurements.md#simpler-site-inputs): a hub
-speed with a power-law shear exponent and/or the veer across the rotor, fitted by the profile fit."""
+"""The atmosphere of FLORIS's simpler inflow inputs (docs/measurements.md#simpler-site-inputs): a
+hub speed with a power-law shear exponent and/or the veer across the rotor, fitted by the profile
+fit."""
 
 from __future__ import annotations
 
