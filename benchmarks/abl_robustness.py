@@ -65,7 +65,7 @@ def solution_exists(speed, height, inputs):
         return False
     g = u_star[valid] * np.hypot(along[valid], b[valid]) / probe.von_karman
     # the states themselves (explicit in u*), the physical domain aside: existence of a root
-    speeds = EkmanABL._solved_at(log_u[valid], g, **inputs).speed(height)
+    speeds = EkmanABL.solved_at(log_u[valid], g, **inputs).speed(height)
     return bool(speeds.min() <= speed <= speeds.max())
 
 

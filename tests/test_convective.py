@@ -15,8 +15,8 @@ from scipy.integrate import quad
 
 from conftest import EXAMPLE_WAKES, make_config
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.atmosphere.ekman import (
-    air_heat_capacity,
+from floris_ekman_veer.atmosphere.constants import air_heat_capacity
+from floris_ekman_veer.atmosphere.similarity import (
     boundary_layer_height_hat,
     gdl_coefficients,
     stability_term,

@@ -14,7 +14,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, ReferenceWindWarning
-from floris_ekman_veer.atmosphere.ekman import PHYSICAL_DOMAIN, physical_domain
+from floris_ekman_veer.atmosphere.physical_domain import PHYSICAL_DOMAIN, physical_domain
 
 # The convective domain: Obukhov length -1e5 ... -1 m (log-uniform), mixed-layer depth 100 m to
 # 5 km or the default (the neutral height), 2-30 m/s at 20-200 m, |latitude| 5-80 deg either
@@ -122,7 +122,7 @@ def test_physical_domain_agrees_with_the_refusals_on_a_grid():
     marks = []
     for i in range(3):
         for j in range(4):
-            abl = EkmanABL._solved_at(
+            abl = EkmanABL.solved_at(
                 np.log(_u_star(g[j], length[i, 0])), g[j], **{**inputs, "obukhov_length": length[i, 0]})
             marks.append(bool(physical_domain(abl.sensible_heat_flux, abl.geostrophic_wind,
                                               abl.cross_isobaric_angle, abl.stability_parameter).inside))
@@ -136,7 +136,7 @@ def _u_star(g, length):
     lo, hi = np.log(1e-3 * g), np.log(0.2 * g)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
-        abl = EkmanABL._solved_at(mid, g, latitude=45.0, roughness_length=0.1, obukhov_length=length)
+        abl = EkmanABL.solved_at(mid, g, latitude=45.0, roughness_length=0.1, obukhov_length=length)
         u_g, v_g = abl.geostrophic_components
         if u_g > 0 and np.hypot(u_g, v_g) < g:
             lo = mid

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from floris_ekman_veer.atmosphere import ekman
+from floris_ekman_veer.atmosphere import similarity
 from floris_ekman_veer.atmosphere.ekman import EkmanABL, friction_velocity_fixed_point
 
 KAPPA, C_G, GAMMA, C_TN, C_CN, C_NS = 0.41, 1.43, 0.83, 0.5, 1.6, 0.78
@@ -317,21 +317,21 @@ def test_h_hat_hand_arithmetic():
     # mu = 10, mu_N = 61: 1/h^2 = 1/0.5^2 + 61/1.6^2 + 10/0.78^2
     #                           = 4 + 23.828125 + 16.43655489809336 = 44.26467989809336
     expected = 44.26467989809336 ** -0.5  # = 0.150304276...
-    assert ekman.boundary_layer_height_hat(10.0, 61.0, C_TN, C_CN, C_NS) == pytest.approx(
+    assert similarity.boundary_layer_height_hat(10.0, 61.0, C_TN, C_CN, C_NS) == pytest.approx(
         expected, rel=1e-14)
     a = EkmanABL(**{**PAPER, "stability_parameter": 10.0, "brunt_vaisala_frequency": 6.1e-3})
     assert float(a.h_hat) == pytest.approx(expected, rel=1e-14)
     # neutral, no stratification: h_hat = C_TN = 0.5
-    assert ekman.boundary_layer_height_hat(0.0, 0.0, C_TN, C_CN, C_NS) == 0.5
+    assert similarity.boundary_layer_height_hat(0.0, 0.0, C_TN, C_CN, C_NS) == 0.5
 
 
 def test_coriolis_from_latitude():
     # 2 * 7.27e-5 * sin(45 deg) = 1.4540e-4 * 0.70710678 = 1.02813e-4
-    assert ekman.coriolis_parameter_from_latitude(45.0) == pytest.approx(1.0281332598452e-4,
+    assert similarity.coriolis_parameter_from_latitude(45.0) == pytest.approx(1.0281332598452e-4,
                                                                          rel=1e-12)
     # sin(30 deg) = 1/2: f = 7.27e-5
-    assert ekman.coriolis_parameter_from_latitude(30.0) == pytest.approx(7.27e-5, rel=1e-14)
-    assert ekman.coriolis_parameter_from_latitude(-30.0) == pytest.approx(-7.27e-5, rel=1e-14)
+    assert similarity.coriolis_parameter_from_latitude(30.0) == pytest.approx(7.27e-5, rel=1e-14)
+    assert similarity.coriolis_parameter_from_latitude(-30.0) == pytest.approx(-7.27e-5, rel=1e-14)
     a = EkmanABL(geostrophic_wind=10.0, latitude=30.0, roughness_length=0.1)
     assert float(a.coriolis_parameter) == pytest.approx(7.27e-5, rel=1e-14)
 

@@ -253,7 +253,7 @@ def test_any_model_profile_is_recovered(speed, inverse_length, latitude, log_z0,
 
 
 def test_states_set_at_their_known_friction_velocity_are_the_solved_ones():
-    """The fit's trial states are set at their u* (EkmanABL._solved_at, no re-solve,
+    """The fit's trial states are set at their u* (EkmanABL.solved_at, no re-solve,
     docs/measurements.md#fit-time): the same ABL as the solve from their G, stable, neutral and
     convective, both hemispheres, to the solver's tolerance."""
     lengths = np.array([-40.0, -300.0, np.inf, 400.0, 120.0, 60.0])
@@ -262,7 +262,7 @@ def test_states_set_at_their_known_friction_velocity_are_the_solved_ones():
                                           coriolis_parameter=f, roughness_length=0.1,
                                           mixed_layer_height=900.0)
     mu = np.asarray(solved.stability_parameter)
-    at = EkmanABL._solved_at(np.log(solved.friction_velocity), solved.geostrophic_wind,
+    at = EkmanABL.solved_at(np.log(solved.friction_velocity), solved.geostrophic_wind,
                              stability_parameter=mu, coriolis_parameter=f, roughness_length=0.1,
                              mixed_layer_height=900.0)
     again = EkmanABL(geostrophic_wind=solved.geostrophic_wind, stability_parameter=mu,

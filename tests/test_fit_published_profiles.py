@@ -295,7 +295,7 @@ def test_a_top_below_the_lowest_measurement_is_never_shown():
     2.5 times speed_noise over 150 m): a stable top at 20 m, below every measurement, is not
     shown by that maximum (refused as no top); one at 90 m, with measurements below it, is
     (docs/measurements.md#a-top-the-data-show)."""
-    from floris_ekman_veer.atmosphere.fit import _hidden_top
+    from floris_ekman_veer.atmosphere.misfit import hidden_top as _hidden_top
 
     heights = np.array([[30.0, 70.0, 110.0, 150.0]] * 2)
     speeds = np.array([[1.83, 2.01, 2.01, 1.76]] * 2)

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, fit_site
-from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
+from floris_ekman_veer.studies.shear_and_veer import atmosphere_from_shear_and_veer
 
 SITE = dict(latitude=52.0, roughness_length=0.05)
 Z = np.arange(30.0, 151.0, 20.0)
@@ -275,7 +275,7 @@ def _check_site(records):
     leaves out with a reason, and every fitted state is one the atmosphere accepts as input."""
     import warnings
 
-    from floris_ekman_veer.atmosphere.ekman import (MIN_BOUNDARY_LAYER_HEIGHT,
+    from floris_ekman_veer.atmosphere.input_ranges import (MIN_BOUNDARY_LAYER_HEIGHT,
                                                    SENSIBLE_HEAT_FLUX_RANGE)
     from floris_ekman_veer.studies.site import EXCLUSION_KINDS
 
@@ -300,7 +300,7 @@ def _check_site(records):
     # the atmosphere accepts each fitted state as input: as its heat flux, at its wind
     again = EkmanABL(geostrophic_wind=abl.geostrophic_wind, sensible_heat_flux=heat_flux,
                      latitude=53.3, roughness_length=0.05,
-                     **site.profile_fit._fitted_depth())
+                     **site.profile_fit.fitted_depth())
     np.testing.assert_allclose(again.friction_velocity, abl.friction_velocity, rtol=1e-6)
     return site
 

@@ -102,7 +102,7 @@ def test_physics_does_not_import_floris():
 # warnings, version, example inputs); the top is the package itself and the registry, which wire
 # the plugin and the studies into FLORIS; the old paths are aliases that nothing imports.
 LAYERS = ("base", "physics", "plugin", "studies", "top", "old paths")
-BASE = {f"{PACKAGE}._validation", f"{PACKAGE}._version", f"{PACKAGE}.warnings",
+BASE = {f"{PACKAGE}._validation", f"{PACKAGE}._version", f"{PACKAGE}.warnings", f"{PACKAGE}.warning_classes",
         f"{PACKAGE}.example_inputs", f"{PACKAGE}._old_paths"}
 
 

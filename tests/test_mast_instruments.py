@@ -12,7 +12,7 @@ import pytest
 import floris_ekman_veer
 from floris_ekman_veer import fit_site
 from floris_ekman_veer.studies import mast
-from floris_ekman_veer.studies.site import _neutral_turning
+from floris_ekman_veer.studies.site_records import neutral_turning as _neutral_turning
 from tests.data.generate_mast_instruments import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS,
                                                   VANE_OFFSETS, mast_year, shadow_deficit)
 

@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.atmosphere.ekman import (
+from floris_ekman_veer.atmosphere.constants import GRAVITY, air_heat_capacity
+from floris_ekman_veer.atmosphere.physical_domain import (
     PHYSICAL_DOMAIN,
-    GRAVITY,
-    air_heat_capacity,
     physical_domain,
 )
 

@@ -30,6 +30,9 @@ What :func:`read_instruments` makes of them:
   the records themselves as the median turning from the reference vane in strong-wind records
   (near-neutral) minus the model's own neutral turning between those heights, with the median's
   standard error; or given (``direction_offsets={38: -4.1}``); subtracted from the readings.
+
+The vanes' part (stuck vanes, the offsets) is ``studies/vanes.py``; this module reads the columns
+and the cups and puts the instruments together.
 """
 
 from __future__ import annotations
@@ -39,6 +42,17 @@ import re
 import attrs
 import numpy as np
 import pandas as pd
+
+from floris_ekman_veer.studies.vanes import (
+    direction_near,
+    median_and_error,
+    offsets_given,
+    reference_index,
+    strong_wind_rows,
+    unstick,
+    with_offsets_from,
+    wrapped_angle,
+)
 
 #: Column names: the height in metres, a cup's boom, a cup's standard deviation.
 _NUMBER = r"(\d+(?:\.\d+)?)"
@@ -68,14 +82,6 @@ MAX_SHADOW_DEFICIT = 0.4
 #: Median ratio of a pair beyond 1 +- this: the pair disagrees (two class-1 calibrations, 1 %
 #: each, at two standard deviations of their ratio).
 PAIR_TOLERANCE = 0.03
-#: A vane repeating its reading (within its 0.1 deg resolution) this many records in a row
-#: while another vane turns by more than :data:`STUCK_TURN` is stuck.
-STUCK_RECORDS = 4
-STUCK_TURN = 2.0
-#: Records from which vane offsets are estimated: the speed at the reference height from this
-#: [m/s] (near-neutral: mechanical mixing), at least :data:`OFFSET_MIN_RECORDS` of them.
-OFFSET_MIN_SPEED = 12.0
-OFFSET_MIN_RECORDS = 20
 #: What is named per value removed.
 FLAG_KINDS = ("infinite reading", "cups disagree", "stuck vane")
 
@@ -193,11 +199,6 @@ def _numbers(records, columns):
     return frame.to_numpy(dtype=float)
 
 
-def _angle(a):
-    """Angle wrapped to [-180, 180) deg."""
-    return (np.asarray(a, float) + 180.0) % 360.0 - 180.0
-
-
 class _Flags:
     def __init__(self):
         self.rows = []
@@ -240,8 +241,8 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     if vane_heights.size:
         vane_columns = [columns.vanes[h] for h in vane_heights]
         directions = _remove_bad(_numbers(records, vane_columns), vane_columns, flags)
-        directions = _unstick(directions, vane_columns, flags, labels)
-    offsets = _offsets_given(direction_offsets, vane_heights)
+        directions = unstick(directions, vane_columns, flags, labels)
+    offsets = offsets_given(direction_offsets, vane_heights)
     if directions is not None:
         directions = directions - offsets["offset_deg"].to_numpy()[None, :]  # given ones
     cup_heights = columns.cup_heights
@@ -268,78 +269,6 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     return attrs.evolve(instruments, flags=flags.table())
 
 
-def strong_wind_rows(instruments: Instruments, reference_height: float) -> np.ndarray:
-    """The records whose speed at the cup height nearest the reference height is at least
-    :data:`OFFSET_MIN_SPEED` (the vane offsets' records, near-neutral by their wind)."""
-    speed = instruments.speeds[:, reference_index(instruments.cup_heights, reference_height)]
-    return np.flatnonzero(np.isfinite(speed) & (speed >= OFFSET_MIN_SPEED))
-
-
-def with_offsets_from(instruments: Instruments, rows, reference_height: float,
-                      neutral_turning) -> Instruments:
-    """``instruments`` with its vanes' offsets estimated from the records ``rows`` (module
-    docstring) in place of those it has."""
-    applied = instruments.offsets["offset_deg"].to_numpy()
-    readings = instruments.directions + applied[None, :]
-    offsets = _estimate_offsets(readings, instruments.vane_heights, instruments.speeds,
-                                instruments.cup_heights, reference_height, neutral_turning,
-                                np.asarray(rows, dtype=int))
-    return attrs.evolve(instruments, offsets=offsets,
-                        directions=readings - offsets["offset_deg"].to_numpy()[None, :])
-
-
-def _offsets_given(direction_offsets, vane_heights):
-    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
-                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
-    if direction_offsets is None or isinstance(direction_offsets, str):
-        if isinstance(direction_offsets, str) and direction_offsets != "estimate":
-            raise ValueError(f"fit_site: direction_offsets must be 'estimate', None or "
-                             f"{{vane height: offset deg}}; got {direction_offsets!r}")
-        return table
-    if not isinstance(direction_offsets, dict):
-        raise ValueError(f"fit_site: direction_offsets must be 'estimate', None or "
-                         f"{{vane height: offset deg}}; got {direction_offsets!r}")
-    for height, offset in direction_offsets.items():
-        match = np.flatnonzero(np.isclose(vane_heights, float(height)))
-        if match.size != 1:
-            raise ValueError(f"fit_site: direction_offsets names a vane at {height!r} m; the "
-                             f"records' vanes are at {vane_heights.tolist()} m")
-        if isinstance(offset, bool) or not np.isscalar(offset) or not np.isfinite(offset):
-            raise ValueError(f"fit_site: direction_offsets[{height!r}] must be a number of "
-                             f"degrees; got {offset!r}")
-        table.iloc[match[0], :] = [float(offset), np.nan, 0, "given"]
-    return table
-
-
-def _unstick(directions, vane_columns, flags, labels):
-    """Readings of vanes that repeat for STUCK_RECORDS records or more while another vane turns
-    by more than STUCK_TURN (icing): removed and named."""
-    n, m = directions.shape
-    if n < STUCK_RECORDS:
-        return directions
-    same = np.zeros((n, m), bool)
-    same[1:] = np.abs(_angle(directions[1:] - directions[:-1])) < 0.05
-    out = directions.copy()
-    for j in range(m):
-        # Runs of equal readings: starts where a reading differs from the one before.
-        start = np.flatnonzero(~same[:, j])
-        stop = np.append(start[1:], n)
-        for a, b in zip(start[(stop - start) >= STUCK_RECORDS], stop[(stop - start) >= STUCK_RECORDS]):
-            others = [k for k in range(m) if k != j]
-            turns = [np.nanmax(np.abs(_angle(directions[a:b, k] - directions[a, k])), initial=0.0)
-                     for k in others if np.isfinite(directions[a, k])]
-            if others and not (turns and max(turns) > STUCK_TURN):
-                continue
-            if not np.isfinite(directions[a, j]):
-                continue
-            rows = np.arange(a, b)
-            out[rows, j] = np.nan
-            flags.add(rows, vane_columns[j], "stuck vane",
-                      f"the vane reads {directions[a, j]:g} deg in {b - a} records in a row "
-                      f"({labels[a]} to {labels[b - 1]}) while the other vanes turn (icing): removed")
-    return out
-
-
 def _combine_cups(records, columns, directions, vane_heights, booms, half_width, flags):
     """Per cup height the speed and standard deviation from its cups (module docstring), and
     the pairs' agreement."""
@@ -359,10 +288,10 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
         if len(group) == 1:
             speeds[:, i], variance[:, i] = values[:, 0], stds[:, 0] ** 2
             continue
-        wind = _direction_near(directions, vane_heights, height, n)
+        wind = direction_near(directions, vane_heights, height, n)
         orientation = np.array([booms[b] for b, _, _ in group])
         # Each cup's angle from its wake's centre: the wind from its boom's orientation + 180.
-        offset = _angle(wind[:, None] - orientation[None, :] - 180.0)
+        offset = wrapped_angle(wind[:, None] - orientation[None, :] - 180.0)
         shadowed = np.abs(offset) < half_width
         finite = np.isfinite(values)
         # A cup in the wake is never used (with its partner missing, the height is missing);
@@ -399,7 +328,7 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
         with np.errstate(invalid="ignore", divide="ignore"):
             ratio = ratio[np.all(np.isfinite(ratio), axis=1)]
         for k in range(1, len(group)):
-            median, error = _median_and_error(ratio[:, k - 1]) if len(ratio) else (np.nan, np.nan)
+            median, error = median_and_error(ratio[:, k - 1]) if len(ratio) else (np.nan, np.nan)
             pairs.append({"height": height, "cups": f"{names[k]} / {names[0]}",
                           "median_ratio": median, "uncertainty": error, "records": len(ratio),
                           "disagree": bool(abs(median - 1.0) > PAIR_TOLERANCE),
@@ -441,61 +370,6 @@ def _row_mean(values, use):
     count = np.sum(use, axis=1)
     total = np.sum(np.where(use, values, 0.0), axis=1)
     return np.where(count > 0, total / np.maximum(count, 1), np.nan)
-
-
-def _direction_near(directions, vane_heights, height, n):
-    """Per record the direction of the vane nearest ``height`` that reads (NaN: none)."""
-    if directions is None:
-        return np.full(n, np.nan)
-    order = np.argsort(np.abs(vane_heights - height), kind="stable")
-    wind = np.full(directions.shape[0], np.nan)
-    for k in order[::-1]:
-        wind = np.where(np.isfinite(directions[:, k]), directions[:, k], wind)
-    return wind
-
-
-def _median_and_error(values):
-    """The median and its standard error (1.2533 sigma / sqrt(n), sigma from the MAD)."""
-    values = np.asarray(values, float)
-    values = values[np.isfinite(values)]
-    if values.size == 0:
-        return np.nan, np.nan
-    median = float(np.median(values))
-    sigma = 1.4826 * float(np.median(np.abs(values - median)))
-    return median, 1.2533 * sigma / np.sqrt(values.size)
-
-
-def reference_index(heights, reference_height):
-    """Index of the height nearest the reference height (the higher one on a tie)."""
-    heights = np.asarray(heights, float)
-    distance = np.abs(heights - reference_height)
-    return int(np.flatnonzero(distance == distance.min())[-1])
-
-
-def _estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_height,
-                      neutral_turning, rows):
-    """Vane offsets relative to the vane nearest the reference height from the records
-    ``rows`` (module docstring)."""
-    ref = reference_index(vane_heights, reference_height)
-    cup = reference_index(cup_heights, reference_height)
-    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
-                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
-    strong = np.zeros(directions.shape[0], dtype=bool)
-    strong[rows] = True
-    strong &= np.isfinite(speeds[:, cup]) & np.isfinite(directions[:, ref])
-    for k, height in enumerate(vane_heights):
-        if k == ref:
-            continue
-        rows = np.flatnonzero(strong & np.isfinite(directions[:, k]))
-        if rows.size < OFFSET_MIN_RECORDS:
-            table.loc[height, ["records", "source"]] = [rows.size, "not estimated"]
-            continue
-        model = neutral_turning(speeds[rows, cup], cup_heights[cup],
-                                np.array([height, vane_heights[ref]]))
-        turning = _angle(directions[rows, k] - directions[rows, ref])
-        median, error = _median_and_error(_angle(turning - (model[:, 0] - model[:, 1])))
-        table.loc[height, :] = [median, error, rows.size, "estimated"]
-    return table
 
 
 def measured_turbulence(instruments: Instruments, reference_height: float):

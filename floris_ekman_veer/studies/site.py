@@ -20,18 +20,23 @@ import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
-import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit import FIT_OPTIONS
-from floris_ekman_veer.studies.mast import (OFFSET_MIN_RECORDS, SHADOW_HALF_WIDTH, mast_columns,
-                                            measured_turbulence, read_instruments,
-                                            strong_wind_rows, with_offsets_from)
+from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
+                                            read_instruments)
+from floris_ekman_veer.studies.site_records import (
+    EXCLUSION_KINDS,
+    fit_data,
+    fit_heights,
+    more_excluded_text,
+    neutral_turning,
+    offsets_from_neutral_fits,
+    reasons_text,
+    screen_records,
+)
 from floris_ekman_veer.studies.energy import energy_by_period, record_energy
 from floris_ekman_veer.plugin.inflow import set_atmosphere
 
-#: Fractions of the rotor radius at which :func:`atmosphere_from_shear_and_veer` samples the
-#: power law: bottom tip, half way, hub, half way, top tip.
-ROTOR_SAMPLES = (-1.0, -0.5, 0.0, 0.5, 1.0)
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")
 #: The reference height may lie at most this many times above the highest measurement: the
@@ -340,20 +345,20 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                          f"times the highest measurement ({top:g} m: the fitted profile is not "
                          f"extrapolated further); got {reference_height!r} m")
     instruments = read_instruments(
-        records, columns, float(reference_height), _neutral_turning(fit_options_and_inputs),
+        records, columns, float(reference_height), neutral_turning(fit_options_and_inputs),
         booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width,
         labels=labels)
     if (isinstance(direction_offsets, str)
             and (instruments.offsets["source"] == "estimated").any()):
-        instruments = _offsets_from_neutral_fits(instruments, float(reference_height),
+        instruments = offsets_from_neutral_fits(instruments, float(reference_height),
                                                  fit_options_and_inputs)
-    heights, speeds, directions, speed_columns = _fit_heights(instruments, columns)
-    excluded = _screen(speed_columns, labels, heights, speeds, directions,
+    heights, speeds, directions, speed_columns = fit_heights(instruments, columns)
+    excluded = screen_records(speed_columns, labels, heights, speeds, directions,
                        3 if fit_options_and_inputs.get("fit_roughness") else 2)
     if on_misfit == "raise" and excluded:
         row, (kind, text) = next(iter(sorted(excluded.items())))
         raise ValueError(f"fit_site: record {labels[row]} cannot be fitted: {text}"
-                         + _more(excluded, labels, row) + ". Give on_misfit='drop' to leave out "
+                         + more_excluded_text(excluded, labels, row) + ". Give on_misfit='drop' to leave out "
                          "such records (SiteAtmosphere.summary() tells what was left out and why)")
     fit_inputs = dict(fit_options_and_inputs)
     # (a measured turbulence intensity is a pair (height, value), each one number or a column)
@@ -364,13 +369,13 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
     candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
     if candidates.size == 0:
-        raise ValueError(f"fit_site: no record can be fitted ({_reasons_text(excluded)})")
+        raise ValueError(f"fit_site: no record can be fitted ({reasons_text(excluded)})")
     inputs = {**fit_inputs, **{k: np.asarray(v)[candidates] for k, v in per_record.items()}}
     if turbulence is not None:
         inputs["turbulence_intensity"] = tuple(
             np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
     abl = EkmanABL.fit_profile(
-        **_fit_data(instruments, candidates),
+        **fit_data(instruments, candidates),
         on_misfit="raise" if on_misfit == "raise" else "flag",
         labels=[labels[i] for i in candidates], **inputs,
     )
@@ -396,7 +401,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             fit = abl.profile_fit
     if kept.size == 0:
         raise ValueError(f"fit_site: no record fits an atmosphere of the model "
-                         f"({_reasons_text(excluded)})")
+                         f"({reasons_text(excluded)})")
     rows = sorted(excluded)
     table = pd.DataFrame({"time": [labels[i] for i in rows],
                           "kind": [excluded[i][0] for i in rows],
@@ -420,256 +425,3 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         cup_pairs=instruments.cup_pairs,
         flags=flags,
     )
-
-
-#: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
-EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "infinite reading",
-                   "zero reading", "missing data",
-                   "calm", "falling speeds", "convective", "backing", "no top", "misfit",
-                   "physical bound", "two states")
-
-
-def _fit_heights(instruments, columns):
-    """(heights, speeds, directions, speed column names per height) as the fit takes them:
-    vanes at heights other than the cups' give their directions at their own heights (the
-    speeds there missing, and the directions missing at the cups' heights)."""
-    cups, vanes = instruments.cup_heights, instruments.vane_heights
-    names = {h: ", ".join(c for _, c, _ in columns.cups[h]) for h in cups}
-    directions = instruments.directions
-    if directions is None or (cups.size == vanes.size and np.allclose(cups, vanes)):
-        return cups, instruments.speeds, directions, [names[h] for h in cups]
-    heights = np.union1d(cups, vanes)
-    n = instruments.speeds.shape[0]
-    speeds = np.full((n, heights.size), np.nan)
-    speeds[:, np.searchsorted(heights, cups)] = instruments.speeds
-    at_heights = np.full((n, heights.size), np.nan)
-    at_heights[:, np.searchsorted(heights, vanes)] = directions
-    return heights, speeds, at_heights, [names.get(h, f"(no cup at {h:g} m)") for h in heights]
-
-
-def _offsets_from_neutral_fits(instruments, reference_height, fit_options_and_inputs):
-    """The vane offsets again from the strong-wind records the fit (either sign, the offsets of
-    the first estimate applied) finds neutral: a strong wind of a stable night turns with height
-    more than a neutral one, and would move the median (docs/measurements.md#vane-offsets)."""
-    rows = strong_wind_rows(instruments, reference_height)
-    speeds = instruments.speeds[rows]
-    rows = rows[~np.any(speeds <= 0, axis=1) & (np.sum(np.isfinite(speeds), axis=1) >= 2)]
-    if rows.size < OFFSET_MIN_RECORDS:
-        return instruments
-    inputs = {k: (np.asarray(v)[rows] if k not in FIT_OPTIONS and np.ndim(v) == 1 else v)
-              for k, v in fit_options_and_inputs.items() if k not in ("stability",)}
-    if "turbulence_intensity" in inputs:
-        inputs["turbulence_intensity"] = tuple(
-            np.asarray(v, float)[rows] if np.ndim(v) == 1 else v
-            for v in inputs["turbulence_intensity"])
-    elif instruments.speed_std is not None:
-        height, intensity = measured_turbulence(instruments, reference_height)
-        inputs["turbulence_intensity"] = (height, intensity[rows])
-    # (the records are fitted again, and warned about, by fit_site's own fit)
-    with package_warnings.discarding():
-        fit = EkmanABL.fit_profile(**_fit_data(instruments, rows), on_misfit="flag",
-                                   stability="either", **inputs).profile_fit
-    neutral = rows[np.asarray(fit.fits) & (np.asarray(fit.stability_class) == "neutral")]
-    if neutral.size < OFFSET_MIN_RECORDS:
-        return instruments
-    return with_offsets_from(instruments, neutral, reference_height,
-                             _neutral_turning(fit_options_and_inputs))
-
-
-def _fit_data(instruments, rows):
-    """``fit_profile``'s data of the records ``rows``: the cups' heights and speeds, and the
-    vanes' directions with their own heights (``direction_heights``) where those differ."""
-    cups, vanes = instruments.cup_heights, instruments.vane_heights
-    data = {"heights": cups, "speeds": instruments.speeds[rows], "directions": None}
-    if instruments.directions is not None:
-        data["directions"] = instruments.directions[rows]
-        if not (cups.size == vanes.size and np.allclose(cups, vanes)):
-            data["direction_heights"] = vanes
-    return data
-
-
-def _neutral_turning(fit_options_and_inputs):
-    """The model's neutral turning between heights (for the vane offsets): the direction at
-    ``heights`` minus that at ``height`` [deg, meteorological] per speed at ``height``."""
-    fixed = {k: (float(np.median(v)) if np.ndim(v) else v)
-             for k, v in fit_options_and_inputs.items() if k not in FIT_OPTIONS}
-
-    def turning(speed, height, heights):
-        abl = EkmanABL.from_reference_wind(speed, height, obukhov_length=np.inf, **fixed)
-        angle = np.asarray(abl.wind_angle(np.asarray(heights, float)[:, None]), float)
-        return -(angle - np.asarray(abl.wind_angle(height), float)[None, :]).T
-
-    return turning
-
-
-def _screen(speed_columns, labels, heights, speeds, directions, unknowns):
-    """{row: (kind, text)} of the records no fit should see: repeated time stamps, zero or
-    negative speed readings, too few data."""
-    excluded = {}
-    stamps = pd.Series(labels)
-    repeated = stamps.duplicated(keep=False)
-    if repeated.any():
-        data = pd.DataFrame(speeds if directions is None else np.hstack([speeds, directions]))
-        for stamp, group in stamps[repeated].groupby(stamps[repeated], sort=False):
-            same = group.index.to_numpy()
-            if len(data.iloc[same].drop_duplicates()) == 1:  # (NaN equals NaN here)
-                for k in same[1:]:
-                    excluded[k] = ("repeated record", f"a repeat of row {same[0]} (same time "
-                                   "stamp and data): counted once")
-            else:
-                for k in same:
-                    excluded[k] = ("repeated time stamp",
-                                   f"time stamp {stamp} is given to {len(same)} records (rows "
-                                   f"{', '.join(str(j) for j in same)}) with different data: "
-                                   "which one is the record of that time is unknown")
-    # An infinite reading (a logger's overflow) is no measurement: named by its time stamp.
-    infinite = np.isinf(speeds) | (np.isinf(directions) if directions is not None else False)
-    for i in np.flatnonzero(np.atleast_2d(infinite).any(axis=1)):
-        if i not in excluded:
-            excluded[i] = ("infinite reading", "an infinite speed or direction reading: a "
-                           "logger or instrument fault; give NaN (missing) where a reading is "
-                           "not a measurement")
-    bad = ~(np.isnan(speeds) | (speeds > 0))
-    for i in np.flatnonzero(bad.any(axis=1)):
-        if i in excluded:
-            continue
-        columns = [speed_columns[j] for j in np.flatnonzero(bad[i])]
-        values = sorted({f"{v:g}" for v in speeds[i][bad[i]]})
-        what = "zero" if values == ["0"] else "zero or negative" if "0" in values else "negative"
-        excluded[i] = ("zero reading",
-                       f"{what} speed reading ({', '.join(values)} m/s) in "
-                       f"{', '.join(columns)}: a calm or a stalled or failed anemometer; give NaN "
-                       "(missing) where a reading is not a measurement")
-    valid = np.sum(np.isfinite(speeds), axis=1)
-    changes = 0 if directions is None else np.maximum(
-        np.sum(np.isfinite(directions), axis=1) - 1, 0)
-    for i in np.flatnonzero((valid < 1) | (valid + changes < unknowns)):
-        if i not in excluded:
-            excluded[i] = ("missing data",
-                           f"{valid[i]} speed(s) and {np.broadcast_to(changes, valid.shape)[i]} "
-                           f"direction change(s): the fit needs a speed and {unknowns} data in all")
-    return excluded
-
-
-def _more(excluded, labels, first):
-    others = [k for k in sorted(excluded) if k != first]
-    if not others:
-        return ""
-    shown = ", ".join(labels[k] for k in others[:5])
-    return (f"; {len(others)} more record(s) cannot be fitted either ({_reasons_text(excluded)}"
-            f": {shown}{', ...' if len(others) > 5 else ''})")
-
-
-def _reasons_text(excluded):
-    counts = pd.Series([kind for kind, _ in excluded.values()]).value_counts()
-    return ", ".join(f"{n} {kind}" for kind, n in counts.items())
-
-
-def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_exponent=None,
-                                   veer=None, *, speed_tolerance=0.01, veer_tolerance=0.5,
-                                   **fit_options_and_inputs) -> EkmanABL:
-    """The atmosphere of FLORIS's simpler inflow inputs (docs/measurements.md#simpler-site-inputs):
-    a hub speed [m/s] with a power-law ``shear_exponent`` and/or the ``veer`` [deg, positive
-    veering] from the bottom to the top of the rotor.
-
-    The power law U_hub (z/z_hub)^shear is sampled at the rotor's bottom tip, half radius, hub,
-    and up, and the veer taken as the direction change between the tips; ``EkmanABL.fit_profile``
-    fits them with ``speed_noise = speed_tolerance * hub_speed`` and ``direction_noise =
-    veer_tolerance``. With one of shear and veer the atmosphere follows exactly (two unknowns,
-    u* and L, two data: the hub speed and that number) and its profile gives the other; with
-    both, the model has one stability to meet two numbers (at a given z0 its shear and veer go
-    together) and the fit is refused when no stability meets both within the tolerances
-    (``fit_roughness=True`` lets z0 meet the shear). Vectorised: the inputs broadcast over
-    conditions of shape (n,).
-    """
-    from floris_ekman_veer._validation import real_array, require_at
-
-    if shear_exponent is None and veer is None:
-        raise ValueError("atmosphere_from_shear_and_veer needs shear_exponent, veer or both")
-    for name, value, ok, valid in (
-            ("hub_speed", hub_speed, lambda v: v > 0, "> 0 m/s"),
-            ("hub_height", hub_height, lambda v: v > 0, "> 0 m"),
-            ("rotor_diameter", rotor_diameter, lambda v: v > 0, "> 0 m"),
-            ("shear_exponent", shear_exponent, lambda v: np.isfinite(v), "finite"),
-            ("veer", veer, lambda v: np.isfinite(v), "finite [deg]"),
-            ("speed_tolerance", speed_tolerance, lambda v: (v > 0) & (v < 1),
-             "in (0, 1): a fraction of the hub speed"),
-            ("veer_tolerance", veer_tolerance, lambda v: v > 0, "> 0 deg")):
-        if value is None:
-            continue
-        array = real_array(f"atmosphere_from_shear_and_veer: {name}", value, valid)
-        require_at(np.isfinite(array) & ok(array), f"atmosphere_from_shear_and_veer: {name}",
-                   valid, array)
-    for name, tolerance in (("speed_tolerance", speed_tolerance),
-                            ("veer_tolerance", veer_tolerance)):
-        if np.ndim(tolerance) != 0:
-            raise ValueError(f"atmosphere_from_shear_and_veer: {name} must be one number; got "
-                             f"an array of shape {np.shape(tolerance)}")
-    single = all(np.ndim(v) == 0 for v in (hub_speed, hub_height, rotor_diameter,
-                                           shear_exponent, veer))
-    hub_speed, hub_height, rotor_diameter = (
-        np.atleast_1d(np.asarray(v, dtype=float)) for v in (hub_speed, hub_height, rotor_diameter)
-    )
-    given = {"hub_speed": hub_speed, "hub_height": hub_height, "rotor_diameter": rotor_diameter,
-             "shear_exponent": shear_exponent, "veer": veer}
-    try:
-        n = np.broadcast_shapes(*(np.shape(v) for v in given.values() if v is not None))
-    except ValueError:
-        shapes = ", ".join(f"{k} {np.shape(v)}" for k, v in given.items() if v is not None)
-        raise ValueError("atmosphere_from_shear_and_veer: the inputs must be numbers or 1-D "
-                         f"arrays of one length (one per condition); got shapes {shapes}") from None
-    if len(n) != 1:
-        raise ValueError("atmosphere_from_shear_and_veer: inputs must be numbers or 1-D arrays")
-    radius = 0.5 * np.broadcast_to(rotor_diameter, n)[:, None]
-    hub = np.broadcast_to(hub_height, n)[:, None]
-    if np.any(~(radius < hub)):
-        raise ValueError("atmosphere_from_shear_and_veer: the rotor's bottom tip must be above "
-                         f"the ground (rotor_diameter / 2 < hub_height); got rotor_diameter "
-                         f"{rotor_diameter}, hub_height {hub_height}")
-    heights = hub + radius * np.asarray(ROTOR_SAMPLES)[None, :]
-    centre = ROTOR_SAMPLES.index(0.0)
-    speed = np.broadcast_to(hub_speed, n)[:, None]
-    if shear_exponent is None:
-        speeds = np.where(np.arange(heights.shape[1]) == centre, speed, np.nan)
-    else:
-        speeds = speed * (heights / hub) ** np.broadcast_to(shear_exponent, n)[:, None]
-    directions = None
-    if veer is not None:
-        # Meteorological direction grows with veering; only the tips carry the veer.
-        turn = np.broadcast_to(veer, n)[:, None] * (heights - hub) / (2.0 * radius)
-        directions = np.where(np.isin(np.arange(heights.shape[1]), (0, heights.shape[1] - 1)),
-                              270.0 + turn, np.nan)
-    if single:
-        heights, speeds = heights[0], speeds[0]
-        directions = None if directions is None else directions[0]
-    # The veer is met within veer_tolerance as stated: no model error of the directions is
-    # added to it (docs/measurements.md#direction-model-error).
-    fit_options_and_inputs.setdefault("direction_model_error", 0.0)
-    # The fit flags what it refuses; the refusal is said here, of this function's inputs.
-    on_misfit = fit_options_and_inputs.pop("on_misfit", "raise")
-    abl = EkmanABL.fit_profile(
-        heights, speeds, directions,
-        speed_noise=float(speed_tolerance * np.min(hub_speed)), direction_noise=veer_tolerance,
-        on_misfit="flag" if on_misfit == "raise" else on_misfit, **fit_options_and_inputs,
-    )
-    failing = np.flatnonzero(~np.atleast_1d(abl.profile_fit.fits))
-    if on_misfit != "raise" or failing.size == 0:
-        return abl
-    k = int(failing[0])
-    value = (lambda v: repr(float(np.ravel(v)[0]))) if single else (
-        lambda v: f"{float(np.broadcast_to(v, n)[k]):g}")
-    given = " and ".join(f"{name}={value(v)}{unit}" for name, v, unit in (
-        ("shear_exponent", shear_exponent, ""),
-        ("veer", veer, " [deg, from the bottom to the top of the rotor]")) if v is not None)
-    where = (f"{given} at hub_speed {hub_speed.tolist()} m/s" if single else
-             f"condition {k} ({given} at hub_speed {value(hub_speed)} m/s)")
-    more = ""
-    if failing.size > 1:
-        shown = ", ".join(str(j) for j in failing[1:6])
-        more = (f"; {failing.size - 1} more condition(s) fail ({shown}"
-                f"{', ...' if failing.size > 6 else ''})")
-    raise ValueError(
-        f"atmosphere_from_shear_and_veer: {where} "
-        f"fits no atmosphere of the model (within speed_tolerance={speed_tolerance:g}, "
-        f"veer_tolerance={veer_tolerance:g} deg): {abl.profile_fit.reason(k)[1]}{more}. Give "
-        "on_misfit='flag' to keep the fits and read profile_fit.fits")
