@@ -106,7 +106,8 @@ def _dispatching_optimize(original):
 
 def _row(owner: type, name: str, make_wrapper, why: str) -> Patch:
     return Patch(owner=f"{owner.__module__}.{owner.__qualname__}.{name}", why=why,
-                 checked_against="4.7", install=functools.partial(_patch, owner, name, make_wrapper))
+                 checked_against="4.7",
+                 install=functools.partial(_patch, owner, name, make_wrapper))
 
 
 _RECORD = ("keeps the options of the user's constructor call, with which {name}.optimize() "

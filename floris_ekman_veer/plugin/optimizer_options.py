@@ -25,10 +25,10 @@ SCIPY_METHODS = (
     "slsqp", "trust-constr", "dogleg", "trust-ncg", "trust-exact", "trust-krylov",
 )
 
-#: The yaw bounds [deg] :func:`~floris_ekman_veer.optimize_yaw` searches where the caller gives none: both signs.
-#: FLORIS's optimisers default to 0..25 deg, one sign only; with veer the two signs differ and
-#: the gain can lie on the negative side (docs/yaw_steering.md#both-signs-by-default). A bound the
-#: caller gives is kept as given.
+#: The yaw bounds [deg] :func:`~floris_ekman_veer.optimize_yaw` searches where the caller gives
+#: none: both signs. FLORIS's optimisers default to 0..25 deg, one sign only; with veer the two
+#: signs differ and the gain can lie on the negative side
+#: (docs/yaw_steering.md#both-signs-by-default). A bound the caller gives is kept as given.
 DEFAULT_YAW_BOUNDS = {"minimum_yaw_angle": -25.0, "maximum_yaw_angle": 25.0}
 
 
@@ -68,7 +68,6 @@ def with_default_yaw_bounds(optimizer_class, options: Mapping) -> dict:
             if name in accepted and name not in options:
                 options[name] = bound
     return options
-
 
 
 def check_optimizer_options(optimizer_class, options: Mapping, n_findex: int, n_turbines: int):

@@ -46,7 +46,6 @@ def chunk_rows(n: int, chunk_size: int) -> list:
             if rows.size]
 
 
-
 def atmosphere_rows(atmosphere: dict, rows) -> dict:
     """A plain atmosphere block (scalars, or one value per condition) for its conditions
     ``rows``."""
@@ -72,7 +71,6 @@ class Chunk:
         return Chunk(atmosphere_rows(self.atmosphere, rows),
                      self.directions[rows], self.speeds[rows], self.wind_ti[rows],
                      options_for_conditions(self.optimizer_kwargs, rows), self.steering_chunk_size)
-
 
 
 def run_chunk(template, model, chunk, ti_source, optimizer_class) -> dict:

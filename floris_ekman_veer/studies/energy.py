@@ -46,7 +46,6 @@ studies/condition_chunks.py (on a Dask cluster: studies/distributed.py), and the
 tabulated in studies/energy_results.py.
 """
 
-
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
@@ -263,7 +262,6 @@ def _check_study(fmodel, wind_data, optimizer_class, models, turbulence_intensit
                 steering_chunk_size=int(steering_chunk_size), client=client)
 
 
-
 def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_class, study,
                progress, optimizer_kwargs) -> AnnualEnergy:
     """Run every model over the study's conditions in chunks, one vectorised FLORIS model per
@@ -286,7 +284,7 @@ def _run_study(fmodel, wind_data, names, frequencies, conditions, optimizer_clas
                 parts = []
                 for chunk in chunks:
                     parts.append(run_chunk(template, model, chunk, study["turbulence_intensities"],
-                                            optimizer_class))
+                                           optimizer_class))
                     bar.update(chunk.speeds.size)
             else:
                 parts = run_chunks_on_cluster(study["client"], template, model, chunks,
@@ -306,7 +304,6 @@ def _chunk_of(conditions, rows, study, optimizer_kwargs) -> Chunk:
     return Chunk(conditions.atmosphere_of(rows), study["directions"][index],
                  study["speeds"][index], study["wind_ti"][index],
                  options_for_conditions(optimizer_kwargs, index), study["steering_chunk_size"])
-
 
 
 def energy_by_period(energy: AnnualEnergy, periods) -> pd.DataFrame:

@@ -77,7 +77,6 @@ class AnnualEnergy:
         object.__setattr__(self, "table", FullTable(self.table))
 
 
-
 def energy_table(per_model: dict, names, frequencies, owner, freq, wind_index,
                  steered: bool) -> AnnualEnergy:
     """The :class:`AnnualEnergy` of a study from its farm powers per condition.
