@@ -15,7 +15,7 @@
    search.
 3. Rebuild: the 3 x 3 night farm with an Obukhov length per condition, both signs, with the
    optimiser subsets' condition rebuild and with FLORIS's full Core rebuild per evaluation
-   (studies/optimization.py ``_reinitialize_conditions``): time and bitwise comparison.
+   (plugin/optimizer_conditions.py ``_reinitialize_conditions``): time and bitwise comparison.
 4. Shortfall: 3-turbine rows held out from the yaw study (tests/test_yaw_search.py): the farm
    power of FLORIS's single run and of the both-signs search against a brute-force search on a
    1-degree grid of all three yaws refined by Nelder-Mead (the reference the tests build), for
@@ -135,7 +135,7 @@ def rebuild(repeats: int):
     its own Obukhov length (one row-following run), both signs, with the optimiser subsets'
     condition rebuild and with FLORIS's full Core rebuild at every evaluation, interleaved, best
     of ``repeats``; the two results compared bit for bit."""
-    from floris_ekman_veer.studies import optimization
+    from floris_ekman_veer.plugin import optimizer_conditions as optimization
 
     quick = optimization._reinitialize_conditions
     full = FlorisModel._reinitialize  # bound to each subset as the condition rebuild is

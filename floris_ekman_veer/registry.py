@@ -112,7 +112,7 @@ def register() -> None:
         EkmanVeerVelocityDeflection,
         Gaussian2014VelocityDeficit,
     )
-    from floris_ekman_veer.studies.optimization import install_optimizer_hook
+    from floris_ekman_veer.plugin.optimizer_hooks import install_optimizer_hook
     from floris_ekman_veer.plugin.parallel import install_parallel_hook
     from floris_ekman_veer.plugin.solver import install_solver_hook
     from floris_ekman_veer.studies.uncertain import install_uncertain_hook

@@ -10,7 +10,7 @@ import pytest
 from floris import FlorisModel, TimeSeries, WindRose
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-from floris_ekman_veer.studies import energy
+from floris_ekman_veer.studies import condition_chunks, energy, energy_results
 from floris_ekman_veer.studies.comparison import builtin_inflow_settings, builtin_model
 from floris_ekman_veer.studies.energy import annual_energy
 from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
@@ -103,7 +103,7 @@ def test_steered_energy_is_the_optimisers_power(row, atmospheres):
     freq = ROSE.unpack_freq()
     for (model, name), df_opt in result.optima.items():
         row_ = result.table.set_index(["model", "stability"]).loc[(model, name)]
-        expected = 0.5 * energy.HOURS_PER_YEAR * np.sum(freq * df_opt["farm_power_opt"]) / 1e9
+        expected = 0.5 * energy_results.HOURS_PER_YEAR * np.sum(freq * df_opt["farm_power_opt"]) / 1e9
         assert row_["aep_steered_gwh"] == pytest.approx(expected, rel=1e-12)
         assert row_["aep_steered_gwh"] >= row_["aep_baseline_gwh"] * (1 - 1e-12)
     # Every model on the same inflow: the class's I_u(z_h) per condition, for both models.
@@ -128,7 +128,7 @@ def no_work(monkeypatch):
     def fail(*args, **kwargs):
         raise AssertionError("a FLORIS model was built before the input was checked")
 
-    monkeypatch.setattr(energy, "_chunk_model", fail)
+    monkeypatch.setattr(condition_chunks, "_chunk_model", fail)
 
 
 def _classes(atmospheres, **changes):
@@ -349,14 +349,14 @@ def test_steered_records_do_not_depend_on_the_chunking(row, monkeypatch):
     skip the optimiser and get exactly what it gives them (zero yaw, the baseline power)."""
     series, atmosphere, labels = _steered_records(row)
     optimised = []
-    original = energy.optimize_yaw
+    original = condition_chunks.optimize_yaw
 
     def counting(fmodel, *args, **kwargs):
         speeds = fmodel.core.flow_field.wind_speeds
         optimised.append((speeds.size, int(np.sum(speeds == 19.0)), kwargs["chunk_size"]))
         return original(fmodel, *args, **kwargs)
 
-    monkeypatch.setattr(energy, "optimize_yaw", counting)
+    monkeypatch.setattr(condition_chunks, "optimize_yaw", counting)
 
     def study(**sizes):
         return energy.record_energy(row, series, atmosphere, labels, YawOptimizationSR,
@@ -364,7 +364,7 @@ def test_steered_records_do_not_depend_on_the_chunking(row, monkeypatch):
 
     results = [study(chunk_size=1), study(steering_chunk_size=1)]
     # Without the skip every record is optimised, in one run, with the same numbers.
-    monkeypatch.setattr(energy, "_cannot_gain", lambda fmodel, powers, *_: np.zeros(
+    monkeypatch.setattr(condition_chunks, "_cannot_gain", lambda fmodel, powers, *_: np.zeros(
         powers.shape[0], dtype=bool))
     results.append(study())
     # (records optimised, of them at rated, conditions per optimiser run): the records at rated
@@ -407,7 +407,7 @@ def test_what_steering_cannot_gain(row):
     assert powers[2, 0] == 5e6 and np.all(powers[2, 1:] < 5e6)
 
     def skip(optimizer=YawOptimizationSR, **options):
-        return energy._cannot_gain(case, powers, optimizer, options).tolist()
+        return condition_chunks._cannot_gain(case, powers, optimizer, options).tolist()
 
     assert skip() == [True, False, False]
     assert skip(**YAW) == [True, False, False]

@@ -17,7 +17,7 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import ModelSettingsWarning
-from floris_ekman_veer.studies.energy import COLUMNS, AnnualEnergy
+from floris_ekman_veer.studies.energy_results import COLUMNS, AnnualEnergy
 from floris_ekman_veer.registry import UnknownModelError
 
 REPO = Path(__file__).resolve().parents[1]

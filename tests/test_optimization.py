@@ -20,7 +20,7 @@ import floris_ekman_veer
 from floris_ekman_veer import optimize_yaw
 from floris_ekman_veer.plugin import inflow
 from floris_ekman_veer import registry
-from floris_ekman_veer.studies.optimization import atmosphere_groups
+from floris_ekman_veer.plugin.optimizer_conditions import atmosphere_groups
 
 from conftest import STABLE_ATMOSPHERE, assert_as_plain_floris, make_config
 
@@ -239,10 +239,10 @@ def test_plain_floris_optimizer_and_uncertain_model_are_bitwise_unchanged():
 @pytest.mark.parametrize("per_condition_atmosphere", [True, False], ids=["rows", "scalar"])
 def test_condition_rebuild_is_bitwise_floris_full_rebuild(monkeypatch, per_condition_atmosphere):
     """The optimiser's subsets rebuild only what new conditions change
-    (studies/optimization.py ``_reinitialize_conditions``): the both-signs search of a
+    (plugin/optimizer_conditions.py ``_reinitialize_conditions``): the both-signs search of a
     per-condition (row-following) and of a scalar atmosphere gives bit for bit the yaw angles
     and powers of FLORIS's full Core rebuild at every evaluation."""
-    from floris_ekman_veer.studies import optimization
+    from floris_ekman_veer.plugin import optimizer_conditions as optimization
 
     atmosphere = per_condition(CLASSES) if per_condition_atmosphere else STABLE
     options = OPTIMIZERS["sr"][1]

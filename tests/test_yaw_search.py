@@ -1,5 +1,5 @@
 """optimize_yaw finds the optimum over both signs of yaw, whatever the bounds
-(studies/optimization.py, docs/yaw_steering.md#finding-the-optimum).
+(studies/yaw_search.py, docs/yaw_steering.md#finding-the-optimum).
 
 The reference is a brute-force search on a 1-degree grid, built here: every pair of yaw angles of
 the two front turbines of a 3-turbine row, and for each pair the best yaw of the last turbine

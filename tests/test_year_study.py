@@ -11,7 +11,7 @@ from floris import FlorisModel
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.studies import optimization
+from floris_ekman_veer.plugin import optimizer_conditions as optimization
 from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 
 FARM = Path(__file__).resolve().parents[1] / "inputs" / "farm_sbl6.yaml"

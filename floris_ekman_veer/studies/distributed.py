@@ -17,6 +17,9 @@ conditions. When the model is built, every current worker imports the package on
 versions: a worker without the package, or with another version of it or of FLORIS than the
 client, is an error then, not a wrong number later.
 
+``annual_energy(..., client=)`` runs its chunks of conditions (studies/condition_chunks.py) as
+tasks on a cluster in the same way (:func:`check_client`, :func:`run_chunks_on_cluster`).
+
 Requires the optional extra ``dask`` (``pip install 'floris-ekman-veer[dask]'``), on the workers
 too.
 """
@@ -27,12 +30,14 @@ import contextlib
 import copy
 
 import numpy as np
-
+from floris import FlorisModel
 from floris.par_floris_model import ParFlorisModel as _FlorisParFlorisModel
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._version import __version__
+from floris_ekman_veer.plugin.inflow import ATMOSPHERE_KEY, PARAMETER_BLOCK
 from floris_ekman_veer.plugin.parallel import prepare_worker
+from floris_ekman_veer.studies.condition_chunks import run_chunk
 
 DASK = "dask"
 
@@ -218,3 +223,69 @@ class ParFlorisModel(_FlorisParFlorisModel):
         memo[id(self)] = new
         new.__dict__.update(copy.deepcopy(self.__dict__, memo))
         return new
+
+
+# ---------------------------------------------------------------------------------------------
+# An annual-energy study's chunks of conditions as Dask tasks (annual_energy(..., client=))
+
+
+def check_client(fmodel, client) -> None:
+    """Refuse, before any run, a ``client`` that is not a ``dask.distributed.Client`` or a
+    model the workers cannot rebuild as it is; register the package on every worker."""
+    if isinstance(fmodel, _FlorisParFlorisModel) or not isinstance(fmodel, FlorisModel):
+        raise ValueError(
+            "annual energy: with client= each chunk of conditions runs on a Dask worker as a "
+            f"plain FlorisModel; fmodel must be a FlorisModel, got {type(fmodel).__name__} "
+            "(give its FlorisModel, or drop client= to let the model run its own chunks)"
+        )
+    distributed = _import_distributed()
+    if not isinstance(client, distributed.Client):
+        raise ValueError(
+            "annual energy: client must be a dask.distributed.Client (e.g. "
+            f"Client(LocalCluster()) or Client('tcp://scheduler:8786')); got "
+            f"{type(client).__name__}"
+        )
+    _check_workers(client)
+
+
+def run_chunks_on_cluster(client, template, model, chunks, ti_source, optimizer_class, bar) -> list:
+    """:func:`~floris_ekman_veer.studies.condition_chunks.run_chunk` of every chunk as a task on
+    the Dask cluster of ``client``; the results in the chunks' order, the workers' warnings
+    reported here once (floris_ekman_veer.warnings)."""
+    from distributed import as_completed
+
+    config = template.core.as_dict()
+    # The workers set every chunk's conditions and atmosphere: the template's own (possibly a
+    # year of per-record lists) need not travel.
+    config["flow_field"].update(wind_directions=[], wind_speeds=[], turbulence_intensities=[])
+    block = config["wake"]["wake_velocity_parameters"].get(PARAMETER_BLOCK)
+    if block is not None:
+        block.pop(ATMOSPHERE_KEY, None)
+    [config] = client.scatter([config], broadcast=True)
+    futures = client.map(_remote_chunk, chunks, config=config, model=model, ti_source=ti_source,
+                         optimizer_class=optimizer_class,
+                         setting=package_warnings.warnings_setting(), pure=False)
+    sizes = {future.key: chunk.speeds.size for future, chunk in zip(futures, chunks)}
+    package_warnings.discard_from_workers()
+    for future in as_completed(futures):
+        bar.update(sizes[future.key])
+    results = client.gather(futures)
+    package_warnings.report_from_workers(sum(sizes.values()))
+    return [part for part, _ in results]
+
+
+def _remote_chunk(chunk, config, model, ti_source, optimizer_class, setting):
+    """A chunk on a Dask worker: the template rebuilt there with the chunk's conditions (a plain
+    FlorisModel), then :func:`~floris_ekman_veer.studies.condition_chunks.run_chunk` as in the
+    serial study; the package's warnings travel back with the result."""
+    prepare_worker()
+    package_warnings.apply_setting(setting)
+    config = copy.deepcopy(config)
+    config["flow_field"].update(wind_directions=chunk.directions.tolist(),
+                                wind_speeds=chunk.speeds.tolist(),
+                                turbulence_intensities=chunk.wind_ti.tolist())
+    parameters = config["wake"]["wake_velocity_parameters"]
+    parameters.setdefault(PARAMETER_BLOCK, {})[ATMOSPHERE_KEY] = dict(chunk.atmosphere)
+    with package_warnings.collecting() as records:
+        part = run_chunk(FlorisModel(config), model, chunk, ti_source, optimizer_class)
+    return part, package_warnings.WorkerRecords(records) if records else None

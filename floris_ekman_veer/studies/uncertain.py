@@ -29,7 +29,7 @@ from floris_ekman_veer.plugin.inflow import (
     atmosphere_of,
     set_atmosphere,
 )
-from floris_ekman_veer.studies.optimization import atmosphere_groups
+from floris_ekman_veer.plugin.optimizer_conditions import atmosphere_groups
 
 
 def _per_condition_set_uncertain(original):
