@@ -30,7 +30,13 @@ from floris.optimization.yaw_optimization.yaw_optimization_base import YawOptimi
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer._validation import real_array, require_floris_model
-from floris_ekman_veer.plugin.inflow import _patch, atmosphere_of, set_atmosphere, warn_shallow
+from floris_ekman_veer.plugin.inflow import (
+    _patch,
+    atmosphere_groups,
+    atmosphere_of,
+    set_atmosphere,
+    warn_shallow,
+)
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 #: Optimiser options that may be given per condition, as (n_findex, n_turbines) arrays.
@@ -549,28 +555,6 @@ def _optimize_once(fmodel, optimizer_class, *, progress, chunk_size, **optimizer
             frames.append(df)
             bar.update(index.size)
     return pd.concat(frames).sort_index()
-
-
-def atmosphere_groups(fmodel) -> list[tuple[Mapping | None, np.ndarray]]:
-    """[(scalar atmosphere mapping or None, condition indices)] of ``fmodel``.
-
-    One group holding every condition when the atmosphere is scalar (its mapping is returned
-    unchanged) or absent (None); otherwise one group per distinct row of the per-condition
-    values, in order of first appearance.
-    """
-    n_findex = fmodel.core.flow_field.n_findex
-    spec = atmosphere_of(fmodel.core)
-    if spec is None or spec.n_conditions is None:
-        return [(None if spec is None else spec.sliced(slice(None)), np.arange(n_findex))]
-    names = sorted(k for k, v in spec.inputs.items() if not isinstance(v, float))
-    rows = np.stack([spec.inputs[k].reshape(-1) for k in names], axis=1)
-    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    groups = []
-    for label in np.argsort(first):
-        index = np.flatnonzero(inverse == label)
-        groups.append((spec.sliced(index[0]), index))
-    return groups
 
 
 #: Marks the run of :func:`_optimize_once` holding conditions of different atmospheres.
