@@ -26,6 +26,7 @@ def validating_post_init(method):
     """Validate the atmosphere, and the layout, conditions and turbines of a Core using the
     package (:func:`floris_ekman_veer.plugin.input_checks.check_core`, before FLORIS builds
     its grid), when a Core is built (FlorisModel(), set(), copy())."""
+
     @functools.wraps(method)
     def wrapper(self: Core) -> None:
         spec = atmosphere_of(self)

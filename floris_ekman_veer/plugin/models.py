@@ -85,12 +85,15 @@ from floris_ekman_veer.wake.fused import (
 )
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
-__all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "Gaussian2014VelocityDeficit"]
+__all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "EkmanWakeModel",
+           "Gaussian2014VelocityDeficit"]
 
 
 @define
-class _EkmanWakeModel(BaseModel):
-    """Parameters shared by the velocity models that draw on the Ekman atmosphere."""
+class EkmanWakeModel(BaseModel):
+    """Parameters shared by the velocity models that draw on the Ekman atmosphere, and their
+    integration over the rotor cells (plugin/rotor.py); plugin/solver.py runs the solver of the
+    models of this class."""
 
     #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
     #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.plugin.inflow.
@@ -296,7 +299,7 @@ class _EkmanWakeModel(BaseModel):
 
 # --------------------------------------------------------------------------------- M-1 / M-2
 @define
-class EkmanVeerVelocityDeficit(_EkmanWakeModel):
+class EkmanVeerVelocityDeficit(EkmanWakeModel):
     """Veer-corrected curled-wake deficit, Eq. (du_model) of Narasimhan, Gayme & Meneveau (2025).
 
     Delta u / U_h = C(x) exp(-((y - y_c)^2 + (z - z_h)^2) / (2 sigma(theta, x)^2)), with C(x) of
@@ -351,7 +354,7 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
 
 # --------------------------------------------------------------------------------- M-3
 @define
-class Gaussian2014VelocityDeficit(_EkmanWakeModel):
+class Gaussian2014VelocityDeficit(EkmanWakeModel):
     """The paper's M-3: Bastankhah & Porte-Agel (2014) Gaussian, no yaw or veer physics
     (docs/wake_model.md#m-3), on the Ekman inflow; centred on FLORIS's deflection field.
 

@@ -119,8 +119,8 @@ def check_core(core, abl, height: float, stage: str) -> None:
 
 def warn_shallow(core, spec: AtmosphereSpec | None = None) -> None:
     """Count a Core's conditions whose boundary layer is shallower than a rotor top in one
-    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning` , at
-    the user's run: every Core solve, the ParFlorisModel parent before its workers (sent with
+    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning`, at the user's run: every
+    Core solve, the ParFlorisModel parent before its workers (sent with
     the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
     Core's atmosphere, if known (else read)."""
     spec = atmosphere_of(core) if spec is None else spec

@@ -17,8 +17,6 @@ import numpy as np
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.plugin.atmosphere_block import CONFIG_PATH, AtmosphereSpec
 
-
-
 _SOLVE_CACHE: OrderedDict = OrderedDict()
 _SOLVE_CACHE_SIZE = 32
 _SOLVE_LOCK = threading.Lock()

@@ -38,7 +38,7 @@ from floris.core import solver as floris_solver
 
 from floris_ekman_veer.plugin import inflow
 from floris_ekman_veer.plugin.ambient import is_rotor_grid
-from floris_ekman_veer.plugin.models import _EkmanWakeModel
+from floris_ekman_veer.plugin.models import EkmanWakeModel as _EkmanWakeModel
 
 #: GCH's switches: each makes FLORIS's solver read or write whole-farm fields per turbine.
 WHOLE_FARM_TERMS = ("enable_secondary_steering", "enable_transverse_velocities",
