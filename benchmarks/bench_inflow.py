@@ -13,7 +13,7 @@ import numpy as np
 from floris import FlorisModel
 
 from floris_ekman_veer.studies import comparison
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin import inflow, solve_cache
 
 N_CONDITIONS, N_TURBINES, REPEATS = 1000, 100, 5
 ATMOSPHERE = {
@@ -49,13 +49,13 @@ def best_time(fmodel):
     core = fmodel.core
     times = []
     for _ in range(REPEATS):
-        token = inflow._ACTIVE.set(inflow.atmosphere_of(core))
+        token = inflow.ACTIVE_ATMOSPHERE.set(inflow.atmosphere_of(core))
         try:
             start = time.perf_counter()
             core.flow_field.initialize_velocity_field(core.grid)
             times.append(time.perf_counter() - start)
         finally:
-            inflow._ACTIVE.reset(token)
+            inflow.ACTIVE_ATMOSPHERE.reset(token)
     return min(times)
 
 
@@ -68,7 +68,7 @@ def main():
     ekman = build(ATMOSPHERE)
     print(f"  build incl. ABL solve (once, cached): {time.perf_counter() - start:.3f} s")
     spec = inflow.atmosphere_of(ekman.core)
-    inflow._SOLVE_CACHE.clear()
+    solve_cache.clear()
     start = time.perf_counter()
     inflow.solve(spec, ekman.core.flow_field.wind_speeds, 90.0)
     print(f"  ABL solve alone:                      {time.perf_counter() - start:.3f} s")

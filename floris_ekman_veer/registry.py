@@ -2,13 +2,13 @@
 
 ``register()`` makes the wake models selectable by name in a FLORIS input
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
-bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs the Ekman
-inflow hook, the support of ParFlorisModel, UncertainFlorisModel and the yaw optimisers, and the
-conversion of FLORIS wake inputs (plugin/wake_settings.py).
-Importing ``floris_ekman_veer`` calls it.
+bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs every FLORIS
+patch by walking the patch tables (plugin/patches.py: the Ekman inflow, the support of
+ParFlorisModel, UncertainFlorisModel and the yaw optimisers, the conversion of FLORIS wake inputs,
+the veer-aware rotor and the models' solver). Importing ``floris_ekman_veer`` calls it.
 
-This is the top of the coupling layer: it imports the model, turbine, inflow, parallel, uncertain
-and optimization modules, and none of them imports it (docs/coupling.md#registry).
+This is the top of the coupling layer: it imports the models, the turbine, the patch tables and
+the yaw optimisation, and none of them imports it (docs/coupling.md#registry).
 """
 
 from __future__ import annotations
@@ -101,23 +101,24 @@ def register_operation_model() -> type:
     )
 
 
+def patch_tables() -> tuple:
+    """The tables of FLORIS patches :func:`register` installs (tuples of
+    :class:`~floris_ekman_veer.plugin.patches.Patch` rows): the plugin's
+    (plugin/patches.py) and the yaw optimisers' (docs/coupling.md#what-is-patched)."""
+    from floris_ekman_veer.plugin.patches import PATCHES
+    from floris_ekman_veer.plugin.optimizer_hooks import PATCHES as OPTIMIZER_PATCHES
+
+    return (PATCHES, OPTIMIZER_PATCHES)
+
+
 def register() -> None:
-    """Register the wake models and the actuator-disk turbine, install the inflow hook, the
-    ParFlorisModel support and the models' solver (plugin/solver.py)."""
+    """Register the wake models and the actuator-disk turbine, and install every FLORIS patch by
+    walking :func:`patch_tables` (the inflow, ParFlorisModel, UncertainFlorisModel and yaw
+    optimiser support, the wake inputs, the veer-aware rotor and the models' solver)."""
     from floris.core.wake import MODEL_MAP
 
-    from floris_ekman_veer.plugin.inflow import install_inflow_hook
-    from floris_ekman_veer.plugin.models import (
-        EkmanVeerVelocityDeficit,
-        EkmanVeerVelocityDeflection,
-        Gaussian2014VelocityDeficit,
-    )
-    from floris_ekman_veer.plugin.optimizer_hooks import install_optimizer_hook
-    from floris_ekman_veer.plugin.parallel import install_parallel_hook
-    from floris_ekman_veer.plugin.solver import install_solver_hook
-    from floris_ekman_veer.studies.uncertain import install_uncertain_hook
-    from floris_ekman_veer.plugin.wake_settings import install_wake_settings_hook
-    from floris_ekman_veer.plugin.yawed_rotor import install_yawed_rotor_hook
+    from floris_ekman_veer.plugin.deflection_model import EkmanVeerVelocityDeflection
+    from floris_ekman_veer.plugin.models import EkmanVeerVelocityDeficit, Gaussian2014VelocityDeficit
 
     name_checked(MODEL_MAP, MODEL_PATHS)
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,
@@ -127,10 +128,6 @@ def register() -> None:
     register_in(MODEL_MAP["deflection_model"], DEFLECTION_MODEL_NAME, EkmanVeerVelocityDeflection,
                 "deflection_model")
     register_operation_model()
-    install_inflow_hook()
-    install_parallel_hook()
-    install_uncertain_hook()
-    install_optimizer_hook()
-    install_wake_settings_hook()
-    install_yawed_rotor_hook()
-    install_solver_hook()
+    for table in patch_tables():
+        for row in table:
+            row.install()

@@ -89,10 +89,10 @@ if MODE == "package":
 def _state():
     state = {"mode": MODE, "imported": "floris_ekman_veer" in sys.modules, "installed": False}
     if state["imported"]:
-        from floris_ekman_veer.plugin import inflow
+        from floris_ekman_veer.plugin import patching
 
-        state["installed"] = inflow.is_installed()
-        state["patched"] = sorted(f"{owner.__name__}.{name}" for owner, name in inflow._ORIGINALS)
+        state["installed"] = patching.is_installed()
+        state["patched"] = sorted(f"{owner.__name__}.{name}" for owner, name in patching.ORIGINALS)
         state["package"] = sys.modules["floris_ekman_veer"].__file__
     return state
 

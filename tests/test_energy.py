@@ -421,7 +421,7 @@ def test_what_steering_cannot_gain(row):
 
 def test_the_comparison_solves_each_chunks_abl_once(row, monkeypatch):
     """The GCH comparison's I_u(z_h) and the inflow hook share one ABL solve per chunk."""
-    from floris_ekman_veer.plugin import inflow
+    from floris_ekman_veer.plugin import solve_cache as inflow
 
     series, atmosphere, labels = _year_of_records(row, n=6, seed=9)
     solved = []

@@ -14,7 +14,7 @@ from floris.core.wake_velocity.none import NoneVelocityDeficit
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.plugin import inflow, parallel
+from floris_ekman_veer.plugin import inflow, parallel, patching
 from floris_ekman_veer import registry
 
 from conftest import EXAMPLE_WAKES, STABLE_ATMOSPHERE, make_config
@@ -82,19 +82,19 @@ def expected_turbine_grid_inflow(fmodel):
 
 
 def test_floris_version_check():
-    inflow._check_floris_version("4.7")
-    inflow._check_floris_version("4.7.3")
+    patching.check_floris_version("4.7")
+    patching.check_floris_version("4.7.3")
     for version in ("4.6.2", "4.8", "5.0.0", "dev"):
         with pytest.raises(ImportError, match="floris>=4.7,<4.8"):
-            inflow._check_floris_version(version)
+            patching.check_floris_version(version)
 
 
 def test_install_is_idempotent():
-    before = dict(inflow._ORIGINALS)
+    before = dict(patching.ORIGINALS)
     wrapper = FlowField.__dict__["initialize_velocity_field"]
     inflow.install_inflow_hook()
     inflow.install_inflow_hook()
-    assert inflow._ORIGINALS == before
+    assert patching.ORIGINALS == before
     assert FlowField.__dict__["initialize_velocity_field"] is wrapper
 
 
@@ -576,7 +576,7 @@ def test_profile_in_pieces_of_heights_is_bitwise_one_evaluation():
     convective alike, below the ground included; ambient_velocity gives them in FLORIS's
     layout."""
     from floris_ekman_veer import EkmanABL
-    from floris_ekman_veer.plugin import inflow
+    from floris_ekman_veer.plugin import inflow_profile as inflow
 
     speeds = np.random.default_rng(0).uniform(3.0, 19.0, 3000).reshape(-1, 1, 1, 1)
     z = np.concatenate([[-1.0, 0.0, 0.01], np.linspace(1.0, 400.0, 253)]).reshape(1, 1, 1, -1)
@@ -599,7 +599,7 @@ def test_profile_pieces_of_one_height_for_more_conditions_than_a_piece(monkeypat
     with the shipped piece) go one height per piece, the same bits; the pieces once split
     themselves again without end (RecursionError)."""
     from floris_ekman_veer import EkmanABL
-    from floris_ekman_veer.plugin import inflow
+    from floris_ekman_veer.plugin import inflow_profile as inflow
 
     monkeypatch.setattr(inflow, "_PROFILE_PIECE", 8)
     speeds = np.random.default_rng(1).uniform(3.0, 20.0, 40).reshape(-1, 1, 1, 1)

@@ -11,7 +11,7 @@ from floris.core.wake import MODEL_MAP
 from floris.utilities import load_yaml
 
 import floris_ekman_veer
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin import inflow, patching
 from floris_ekman_veer import registry
 from floris_ekman_veer.plugin.models import (
     EkmanVeerVelocityDeficit,
@@ -77,11 +77,11 @@ def test_names_do_not_select_floris_special_solvers():
 
 def test_register_is_idempotent():
     before = snapshot()
-    hook_originals = dict(inflow._ORIGINALS)
+    hook_originals = dict(patching.ORIGINALS)
     floris_ekman_veer.register()
     floris_ekman_veer.register()
     assert_same_tables(before, snapshot())
-    assert inflow._ORIGINALS == hook_originals
+    assert patching.ORIGINALS == hook_originals
 
 
 @pytest.mark.parametrize("table, name, cls", REGISTRATIONS, ids=IDS)

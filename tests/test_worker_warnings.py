@@ -117,7 +117,7 @@ def test_wrapped_worker_functions_unpickle_through_the_package(monkeypatch):
     installing twice wraps them once (docs/coupling.md#parallel-workers)."""
     import floris.par_floris_model as par
 
-    wrapped = {name: getattr(par, name) for name in parallel._WORKER_FUNCTIONS}
+    wrapped = {name: getattr(par, name) for name in parallel.WORKER_FUNCTIONS}
     called = []
     monkeypatch.setattr(parallel, "prepare_worker", lambda: called.append(1))
     for function in wrapped.values():

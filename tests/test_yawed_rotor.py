@@ -18,7 +18,7 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin import patching
 from floris_ekman_veer.plugin import turbine as adt
 from floris_ekman_veer.plugin.crossflow import CROSSFLOW, MOMENTS
 from floris_ekman_veer.plugin.inflow import set_atmosphere
@@ -120,7 +120,7 @@ def _cosine_loss_call(method, velocities, yaw):
                   tilt_interp=None, average_method="cubic-mean", cubature_weights=None,
                   correct_cp_ct_for_tilt=np.zeros_like(yaw, dtype=bool))
     # FLORIS's axial induction calls the (patched) thrust coefficient: it has no original.
-    original = inflow._ORIGINALS.get((CosineLossTurbine, method), getattr(CosineLossTurbine,
+    original = patching.ORIGINALS.get((CosineLossTurbine, method), getattr(CosineLossTurbine,
                                                                           method))
     return getattr(CosineLossTurbine, method)(**kwargs), original(**kwargs)
 
@@ -166,7 +166,7 @@ def test_veer_at_zero_yaw_is_floris_bitwise(nrel_sbl4):
     token = CROSSFLOW.set(None)
     try:
         plain = model.core.farm.turbine_map[0]
-        floris_own = inflow._ORIGINALS[(CosineLossTurbine, "power")](
+        floris_own = patching.ORIGINALS[(CosineLossTurbine, "power")](
             power_thrust_table=plain.power_thrust_table, velocities=model.core.flow_field.u,
             air_density=1.225, yaw_angles=np.zeros((3, 1)),
             tilt_angles=model.core.farm.tilt_angles,

@@ -22,7 +22,7 @@ keep_old_paths(__name__, {
     "energy": "floris_ekman_veer.studies.energy",
     "site": "floris_ekman_veer.studies.site",
     "comparison": "floris_ekman_veer.studies.comparison",
-    "uncertain": "floris_ekman_veer.studies.uncertain",
+    "uncertain": "floris_ekman_veer.plugin.uncertain_conditions",
     "distributed": "floris_ekman_veer.studies.distributed",
     "validity": "floris_ekman_veer.studies.validity",
     "tables": "floris_ekman_veer.studies.tables",

@@ -4,7 +4,7 @@
   the curled, polar-angle dependent width (M-1; M-2 when the deflection model's veer is off).
 * ``EkmanVeerVelocityDeflection`` (``ekman_veer``): y_c(x, z) of Eq. (yc_xz), yaw (CVP with
   ground image) plus veer, at every grid point: it varies with height, which is how veer shears
-  the wake.
+  the wake (defined in plugin/deflection_model.py, read from here with the velocity models).
 * ``Gaussian2014VelocityDeficit`` (``bastankhah2014``): the paper's M-3 (docs/wake_model.md#m-3).
 
 Conventions (docs/conventions.md, docs/coupling.md), each pinned by tests:
@@ -35,17 +35,10 @@ import warnings
 from typing import Any
 
 import numpy as np
-import attrs
 from attrs import define, field
 from floris.core import BaseModel, FlowField, Grid
 
-import floris_ekman_veer.warnings as package_warnings
-from floris_ekman_veer._validation import (
-    boolean_field,
-    choice_field,
-    input_block,
-    number_field,
-)
+from floris_ekman_veer._validation import boolean_field, choice_field, number_field
 from floris_ekman_veer.atmosphere.turbulence import (
     ALPHA_PRIME,
     MERGE_EXPONENT,
@@ -56,11 +49,8 @@ from floris_ekman_veer.atmosphere.turbulence import (
     wake_expansion_rate,
 )
 from floris_ekman_veer.plugin.ambient import Ambient
-from floris_ekman_veer.plugin.names import (
-    DEFLECTION_MODEL_NAME,
-    GAUSSIAN_2014_NAME,
-    VELOCITY_MODEL_NAME,
-)
+from floris_ekman_veer.plugin.deflection_model import EkmanVeerVelocityDeflection
+from floris_ekman_veer.plugin.names import GAUSSIAN_2014_NAME, VELOCITY_MODEL_NAME
 from floris_ekman_veer.plugin.rotor import (
     DEFICIT_VELOCITIES,
     ROTOR_PLANE_MARGIN,
@@ -71,6 +61,15 @@ from floris_ekman_veer.plugin.rotor import (
     rotor_cell_deficit,
 )
 from floris_ekman_veer.plugin.shallow import POLICIES as SHALLOW_POLICIES
+from floris_ekman_veer.plugin.wake_inputs import (
+    GLAUERT_THRUST_COEFFICIENT,
+    MERGE_EXPONENT_RANGE,
+    NON_NEGATIVE,
+    POSITIVE,
+    THRUST_LIMIT_RANGE,
+    from_input_block,
+    unyawed_thrust_coefficient,
+)
 from floris_ekman_veer.wake.deficit import (
     CURL_ALPHA,
     WIDTH_FACTOR,
@@ -78,7 +77,7 @@ from floris_ekman_veer.wake.deficit import (
     normalised_deficit,
     stream_tube_area_ratio,
 )
-from floris_ekman_veer.wake.deflection import veer_deflection, wake_centre_offset
+from floris_ekman_veer.wake.deflection import veer_deflection
 from floris_ekman_veer.wake.fused import (
     deficit_on_rows,
     rows_deficit_parameters,
@@ -86,62 +85,24 @@ from floris_ekman_veer.wake.fused import (
 )
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
 
-#: a = 0.4: beyond it momentum theory gives way to the Glauert (turbulent-wake) regime.
-GLAUERT_THRUST_COEFFICIENT = 0.96
-
-
-# --------------------------------------------------------------------------------- shared pieces
-def _from_input_block(cls, data):
-    """FLORIS's ``from_dict`` for a model block, refusing a non-mapping block (e.g. ``"on"``,
-    which FLORIS would iterate as the keys 'o', 'n') or unknown keys with a ValueError naming
-    the block's input path (docs/coupling.md#input-validation)."""
-    input_block(data, cls.input_path, [a.name for a in attrs.fields(cls) if a.init])
-    return BaseModel.from_dict.__func__(cls, data)
-
-
-#: Valid ranges of the model parameters (docs/coupling.md#input-validation): text and test.
-_POSITIVE = ("finite and > 0", lambda v: np.isfinite(v) and v > 0.0)
-_NON_NEGATIVE = ("finite and >= 0", lambda v: np.isfinite(v) and v >= 0.0)
-# k_w_exponent n: the smooth maximum (floor^n + x^n)^(1/n) lies between max(floor, x) (n -> inf)
-# and floor + x (n = 1); n < 1 would exceed the sum, n = 0 divides by zero.
-_MERGE_EXPONENT_RANGE = ("finite and >= 1", lambda v: np.isfinite(v) and v >= 1.0)
-# A thrust-coefficient limit below 1: momentum theory's a < 1/2 (docs/conventions.md).
-_THRUST_LIMIT_RANGE = ("in (0, 1)", lambda v: 0.0 < v < 1.0)
-
-
-def unyawed_thrust_coefficient(ct_i, yaw, max_thrust_coefficient):
-    """C_T = ct_i / cos(yaw) (docs/conventions.md#thrust-coefficient-and-yaw), limited to the momentum-theory range.
-
-    The limit acts on the rotor-normal loading C_T cos^2(yaw), as in Eqs. A_star and
-    ind_factor. ``yaw`` in radians. Returns the C_T the wake formulas use; warns when the limit
-    acts.
-    """
-    if np.any(np.abs(yaw) >= np.pi / 2):
-        raise ValueError(
-            "yaw angles must satisfy |yaw| < 90 degrees for the ekman_veer wake models; got "
-            f"{np.rad2deg(yaw.flat[np.argmax(np.abs(yaw))]):.6g} degrees"
-        )
-    ct = np.asarray(ct_i, dtype=float) / np.cos(yaw)
-    limit = max_thrust_coefficient / np.cos(yaw) ** 2
-    heavy = ct > limit
-    if np.any(heavy):
-        # One summary per run, naming the conditions' wind speeds (floris_ekman_veer.warnings).
-        package_warnings.note_thrust_limit(heavy, max_thrust_coefficient)
-    return np.where(heavy, limit, ct)
+__all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "EkmanWakeModel",
+           "Gaussian2014VelocityDeficit"]
 
 
 @define
-class _EkmanWakeModel(BaseModel):
-    """Parameters shared by the velocity models that draw on the Ekman atmosphere."""
+class EkmanWakeModel(BaseModel):
+    """Parameters shared by the velocity models that draw on the Ekman atmosphere, and their
+    integration over the rotor cells (plugin/rotor.py); plugin/solver.py runs the solver of the
+    models of this class."""
 
     #: The atmosphere (EkmanABL inputs without the wind speed). It is read and validated by the
     #: inflow hook, which also drives FLORIS's inflow with it; see floris_ekman_veer.plugin.inflow.
     atmosphere: dict | None = field(default=None)
-    A1: float = number_field(TOWNSEND_PERRY_A1, *_POSITIVE)
-    B1: float = number_field(TOWNSEND_PERRY_B1, *_NON_NEGATIVE)
-    alpha_prime: float = number_field(ALPHA_PRIME, *_POSITIVE)
-    k_w_floor: float = number_field(MIXING_LAYER_FLOOR, *_POSITIVE)
-    k_w_exponent: float = number_field(MERGE_EXPONENT, *_MERGE_EXPONENT_RANGE)
+    A1: float = number_field(TOWNSEND_PERRY_A1, *POSITIVE)
+    B1: float = number_field(TOWNSEND_PERRY_B1, *NON_NEGATIVE)
+    alpha_prime: float = number_field(ALPHA_PRIME, *POSITIVE)
+    k_w_floor: float = number_field(MIXING_LAYER_FLOOR, *POSITIVE)
+    k_w_exponent: float = number_field(MERGE_EXPONENT, *MERGE_EXPONENT_RANGE)
     #: "ambient": k_w from the ABL's I_u(z_h), Eq. (kw_CNBL_SBL_model), as in the paper.
     #: "local_turbulence": the same with FLORIS's wake-added turbulence at the turbine (from its
     #: turbulence model, the largest of the upstream wakes' as FLORIS combines it) added in
@@ -155,14 +116,14 @@ class _EkmanWakeModel(BaseModel):
     #: (FLORIS's combination ``fls``); "free_stream" the ambient U_h, as FLORIS's gauss
     #: (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor's wake is the paper's with each.
     deficit_velocity: str = choice_field("incoming", DEFICIT_VELOCITIES)
-    max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
+    max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/shallow.py).
     shallow_boundary_layer: str = choice_field("warn", SHALLOW_POLICIES)
 
     #: Where the block sits in a FLORIS input (error messages name it).
     input_path = f"wake.wake_velocity_parameters.{VELOCITY_MODEL_NAME}"
-    from_dict = classmethod(_from_input_block)
+    from_dict = classmethod(from_input_block)
 
     def expansion_rate(self, abl, hub_height, hub_speed, turbulence_intensity,
                        floris_turbulence):
@@ -338,7 +299,7 @@ class _EkmanWakeModel(BaseModel):
 
 # --------------------------------------------------------------------------------- M-1 / M-2
 @define
-class EkmanVeerVelocityDeficit(_EkmanWakeModel):
+class EkmanVeerVelocityDeficit(EkmanWakeModel):
     """Veer-corrected curled-wake deficit, Eq. (du_model) of Narasimhan, Gayme & Meneveau (2025).
 
     Delta u / U_h = C(x) exp(-((y - y_c)^2 + (z - z_h)^2) / (2 sigma(theta, x)^2)), with C(x) of
@@ -391,112 +352,9 @@ class EkmanVeerVelocityDeficit(_EkmanWakeModel):
         )
 
 
-@define
-class EkmanVeerVelocityDeflection(BaseModel):
-    """Wake-centre offset y_c(x, z), Eq. (yc_xz): counter-rotating-vortex deflection with its
-    ground image, Eq. (yhatc) with t_hat of Eq. (that), plus the veer shear x V(z)/U(z),
-    Eq. (yc_veer). Returned at every grid point, so it varies with height.
-
-    Parameters (``wake_deflection_parameters.ekman_veer``):
-        veer: include y_c,veer (False gives the paper's M-2).
-        yaw_deflection: include the yaw (vortex-pair) term; with ``veer`` also False the wake
-            is not deflected at all, as in the paper's M-3 behind a yawed rotor (FLORIS's
-            ``none`` deflection refuses non-zero yaw).
-        ground_image: include the image-vortex term of Eq. (yhatc).
-        max_thrust_coefficient: as for the velocity model.
-    The atmosphere comes from the velocity block (``wake_velocity_parameters.ekman_veer``).
-    """
-
-    veer: bool = boolean_field(True)
-    yaw_deflection: bool = boolean_field(True)
-    ground_image: bool = boolean_field(True)
-    max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *_THRUST_LIMIT_RANGE)
-
-    input_path = f"wake.wake_deflection_parameters.{DEFLECTION_MODEL_NAME}"
-    from_dict = classmethod(_from_input_block)
-
-    def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
-        return {"x": grid.x_sorted, "z": grid.z_sorted, "ambient": Ambient.of(grid, flow_field)}
-
-    def function(
-        self,
-        x_i: np.ndarray,
-        y_i: np.ndarray,
-        yaw_i: np.ndarray,
-        turbulence_intensity_i: np.ndarray,
-        ct_i: np.ndarray,
-        rotor_diameter_i: np.ndarray,
-        *,
-        x: np.ndarray,
-        z: np.ndarray,
-        ambient: Ambient,
-    ) -> np.ndarray:
-        hub_height = ambient.hub_height_at(x_i, y_i)
-        # Without the vortex pair the yaw term vanishes: the offset is that of an unyawed rotor.
-        yaw = np.deg2rad(yaw_i) if self.yaw_deflection else np.zeros_like(yaw_i, dtype=float)
-        ct = unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
-        radius = 0.5 * rotor_diameter_i
-        if ambient.rotor is None:
-            hub_speed, local_u, local_v = ambient.at_hub(hub_height)
-            return self._offset(x - x_i, z, hub_height, radius, ct, yaw, hub_speed, local_u,
-                                local_v, ambient.abl.friction_velocity)
-        # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
-        # heights, downstream of turbine i only (upstream there is no wake: 0), and at the rows
-        # of the rotor cells (plugin/rotor.py) only for the rotors the velocity model
-        # integrates (RotorDeflection.rows_at).
-        rotor = ambient.rotor
-        hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
-        dx = rotor.x - x_i[:, 0, 0]
-        per_condition = [np.broadcast_to(a, yaw.shape)[:, 0, 0, 0] for a in (
-            cos_a, sin_a, hub_height, radius, ct, yaw, hub_speed,
-            ambient.abl.friction_velocity)]
-
-        def centre(f, j, heights, u, v):
-            """The centre at ``heights`` (pairs, h) of rotors (f, j) downstream, from the ambient
-            (u, v) there in FLORIS's frame."""
-            cos_p, sin_p, *pair = (a[f][:, None] for a in per_condition)
-            return self._offset(dx[f, j][:, None], heights, *pair[:5],
-                                u * cos_p + v * sin_p, v * cos_p - u * sin_p, pair[5])
-
-        points = np.zeros(z[:, :, 0, :].shape)
-        f, j = np.nonzero(dx > 0.0)
-        if f.size:
-            u = np.broadcast_to(ambient.u[:, :, 0, :], points.shape)
-            v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)
-            points[f, j] = centre(f, j, z[f, j, 0, :], u[f, j], v[f, j])
-        field_ = np.broadcast_to(points[:, :, None, :], z.shape).view(RotorDeflection)
-        field_.rows_at = lambda f, j: centre(f, j, *rotor.rows(f, j))  # noqa: E731
-        return field_
-
-    def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):
-        flowing = local_u > 0
-        offset = wake_centre_offset(
-            dx, z, hub_height=hub_height, radius=radius, ct=ct, yaw=yaw,
-            friction_velocity=u_star, hub_speed=hub_speed,
-            local_speed=np.where(flowing, local_u, 1.0),
-            lateral_speed=np.where(flowing, local_v, 0.0), veer=self.veer,
-            ground_image=self.ground_image,
-        )
-        return np.where(flowing, offset, 0.0)
-
-
-class RotorDeflection(np.ndarray):
-    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``rows_at(f, j)``:
-    the centre at the rows of the rotor cells' sub-quadrature of rotors (f, j) downstream
-    (index arrays; returns (pairs, rows)), for the velocity model's rotor-cell average, which
-    evaluates it only where the wake can reach. Arithmetic on it gives plain arrays (FLORIS's
-    own velocity models read it as the point field it is)."""
-
-    rows_at = None
-
-    def __array_wrap__(self, array, context=None, return_scalar=False):
-        result = array.view(np.ndarray)
-        return result[()] if return_scalar else result
-
-
 # --------------------------------------------------------------------------------- M-3
 @define
-class Gaussian2014VelocityDeficit(_EkmanWakeModel):
+class Gaussian2014VelocityDeficit(EkmanWakeModel):
     """The paper's M-3: Bastankhah & Porte-Agel (2014) Gaussian, no yaw or veer physics
     (docs/wake_model.md#m-3), on the Ekman inflow; centred on FLORIS's deflection field.
 
@@ -515,7 +373,7 @@ class Gaussian2014VelocityDeficit(_EkmanWakeModel):
     rotor facing the wind with the yawed disk's loading, deeper than the un-yawed wake.
     """
 
-    k_star: float | None = number_field(None, *_POSITIVE, optional=True)
+    k_star: float | None = number_field(None, *POSITIVE, optional=True)
     input_path = f"wake.wake_velocity_parameters.{GAUSSIAN_2014_NAME}"
 
     def wake_thrust_coefficient(self, ct_i, yaw):

@@ -29,7 +29,7 @@ import pandas as pd
 from floris import FlorisModel
 from floris.core import FlowField, TurbineCubatureGrid, TurbineGrid, WakeModelManager
 
-from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.plugin.inflow import atmosphere_groups, atmosphere_of, set_atmosphere
 from floris_ekman_veer.plugin.optimizer_options import options_for_conditions
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
@@ -79,28 +79,6 @@ def optimize_each_atmosphere(fmodel, optimizer_class, *, progress, chunk_size, *
             frames.append(df)
             bar.update(index.size)
     return pd.concat(frames).sort_index()
-
-
-def atmosphere_groups(fmodel) -> list[tuple[Mapping | None, np.ndarray]]:
-    """[(scalar atmosphere mapping or None, condition indices)] of ``fmodel``.
-
-    One group holding every condition when the atmosphere is scalar (its mapping is returned
-    unchanged) or absent (None); otherwise one group per distinct row of the per-condition
-    values, in order of first appearance.
-    """
-    n_findex = fmodel.core.flow_field.n_findex
-    spec = atmosphere_of(fmodel.core)
-    if spec is None or spec.n_conditions is None:
-        return [(None if spec is None else spec.sliced(slice(None)), np.arange(n_findex))]
-    names = sorted(k for k, v in spec.inputs.items() if not isinstance(v, float))
-    rows = np.stack([spec.inputs[k].reshape(-1) for k in names], axis=1)
-    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    groups = []
-    for label in np.argsort(first):
-        index = np.flatnonzero(inverse == label)
-        groups.append((spec.sliced(index[0]), index))
-    return groups
 
 
 #: Marks the run of :func:`optimize_each_atmosphere` holding conditions of different atmospheres.

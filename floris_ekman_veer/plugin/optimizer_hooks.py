@@ -24,30 +24,15 @@ from floris.optimization.yaw_optimization.yaw_optimizer_geometric import YawOpti
 from floris.optimization.yaw_optimization.yaw_optimizer_scipy import YawOptimizationScipy
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-# TODO(lead, at merge): the row mechanism of plugin/patches.py (Patch, and its patch() for
-# install, which keeps the originals the table restores) replaces this stand-in and _patch.
-from floris_ekman_veer.plugin.inflow import _patch, atmosphere_of, warn_shallow
+from floris_ekman_veer.plugin.inflow import atmosphere_of, warn_shallow
 from floris_ekman_veer.plugin.optimizer_conditions import (
     DEFAULT_CHUNK_SIZE,
     optimize_each_atmosphere,
 )
 from floris_ekman_veer.plugin.optimizer_options import checked_options
+from floris_ekman_veer.plugin.patches import Patch, wrapped
 
 
-# TODO(lead, at merge): import Patch from floris_ekman_veer.plugin.patches; a stand-in with its
-# fields until then.
-@attrs.define(frozen=True)
-class Patch:
-    """One patched FLORIS attribute."""
-
-    #: Dotted path of what is patched.
-    owner: str
-    #: One sentence: why the package must patch it.
-    why: str
-    #: The FLORIS version it was checked against.
-    checked_against: str
-    #: Installs it (idempotent).
-    install: Callable[[], None]
 
 
 def _recording_init(original):
@@ -104,12 +89,6 @@ def _dispatching_optimize(original):
     return wrapper
 
 
-def _row(owner: type, name: str, make_wrapper, why: str) -> Patch:
-    return Patch(owner=f"{owner.__module__}.{owner.__qualname__}.{name}", why=why,
-                 checked_against="4.7",
-                 install=functools.partial(_patch, owner, name, make_wrapper))
-
-
 _RECORD = ("keeps the options of the user's constructor call, with which {name}.optimize() "
            "rebuilds the optimiser per atmosphere on a per-condition atmosphere")
 _DISPATCH = ("the optimiser tiles, masks and re-orders its model's conditions, which a "
@@ -119,10 +98,10 @@ _DISPATCH = ("the optimiser tiles, masks and re-orders its model's conditions, w
 #: FLORIS's yaw optimisers' patched attributes (FLORIS 4.7: the base class defines
 #: ``__init__``, each of its three optimisers ``__init__`` and ``optimize``).
 PATCHES: tuple[Patch, ...] = (
-    _row(YawOptimization, "__init__", _recording_init, _RECORD.format(name="a subclass's")),
+    wrapped(YawOptimization, "__init__", _recording_init, _RECORD.format(name="a subclass's")),
     *(row for cls in (YawOptimizationSR, YawOptimizationScipy, YawOptimizationGeometric)
-      for row in (_row(cls, "__init__", _recording_init, _RECORD.format(name=cls.__name__)),
-                  _row(cls, "optimize", _dispatching_optimize, _DISPATCH))),
+      for row in (wrapped(cls, "__init__", _recording_init, _RECORD.format(name=cls.__name__)),
+                  wrapped(cls, "optimize", _dispatching_optimize, _DISPATCH))),
 )
 
 

@@ -23,13 +23,11 @@ import functools
 import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
-from floris_ekman_veer.plugin import shallow
+from floris_ekman_veer.plugin import patching, shallow
 from floris_ekman_veer.plugin.inflow import (
     ATMOSPHERE_KEY,
     PARAMETER_BLOCK,
-    _patch,
     atmosphere_of,
-    install_inflow_hook,
     warn_shallow,
 )
 
@@ -38,12 +36,12 @@ def prepare_worker() -> None:
     """Make this process ready to build the package's FLORIS models (idempotent).
 
     Reaching this function imports ``floris_ekman_veer`` (Python imports a package before its
-    modules; unpickling looks the function up by module name), and that import registers the models;
-    this call then re-installs the inflow hook and the ParFlorisModel support, should they have
-    been uninstalled. It imports nothing above it (docs/coupling.md#parallel-workers).
+    modules; unpickling looks the function up by module name), and that import registers the models
+    and installs the package's FLORIS patches (plugin/patches.py); this call then puts the
+    patches back, should they have been uninstalled in this process. It imports nothing above it
+    (docs/coupling.md#parallel-workers).
     """
-    install_inflow_hook()
-    install_parallel_hook()
+    patching.reinstall()
 
 
 def _unpickle_worker_dict(data: dict, warnings_setting: str | None = None) -> dict:
@@ -64,7 +62,9 @@ class WorkerDict(dict):
 _CONDITION_KEYS = ("wind_directions", "wind_speeds", "turbulence_intensities")
 
 
-def _splitting_preprocessing(method):
+def splitting_preprocessing(method):
+    """ParFlorisModel._preprocessing: per-condition atmospheres cut to each worker's share, the
+    shallow-layer count left to the parent, the dict sent as a :class:`WorkerDict`."""
     @functools.wraps(method)
     def wrapper(self):
         multiargs = method(self)
@@ -78,7 +78,7 @@ def _splitting_preprocessing(method):
             block = fmodel_dict["wake"]["wake_velocity_parameters"].get(PARAMETER_BLOCK)
             if spec is not None and block.get(shallow.POLICY_KEY, "warn") == "warn":
                 # The parent counts its shallow conditions once, at the user's run
-                # (_reporting_parent): not again per chunk.
+                # (:func:`reporting_parent`): not again per chunk.
                 block[shallow.POLICY_KEY] = "ignore"
             if per_condition:
                 flow_field = fmodel_dict["flow_field"]
@@ -93,11 +93,11 @@ def _splitting_preprocessing(method):
 
 
 #: FLORIS's functions that run a chunk of conditions in a worker process.
-_WORKER_FUNCTIONS = ("_parallel_run", "_parallel_run_powers_only",
+WORKER_FUNCTIONS = ("_parallel_run", "_parallel_run_powers_only",
                      "_parallel_sample_flow_at_points", "_parallel_sample_ti_at_points")
 
 
-class _RecordingWorker:
+class RecordingWorker:
     """A worker's chunk: the package's warnings are recorded and travel back with the result,
     for the parent to report once at the user's line (floris_ekman_veer.warnings), instead of
     being printed by each worker at the pool's frame with the worker's share of the counts.
@@ -120,7 +120,7 @@ class _RecordingWorker:
 
 
 def _worker_function(name: str):
-    """Unpickle a :class:`_RecordingWorker`: prepare this process, then hand over FLORIS's worker
+    """Unpickle a :class:`RecordingWorker`: prepare this process, then hand over FLORIS's worker
     function ``name`` as this process has it wrapped."""
     import floris.par_floris_model as par
 
@@ -128,7 +128,7 @@ def _worker_function(name: str):
     return getattr(par, name)
 
 
-def _reporting_parent(method):
+def reporting_parent(method):
     """ParFlorisModel.run / _sample_value_at_points: count the shallow conditions of all the
     parent's conditions once (its workers are sent the policy ``ignore``), and report what the
     workers recorded."""
@@ -141,17 +141,3 @@ def _reporting_parent(method):
         return result
 
     return wrapper
-
-
-def install_parallel_hook() -> None:
-    """Wrap ParFlorisModel's condition splitting, its worker functions and the parent's
-    reporting of the workers' warnings (idempotent; ``register()`` calls it;
-    ``uninstall_inflow_hook`` restores it with the other patches)."""
-    import floris.par_floris_model as par
-    from floris.par_floris_model import ParFlorisModel
-
-    _patch(ParFlorisModel, "_preprocessing", _splitting_preprocessing)
-    for name in ("run", "_sample_value_at_points"):
-        _patch(ParFlorisModel, name, _reporting_parent)
-    for name in _WORKER_FUNCTIONS:  # (a module has a __dict__ as a class has)
-        _patch(par, name, _RecordingWorker)

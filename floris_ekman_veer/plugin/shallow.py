@@ -27,6 +27,9 @@ from collections.abc import Mapping
 import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
+from floris_ekman_veer.plugin import input_checks
+from floris_ekman_veer.plugin.atmosphere_block import PARAMETER_BLOCK, AtmosphereSpec, atmosphere_of
+from floris_ekman_veer.plugin.solve_cache import solve
 from floris_ekman_veer.warnings import ShallowBoundaryLayerWarning  # noqa: F401  (its home once)
 
 #: Key of the policy in ``wake.wake_velocity_parameters.ekman_veer``, and its values.
@@ -89,3 +92,45 @@ def check_rotor_inside(
     package_warnings.warn_shallow(index.size, h.size, speeds[index], h[index], top, hub,
                                   hub_above, reference_height, POLICY_PATH)
     return affected
+
+
+def reference_height(core) -> float | None:
+    """The Core's reference wind height, FLORIS's "use the hub height" sentinel (-1, which
+    FlorisModel replaces without a rebuild) read as the hub height; None where FLORIS refuses
+    the sentinel (several hub heights)."""
+    height = core.flow_field.reference_wind_height
+    if abs(height + 1.0) < 1e-6:
+        hubs = np.unique(core.farm.hub_heights)
+        if hubs.size != 1:
+            return None
+        height = float(hubs[0])
+    return height
+
+
+def check_core(core, abl, height: float, stage: str) -> None:
+    """The policy of a Core's ``ekman_veer`` block on its conditions solved as ``abl``
+    (those at rest have no boundary layer to be shallow), at ``stage``."""
+    check_rotor_inside(
+        core.wake.wake_velocity_parameters.get(PARAMETER_BLOCK),
+        np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1)),
+        core.flow_field.wind_speeds, height, core.farm.hub_heights, core.farm.rotor_diameters,
+        stage=stage,
+    )
+
+
+def warn_shallow(core, spec: AtmosphereSpec | None = None) -> None:
+    """Count a Core's conditions whose boundary layer is shallower than a rotor top in one
+    :class:`~floris_ekman_veer.warnings.ShallowBoundaryLayerWarning`, at the user's run: every
+    Core solve, the ParFlorisModel parent before its workers (sent with
+    the policy ``ignore``) and ``optimize_yaw`` before its many re-built models. ``spec``: the
+    Core's atmosphere, if known (else read). FLORIS's turbulence intensities that the ekman_veer
+    model does not read are said there as well (:func:`input_checks.notice_unused_turbulence`)."""
+    spec = atmosphere_of(core) if spec is None else spec
+    if spec is None or not core.flow_field.n_findex:
+        return
+    height = reference_height(core)
+    if height is not None:
+        abl = solve(spec, core.flow_field.wind_speeds, height)
+        check_core(core, abl, height, "run")
+        # Said at the run too, not at build: a shipped input's placeholder TI is not the user's.
+        input_checks.notice_unused_turbulence(core, abl, spec)

@@ -36,9 +36,9 @@ from floris.core import axial_induction, thrust_coefficient
 from floris.core import core as floris_core
 from floris.core import solver as floris_solver
 
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin import inflow, patching
 from floris_ekman_veer.plugin.ambient import is_rotor_grid
-from floris_ekman_veer.plugin.models import _EkmanWakeModel
+from floris_ekman_veer.plugin.models import EkmanWakeModel
 
 #: GCH's switches: each makes FLORIS's solver read or write whole-farm fields per turbine.
 WHOLE_FARM_TERMS = ("enable_secondary_steering", "enable_transverse_velocities",
@@ -47,7 +47,7 @@ WHOLE_FARM_TERMS = ("enable_secondary_steering", "enable_transverse_velocities",
 
 def uses_rotor_solver(grid, model_manager) -> bool:
     """Whether :func:`rotor_solver` solves this grid and these wake models."""
-    return (isinstance(model_manager.velocity_model, _EkmanWakeModel) and is_rotor_grid(grid)
+    return (isinstance(model_manager.velocity_model, EkmanWakeModel) and is_rotor_grid(grid)
             and not any(getattr(model_manager, flag, False) for flag in WHOLE_FARM_TERMS))
 
 
@@ -196,4 +196,4 @@ def install_solver_hook() -> None:
     ``floris.core.core`` (``Core.steady_state_atmospheric_condition``) and in
     ``floris.core.solver`` (the turbine-grid solve of FLORIS's full-flow solvers)."""
     for module in (floris_core, floris_solver):
-        inflow._patch(module, "sequential_solver", _dispatching)
+        patching.patch(module, "sequential_solver", _dispatching)

@@ -89,7 +89,7 @@ def mixed_settings(wake) -> list[str]:
     return found
 
 
-def _converting_post_init(method):
+def converting_post_init(method):
     """WakeModelManager.__attrs_post_init__: defaults for missing package blocks, and the
     mixed-settings warning."""
 
@@ -112,12 +112,3 @@ def _converting_post_init(method):
             )
 
     return wrapper
-
-
-def install_wake_settings_hook() -> None:
-    """Wrap FLORIS's WakeModelManager (idempotent; ``uninstall_inflow_hook`` restores it)."""
-    from floris.core.wake import WakeModelManager
-
-    from floris_ekman_veer.plugin.inflow import _patch
-
-    _patch(WakeModelManager, "__attrs_post_init__", _converting_post_init)

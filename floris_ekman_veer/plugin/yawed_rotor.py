@@ -36,13 +36,10 @@ import functools
 import inspect
 
 import numpy as np
-from floris.core.farm import Farm
 from floris.core.grid import TurbineCubatureGrid
 from floris.core.rotor_velocity import average_velocity
-from floris.core.turbine.operation_models import CosineLossTurbine
-from floris.floris_model import FlorisModel
 
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin.atmosphere_block import atmosphere_of
 from floris_ekman_veer.plugin.crossflow import (
     CROSSFLOW,
     ambient_crossflow,
@@ -52,12 +49,14 @@ from floris_ekman_veer.plugin.crossflow import (
     normal_squares,
     veer_ratio,
 )
+from floris_ekman_veer.plugin.inflow_profile import ambient_velocity
 from floris_ekman_veer.plugin.rotor_cells import (
     AMBIENT_NODES,
     AMBIENT_ROWS,
     rotor_cells,
     row_cell_sums,
 )
+from floris_ekman_veer.plugin.solve_cache import solve
 
 
 def _plain_method(average_method):
@@ -98,8 +97,9 @@ def thrust_veer_ratio(velocities, crossflow, yaw_angles, average_method="cubic-m
     )
 
 
-def _veer_aware(original, kind):
-    """Wrap a cosine-loss static method: without a crossflow it is FLORIS's own, bitwise."""
+def veer_aware_operation(original, kind):
+    """Wrap a cosine-loss static method (``kind``: "power" or "thrust"): without a crossflow it
+    is FLORIS's own, bitwise."""
     signature = inspect.signature(original)
 
     @functools.wraps(original)
@@ -160,12 +160,12 @@ def crossflow_lookup(core):
     None without an atmosphere. V cells are computed once per (rotor, shape).
 
     A table is known by identity: the Core's farm's tables, and those of every farm initialised
-    while the Core solves (:func:`_registering_farm`). FLORIS's full-flow solvers (planes,
+    while the Core solves (:func:`registering_farm`). FLORIS's full-flow solvers (planes,
     ``sample_flow_at_points``) pre-solve the turbines on a deep copy of the farm whose tables
     are new objects; registered, they get the same V cells, so a flow field carries the wakes of
     the thrust the turbine powers see.
     """
-    spec = inflow.atmosphere_of(core)
+    spec = atmosphere_of(core)
     if spec is None or not core.flow_field.n_findex:
         return None
     flow_field = core.flow_field
@@ -191,7 +191,7 @@ def crossflow_lookup(core):
         turbine = min(index for _, _, index in entry[1])
         key = (hub, diameter, turbine, tuple(shape))
         if key not in cache:
-            abl = inflow.solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)
+            abl = solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)
             cache[key] = _cells_crossflow(abl, flow_field.reference_wind_height, hub, diameter,
                                           turbine, shape, core.grid)
         return cache[key]
@@ -216,7 +216,7 @@ def _cells_crossflow(abl, reference_height, hub, diameter, turbine, shape, grid)
         area, cells_shape = cells.area, (cells.n, cells.n)
     else:
         return None
-    u, v = inflow.ambient_velocity(abl, z.reshape(1, 1, 1, -1), reference_height)
+    u, v = ambient_velocity(abl, z.reshape(1, 1, 1, -1), reference_height)
     u, v = (np.broadcast_to(x, (n_findex, 1, 1, z.size)).reshape(n_findex, z.size) for x in (u, v))
     return {name: value.reshape(n_findex, 1, *cells_shape)
             for name, value in cell_moments(u, v, cell_sums, area).items()}
@@ -232,7 +232,8 @@ def veer_aware(core):
         CROSSFLOW.reset(token)
 
 
-def _with_crossflow(method):
+def with_crossflow(method):
+    """FlorisModel's turbine getters: the operation models see the Core's ambient V."""
     @functools.wraps(method)
     def wrapper(self, *args, **kwargs):
         with veer_aware(self.core):
@@ -241,7 +242,7 @@ def _with_crossflow(method):
     return wrapper
 
 
-def _registering_farm(method):
+def registering_farm(method):
     """Farm.initialize: a farm initialised while a Core solves (the full-flow solvers' deep
     copy) joins the Core's crossflow look-up."""
     @functools.wraps(method)
@@ -253,16 +254,3 @@ def _registering_farm(method):
         return result
 
     return wrapper
-
-
-def install_yawed_rotor_hook() -> None:
-    """The veer-aware rotor on by default (idempotent): FLORIS's cosine-loss power and thrust
-    read the crossflow; Core solves (through the inflow hook's Core wrappers) and FlorisModel's
-    turbine getters provide it."""
-    for name, kind in (("power", "power"), ("thrust_coefficient", "thrust")):
-        inflow._patch(CosineLossTurbine, name, lambda original, kind=kind: _veer_aware(original, kind))
-    for name in ("_get_turbine_powers", "get_turbine_thrust_coefficients", "get_turbine_ais"):
-        inflow._patch(FlorisModel, name, _with_crossflow)
-    inflow._patch(Farm, "initialize", _registering_farm)
-    if veer_aware not in inflow.CORE_CONTEXTS:
-        inflow.CORE_CONTEXTS.append(veer_aware)

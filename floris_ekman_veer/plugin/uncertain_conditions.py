@@ -23,16 +23,17 @@ import functools
 
 import numpy as np
 
-from floris_ekman_veer.plugin.inflow import (
-    _patch,
-    _replaced_atmosphere,
+from floris_ekman_veer.plugin.atmosphere_block import (
+    atmosphere_groups,
     atmosphere_of,
+    replaced_atmosphere,
     set_atmosphere,
 )
-from floris_ekman_veer.plugin.optimizer_conditions import atmosphere_groups
 
 
-def _per_condition_set_uncertain(original):
+def per_condition_set_uncertain(original):
+    """UncertainFlorisModel._set_uncertain on per-condition atmospheres (FLORIS's own otherwise)."""
+
     @functools.wraps(original)
     def wrapper(self) -> None:
         fmodel = self.fmodel_unexpanded
@@ -62,7 +63,7 @@ def _per_condition_set_uncertain(original):
 
         self._get_unique_inputs = unique_with_atmosphere
         try:
-            with _replaced_atmosphere(fmodel.core, None):
+            with replaced_atmosphere(fmodel.core, None):
                 original(self)
         finally:
             del self._get_unique_inputs
@@ -74,10 +75,3 @@ def _per_condition_set_uncertain(original):
         set_atmosphere(self.fmodel_expanded, atmosphere)
 
     return wrapper
-
-
-def install_uncertain_hook() -> None:
-    """Wrap ``UncertainFlorisModel._set_uncertain`` (idempotent; ``register()`` calls it)."""
-    from floris.uncertain_floris_model import UncertainFlorisModel
-
-    _patch(UncertainFlorisModel, "_set_uncertain", _per_condition_set_uncertain)
