@@ -2,7 +2,7 @@
 a module that (directly or through others) imports it back; and the layers of
 docs/architecture.md#what-each-folder-may-import hold: the physics (``atmosphere/``, ``wake/``)
 imports no FLORIS and nothing of the plugin or the studies, the plugin (``plugin/``) nothing of
-the studies (``studies/``), and nothing imports the old paths (``coupling/``, ``validation/``).
+the studies (``studies/``).
 
 The graph is read from the source with ``ast``, so a cycle hidden in a function-level import
 counts as much as one at the top of a file. A package's own ``__init__`` that Python runs before
@@ -12,7 +12,6 @@ any of its modules is not an edge; an explicit ``import floris_ekman_veer`` is.
 from __future__ import annotations
 
 import ast
-import re
 from pathlib import Path
 
 PACKAGE = "floris_ekman_veer"
@@ -100,18 +99,18 @@ def test_physics_does_not_import_floris():
 # The layers, lowest first (docs/architecture.md#what-each-folder-may-import): a module may import
 # its own layer and the ones below it. The base is the package's shared helpers (input checks,
 # warnings, version, example inputs); the top is the package itself and the registry, which wire
-# the plugin and the studies into FLORIS; the old paths are aliases that nothing imports.
-LAYERS = ("base", "physics", "plugin", "studies", "top", "old paths")
+# the plugin and the studies into FLORIS.
+LAYERS = ("base", "physics", "plugin", "studies", "top")
 BASE = {f"{PACKAGE}._validation", f"{PACKAGE}._version", f"{PACKAGE}.warnings",
-        f"{PACKAGE}.example_inputs", f"{PACKAGE}._old_paths"}
+        f"{PACKAGE}.example_inputs"}
 
 
 def layer(name: str) -> str:
     if name in BASE:
         return "base"
     part = name.split(".")[1] if "." in name else ""
-    return {"atmosphere": "physics", "wake": "physics", "plugin": "plugin", "studies": "studies",
-            "coupling": "old paths", "validation": "old paths"}.get(part, "top")
+    return {"atmosphere": "physics", "wake": "physics", "plugin": "plugin",
+            "studies": "studies"}.get(part, "top")
 
 
 def test_every_module_has_its_layer():
@@ -121,7 +120,6 @@ def test_every_module_has_its_layer():
     assert layers[f"{PACKAGE}.studies.optimization"] == "studies"
     assert layers[f"{PACKAGE}.studies.validation.cases"] == "studies"
     assert layers[f"{PACKAGE}.registry"] == layers[PACKAGE] == "top"
-    assert layers[f"{PACKAGE}.coupling"] == layers[f"{PACKAGE}.validation"] == "old paths"
     # every layer holds modules, so that no rule below passes on an empty layer
     assert set(layers.values()) == set(LAYERS)
 
@@ -129,33 +127,6 @@ def test_every_module_has_its_layer():
 def test_imports_point_down_the_layers():
     wrong = [f"{name} ({layer(name)}) imports {other} ({layer(other)})"
              for name, others in internal_edges().items() for other in sorted(others)
-             if LAYERS.index(layer(other)) > LAYERS.index(layer(name))
-             and not (layer(name) == "old paths" or other == f"{PACKAGE}._old_paths")]
+             if LAYERS.index(layer(other)) > LAYERS.index(layer(name))]
     assert not wrong, "\n".join(wrong)
 
-
-def test_nothing_imports_the_old_paths():
-    wrong = [f"{name} imports {other}" for name, others in internal_edges().items()
-             for other in others if layer(other) == "old paths" and layer(name) != "old paths"]
-    assert not wrong, "\n".join(wrong)
-
-
-def test_the_old_paths_are_the_new_modules():
-    """A user's old import gets the very module of the new path: a monkeypatch of one is a
-    monkeypatch of the other, and the classes are the same classes (docs/architecture.md#old-import-paths)."""
-    import importlib
-
-    import floris_ekman_veer.coupling as coupling  # old path
-    import floris_ekman_veer.validation as validation  # old path
-
-    for package, shim in ((f"{PACKAGE}.coupling", coupling), (f"{PACKAGE}.validation", validation)):
-        text = MODULES[package].read_text()
-        old = sorted(set(re.findall(r'^    "(\w+)": "([\w.]+)",$', text, re.MULTILINE)))
-        assert len(old) == {"coupling": 20, "validation": 4}[package.rpartition(".")[2]]
-        for short, new in old:
-            module = importlib.import_module(f"{package}.{short}")
-            assert module is importlib.import_module(new) is getattr(shim, short)
-            assert layer(new) in ("plugin", "studies", "top")
-    from floris_ekman_veer.coupling.inflow import set_atmosphere  # old path
-    from floris_ekman_veer.plugin import inflow
-    assert set_atmosphere is inflow.set_atmosphere

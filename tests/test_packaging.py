@@ -36,9 +36,6 @@ assert "site-packages" in str(DATA) and (DATA / "PyWake-LICENSE.txt").is_file(),
 assert HORNS_REV.layout[0].size == 80 and len(list(DATA.glob("*.dat"))) == 60  # Lillgrund too
 assert (DATA / "Lillgrund_layout.csv").is_file() and (DATA / "SWT-2.3-93_power_ct.csv").is_file()
 import floris_ekman_veer.plugin.inflow, floris_ekman_veer.studies.energy  # every layer ships
-import floris_ekman_veer.coupling.inflow as old_inflow  # the old path ships as an alias too
-import floris_ekman_veer.validation.cases as old_cases  # old path
-assert old_inflow is floris_ekman_veer.plugin.inflow and old_cases.DATA == DATA
 """
 
 
