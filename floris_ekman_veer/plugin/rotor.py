@@ -469,7 +469,7 @@ ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
 #: whatever the rotor, so a larger rotor needs more strips per point. 24 strips over the NREL
 #: 5 MW's 126 m (5.25 m) give its single wakes within 0.04 % of the converged reference; the IEA
 #: 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its
-#: 150 m hub), with 48 by 0.15 % (tests/test_multiwake.py).
+#: 150 m hub), with 48 by 0.15 % (tests/plugin/test_multiwake.py).
 MAX_ROW_SPACING = 126.0 / 24.0
 
 
@@ -566,7 +566,7 @@ def turbine_grid_inflow(profile, grid) -> np.ndarray:
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
 #: rotor points can lie a round-off (~1e-13 m) downstream of x_i, where the wake is already 2a
-#: deep: without the margin a turbine sits in its own wake (tests/test_models.py). FLORIS's gauss
+#: deep: without the margin a turbine sits in its own wake (tests/plugin/test_models.py). FLORIS's gauss
 #: model uses the same 0.1 m.
 ROTOR_PLANE_MARGIN = 0.1
 

@@ -8,7 +8,7 @@ Every condition's optimum depends on that condition alone, so :func:`optimize_ya
 optimiser once per distinct atmosphere (and per chunk of conditions, for the progress bar) on
 a model holding just those conditions with that atmosphere as scalars, and puts the rows of
 FLORIS's ``df_opt`` frames back in the caller's order. The result is, by construction, the
-result of running each distinct atmosphere on its own (tests/test_optimization.py measures it).
+result of running each distinct atmosphere on its own (tests/studies/test_optimization.py measures it).
 """
 
 from __future__ import annotations
@@ -108,8 +108,8 @@ def optimize_yaw(
     the serial refine batches its grids (:class:`BothSignsRefinement`,
     docs/yaw_steering.md#how-both-signs-are-searched): measured within 0.05 % of farm power of
     a brute-force 1-degree search refined by Nelder-Mead on held-out 3-turbine rows
-    (tests/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
-    own run on a 3 x 3 farm and on 3-turbine rows (tests/test_yaw_search.py,
+    (tests/studies/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
+    own run on a 3 x 3 farm and on 3-turbine rows (tests/studies/test_yaw_search.py,
     benchmarks/bench_yaw_search.py). Other
     optimisers reporting farm power (``YawOptimizationScipy``) run over the given bounds, over
     their negative and positive parts, and once more within +-:data:`REFINE_FRACTION` of each
@@ -698,7 +698,7 @@ def _reinitialize_conditions(self, **kwargs):
     and every condition is one of the subset's, already validated; the flow field, the wake
     models (with the atmosphere the subset now carries), the per-condition set-points and the
     grid are built as FLORIS builds them (``Core.__attrs_post_init__``). Results are bitwise
-    those of the full rebuild (tests/test_optimization.py).
+    those of the full rebuild (tests/studies/test_optimization.py).
     """
     given = {k for k, v in kwargs.items() if v is not None}
     core = self.core
