@@ -1,5 +1,6 @@
 """The package's imports point one way: no module imports, at module level or inside a function,
-a module that (directly or through others) imports it back; and the layers of
+a module that (directly or through others) imports it back; no module imports another
+dynamically (``importlib.import_module``, ``__import__``) or uses its private names; and the layers of
 docs/architecture.md#what-each-folder-may-import hold: the physics (``atmosphere/``, ``wake/``)
 imports no FLORIS and nothing of the plugin or the studies, the plugin (``plugin/``) nothing of
 the studies (``studies/``).
@@ -130,3 +131,144 @@ def test_imports_point_down_the_layers():
              if LAYERS.index(layer(other)) > LAYERS.index(layer(name))]
     assert not wrong, "\n".join(wrong)
 
+
+
+# ------------------------------------------------------- no hidden channels between modules
+# A module reaches another only through its public names: no ``importlib.import_module`` or
+# ``__import__`` (an import the graph above cannot see), no ``from x import _name`` of another
+# module's private name, no ``module._name`` and no ``obj._name`` where ``_name`` is private to
+# another module of the package (a function, class, method or attribute it defines and this
+# module does not).
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__") and name != "_"
+
+
+def private_definitions(tree: ast.AST) -> set[str]:
+    """The private names a module defines: functions, classes, methods, assigned names and
+    attributes (``self._cache = ...``, attrs fields)."""
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            found.add(node.name)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            found.add(node.id)
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+            found.add(node.attr)
+        elif isinstance(node, ast.arg):
+            found.add(node.arg)
+    return {name for name in found if _is_private(name)}
+
+
+def hidden_channels(name: str, tree: ast.AST, private_elsewhere: dict[str, set[str]]) -> list[tuple[int, str]]:
+    """(line, what) of each dynamic import and each use of another module's private name in the
+    module ``name``; ``private_elsewhere`` maps each other module to the private names it defines."""
+    package = name if name in PACKAGES else name.rpartition(".")[0]
+    own = private_definitions(tree)
+    others = set().union(*private_elsewhere.values()) if private_elsewhere else set()
+    aliases: dict[str, str] = {}  # local name -> package module it is bound to
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == PACKAGE:
+                    aliases[alias.asname or alias.name.split(".")[0]] = alias.name if alias.asname else PACKAGE
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            if base.split(".")[0] != PACKAGE:
+                continue
+            for alias in node.names:
+                if f"{base}.{alias.name}" in MODULES or f"{base}.{alias.name}" in private_elsewhere:
+                    aliases[alias.asname or alias.name] = f"{base}.{alias.name}"
+                elif _is_private(alias.name):
+                    found.append((node.lineno, f"imports {alias.name} of {base}"))
+        elif isinstance(node, ast.Call):
+            func = node.func
+            called = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if called in ("import_module", "__import__"):
+                found.append((node.lineno, f"calls {called}"))
+    for node in ast.walk(tree):
+        if not (isinstance(node, ast.Attribute) and _is_private(node.attr)):
+            continue
+        value = node.value
+        if isinstance(value, ast.Name) and value.id in aliases:
+            if aliases[value.id] != name:
+                found.append((node.lineno, f"uses {node.attr} of {aliases[value.id]}"))
+        elif (not (isinstance(value, ast.Name) and value.id in ("self", "cls"))
+              and node.attr not in own and node.attr in others):
+            owners = sorted(m for m, names in private_elsewhere.items() if node.attr in names)
+            found.append((node.lineno, f"uses {node.attr} of {' or '.join(owners)}"))
+    return sorted(set(found))
+
+
+PACKAGES = {name for name, path in MODULES.items() if path.name == "__init__.py"}
+
+# Today's hidden channels, each "module: what" (the line numbers are in the failure message).
+# An entry that is no longer found fails the test too, so that the list only shrinks.
+KNOWN_VIOLATIONS = {
+    # Removed by the restructuring; the lead empties this at merge.
+    # - the fit reaches EkmanABL through its module and its private methods:
+    f"{PACKAGE}.atmosphere.fit: calls import_module",
+    f"{PACKAGE}.atmosphere.fit: uses _parameters of {PACKAGE}.atmosphere.ekman",
+    f"{PACKAGE}.atmosphere.fit: uses _solved_at of {PACKAGE}.atmosphere.ekman",
+    f"{PACKAGE}.atmosphere.fit: uses _state of {PACKAGE}.atmosphere.ekman",
+    f"{PACKAGE}.atmosphere.fit: uses _velocity of {PACKAGE}.atmosphere.ekman",
+    # - FLORIS patched from several modules through the inflow's private _patch:
+    f"{PACKAGE}.plugin.parallel: imports _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.plugin.solver: uses _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.plugin.wake_settings: imports _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.plugin.yawed_rotor: uses _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.studies.optimization: imports _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.studies.uncertain: imports _patch of {PACKAGE}.plugin.inflow",
+    f"{PACKAGE}.studies.uncertain: imports _replaced_atmosphere of {PACKAGE}.plugin.inflow",
+    # - the annual energy uses the cluster module's private helpers:
+    f"{PACKAGE}.studies.energy: imports _check_workers of {PACKAGE}.studies.distributed",
+    f"{PACKAGE}.studies.energy: imports _import_distributed of {PACKAGE}.studies.distributed",
+    # Found by this test beyond the restructuring's list (wake/ and plugin/solver.py): each
+    # helper wants a public name in the module that defines it.
+    f"{PACKAGE}.plugin.solver: imports _EkmanWakeModel of {PACKAGE}.plugin.models",
+    f"{PACKAGE}.wake.deflection: imports _initial_radius of {PACKAGE}.wake.deficit",
+    f"{PACKAGE}.wake.fused: imports _initial_radius of {PACKAGE}.wake.deficit",
+    f"{PACKAGE}.wake.gaussian2014: imports _thrust_coefficient of {PACKAGE}.wake.deficit",
+}
+
+
+def package_channels() -> dict[str, list[tuple[int, str]]]:
+    trees = {name: ast.parse(path.read_text(), filename=str(path)) for name, path in MODULES.items()}
+    defined = {name: private_definitions(tree) for name, tree in trees.items()}
+    return {name: hidden_channels(name, tree, {m: d for m, d in defined.items() if m != name})
+            for name, tree in trees.items()}
+
+
+def test_hidden_channels_are_found():
+    elsewhere = {f"{PACKAGE}.plugin.inflow": {"_patch", "_cache"},
+                 f"{PACKAGE}.atmosphere.ekman": {"_solved_at", "_state"}}
+    source = (
+        "import importlib\n"
+        "from floris_ekman_veer.plugin import inflow\n"
+        "from floris_ekman_veer.plugin.inflow import _cache, set_atmosphere\n"
+        "physics = importlib.import_module('floris_ekman_veer.atmosphere.ekman')\n"
+        "__import__('floris_ekman_veer.plugin.inflow')\n"
+        "inflow._patch()\n"
+        "def fit(abl):\n"
+        "    return abl._solved_at(1.0), abl._own(), _own(), abl.__class__, set_atmosphere\n"
+        "def _own():\n"
+        "    pass\n"
+    )
+    found = hidden_channels(f"{PACKAGE}.atmosphere.fit", ast.parse(source), elsewhere)
+    assert [what for _, what in found] == [
+        f"imports _cache of {PACKAGE}.plugin.inflow", "calls import_module", "calls __import__",
+        f"uses _patch of {PACKAGE}.plugin.inflow", f"uses _solved_at of {PACKAGE}.atmosphere.ekman"]
+    assert [line for line, _ in found] == [3, 4, 5, 6, 8]
+
+
+def test_no_dynamic_imports_or_private_names_across_modules():
+    found = {f"{name}: {what}": line for name, channels in package_channels().items()
+             for line, what in channels}
+    new = sorted(f"{key} (line {line})" for key, line in found.items() if key not in KNOWN_VIOLATIONS)
+    assert not new, "\n".join(new)
+    gone = sorted(KNOWN_VIOLATIONS - set(found))
+    assert not gone, "no longer found, remove from KNOWN_VIOLATIONS:\n" + "\n".join(gone)
