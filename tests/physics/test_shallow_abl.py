@@ -127,6 +127,9 @@ def test_no_warning_when_every_rotor_is_inside_the_boundary_layer():
         FlorisModel(config).run()
 
 
+# Where h crosses the hub, a reference speed lies in the profile's step at the ABL top: its
+# ReferenceWindWarning (the closest state taken) is tested in tests/physics/test_convective_properties.py.
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.ReferenceWindWarning")
 @pytest.mark.parametrize("height", [HUB, HUB + RADIUS], ids=["hub", "rotor_top"])
 def test_farm_power_is_continuous_where_h_crosses_the_rotor(height):
     """Power just below and just above the wind speed at which h equals the hub height (or

@@ -31,6 +31,12 @@ MODELS = ("gauss", "gch", "cc", "jensen", "turbopark")
 N_TURBINES = 9
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 def floris_model(wake):
     config = copy.deepcopy(load_yaml(FARM))
     choice = dict(EXAMPLE_WAKES[wake])
@@ -111,6 +117,9 @@ def test_issue_reproducer_light_wind_batch():
     np.testing.assert_array_equal(powers[[0, 5]], pair)
 
 
+# Light yawed winds (3-5 m/s) load rotors beyond max_thrust_coefficient by design: the
+# ThrustLimitWarning is tested in tests/test_user_inputs_and_warnings.py, not here.
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.ThrustLimitWarning")
 def test_ekman_veer_light_wind_yawed_farm_raises_no_numpy_warning():
     """The ekman_veer model reads FLORIS's axial induction, 0.5/cos b (1 - sqrt(1 - ct_i cos b)),
     of the veer-aware thrust: with C_T above 1 numpy warned 'invalid value encountered in sqrt'

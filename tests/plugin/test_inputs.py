@@ -27,6 +27,12 @@ PAPER_COOLING_RATES = {
 }
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 @pytest.mark.parametrize("case, cooling_rate", PAPER_COOLING_RATES.items())
 def test_paper_case_inputs(case, cooling_rate):
     """The wind speed of each paper-case file is the 100 m speed of the paper's atmosphere with

@@ -61,6 +61,12 @@ SPACING = 630.0
 # Independent formulas (written here from the paper, not imported from the package)
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 def disk_thrust_coefficient(yaw_deg=0.0):
     """Un-yawed-basis C_T(beta) = 16 C_T' / (4 + C_T' cos^2 beta)^2 of the fixed-C_T' disk."""
     cos2 = np.cos(np.deg2rad(yaw_deg)) ** 2

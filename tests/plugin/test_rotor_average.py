@@ -34,6 +34,12 @@ INPUTS = Path(__file__).resolve().parents[2] / "inputs"
 # ---------------------------------------------------------------------------------- 1. cells
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 @pytest.mark.parametrize("n", [1, 2, 3, 4])
 def test_cells_partition_the_disk_in_equal_areas_around_their_points(n):
     cells = rotor_cells(n, 64 * n, 4)

@@ -208,6 +208,12 @@ SCRIPT = textwrap.dedent(
 )
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 # The cluster run is a long study (a fresh interpreter, a LocalCluster of two worker processes, a
 # FLORIS optimiser and steered annual-energy studies on it, each against its serial run): its
 # tests carry the marker study and run in .ci/run after the fast suite (README, "Set up"); the

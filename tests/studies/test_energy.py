@@ -19,6 +19,12 @@ FARM = Path(__file__).resolve().parents[2] / "inputs" / "farm_sbl6.yaml"
 YAW = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 @pytest.fixture(scope="module")
 def row():
     """The SBL-6 farm input cut to a 3-turbine row at 7 D (wind from 270 deg along it)."""

@@ -17,6 +17,12 @@ from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 FARM = Path(__file__).resolve().parents[2] / "inputs" / "farm_sbl6.yaml"
 
 
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")
+
+
 @pytest.fixture(scope="module")
 def records_row():
     """A 3-turbine row with 6 conditions of 3 atmospheres (neutral, mid, SBL-6) in mixed order."""

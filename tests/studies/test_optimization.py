@@ -24,7 +24,10 @@ from floris_ekman_veer.studies.optimization import atmosphere_groups
 
 from conftest import STABLE_ATMOSPHERE, assert_as_plain_floris, make_config
 
-pytestmark = pytest.mark.usefixtures("inflow_hook")
+# The stable atmospheres of these farms give, in some conditions and by design, boundary layers
+# shallower than the NREL 5 MW rotor top (153 m); their ShallowBoundaryLayerWarning is not what
+# is tested here (tests/physics/test_shallow_abl.py and tests/test_user_inputs_and_warnings.py are).
+pytestmark = [pytest.mark.usefixtures("inflow_hook"), pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")]
 
 INPUTS = Path(__file__).resolve().parents[2] / "inputs"
 
