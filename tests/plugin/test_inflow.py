@@ -208,6 +208,9 @@ def test_vertical_plane_uses_profile():
                                atol=1e-12)
 
 
+# The map given with the atmosphere warns how they combine: tested in
+# tests/test_user_inputs_and_warnings.py::test_heterogeneous_map_with_the_atmosphere_warns_how_they_combine.
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.HeterogeneousInflowWarning")
 def test_heterogeneous_speed_ups_multiply_the_profile():
     fmodel = ekman_model(wind_speeds=(8.0,))
     fmodel.set(heterogeneous_inflow_config={

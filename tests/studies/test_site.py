@@ -44,13 +44,21 @@ def row_model():
     config["wake"]["enable_secondary_steering"] = False
     config["wake"]["enable_yaw_added_recovery"] = False
     config["wake"]["enable_transverse_velocities"] = False
+    config["flow_field"]["wind_shear"] = 0.0  # the atmosphere gives the shear; no GCH term reads it
     return FlorisModel(config)
+
+
+# FLORIS's default sosfs with the incoming-speed deficits is row_model's set-up: its
+# ModelSettingsWarning is tested in tests/plugin/test_models.py::test_summed_wakes_are_asked_for_with_incoming_deficits.
+ROW_MODEL_SETTINGS = pytest.mark.filterwarnings(
+    "ignore:wake.model_strings.combination_model:floris_ekman_veer.ModelSettingsWarning")
 
 
 def test_package_exports_fit_site():
     assert floris_ekman_veer.fit_site is fit_site and "fit_site" in floris_ekman_veer.__all__
 
 
+@ROW_MODEL_SETTINGS
 def test_floris_run_gives_back_the_fitted_profiles():
     records, truth = records_of([8.0, 10.0, 6.0], [np.inf, 150.0, 300.0], [270.0, 265.0, 280.0])
     site = fit_site(records, 90.0, stability_input="obukhov_length", **SITE)
@@ -75,6 +83,10 @@ def test_floris_run_gives_back_the_fitted_profiles():
     np.testing.assert_allclose(series.turbulence_intensities, site.turbulence_intensities)
 
 
+@ROW_MODEL_SETTINGS
+# The records' turbulence intensities, which ekman_veer does not read (a notice tested in
+# tests/plugin/test_floris_input_messages.py), go to the GCH comparison.
+@pytest.mark.filterwarnings("ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning")
 def test_annual_energy_and_optimize_yaw_run_per_record():
     records, _ = records_of([8.0, 8.0, 9.0], [np.inf, 150.0, 150.0], [270.0, 270.0, 272.0],
                             noise=1.0, seed=5)
@@ -123,6 +135,7 @@ def test_misfits_are_refused_or_dropped_by_record():
         pytest.approx(float(site.profile_fit.stability_parameter[0]))]
 
 
+@ROW_MODEL_SETTINGS
 def test_bad_tables_are_refused():
     records, _ = records_of([8.0], [200.0], [270.0])
     with pytest.raises(ValueError, match=r"speed columns at two heights or more"):
