@@ -39,7 +39,8 @@ def test_the_pages_have_snippets():
 def test_snippet_runs_as_written(code, tmp_path):
     script = tmp_path / "snippet.py"
     script.write_text(code)
-    env = {**os.environ, "MPLBACKEND": "Agg"}  # the snippets import the installed package
+    env = {**os.environ, "MPLBACKEND": "Agg",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, f"the snippet failed:\n{code}\n--- stderr:\n{run.stderr[-3000:]}"
