@@ -35,7 +35,6 @@ import gc
 import io
 import os
 import pstats
-import sys
 import time
 import tracemalloc
 from pathlib import Path
@@ -43,11 +42,7 @@ from pathlib import Path
 import numpy as np
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401
 
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402

@@ -46,7 +46,6 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_models  # noqa: E402  (the farm, the inputs and the conditions)
 
 import numexpr  # noqa: E402

@@ -27,7 +27,7 @@ worst case, and the errors of an unwaked rotor (the ambient profile alone). ``--
 
 Multiple wakes: every turbine's power with the shipped settings (the farm input's wake settings:
 sosfs, crespo_hernandez, local_turbulence; 3 x 3 rotor cells) against the converged point-wise
-reference of tests/multiwake_reference.py (FLORIS's point-wise sosfs, wake-added turbulence and
+reference of tests/plugin/multiwake_reference.py (FLORIS's point-wise sosfs, wake-added turbulence and
 cubic mean on 4,096 equal-area points per rotor), for the layouts of MULTIWAKE_CASES in the
 SBL-6, SBL-4 and neutral atmospheres: the largest |P / P_ref - 1| over turbines and conditions.
 """
@@ -43,16 +43,12 @@ from pathlib import Path
 import numpy as np
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401
 
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-sys.path.insert(0, str(REPOSITORY / "tests"))
+sys.path.insert(0, str(REPOSITORY / "tests" / "plugin"))  # the tests' reference, not the package
 from multiwake_reference import (  # noqa: E402
     FARM_3X3,
     SIDE_BY_SIDE,

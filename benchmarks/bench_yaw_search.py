@@ -16,7 +16,7 @@
 3. Rebuild: the 3 x 3 night farm with an Obukhov length per condition, both signs, with the
    optimiser subsets' condition rebuild and with FLORIS's full Core rebuild per evaluation
    (plugin/optimizer_conditions.py ``_reinitialize_conditions``): time and bitwise comparison.
-4. Shortfall: 3-turbine rows held out from the yaw study (tests/test_yaw_search.py): the farm
+4. Shortfall: 3-turbine rows held out from the yaw study (tests/studies/test_yaw_search.py): the farm
    power of FLORIS's single run and of the both-signs search against a brute-force search on a
    1-degree grid of all three yaws refined by Nelder-Mead (the reference the tests build), for
    bounds -25..25 deg.
@@ -40,7 +40,7 @@ from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "studies"))  # the tests' reference, not the package
 import test_yaw_search as reference  # noqa: E402
 
 OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5, 4])

@@ -19,13 +19,8 @@ Lillgrund) and of Horns Rev's farm efficiency against the LES. Takes about 3 min
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
-try:
-    import floris_ekman_veer  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+import floris_ekman_veer  # noqa: F401
 
 from floris_ekman_veer.studies.validation import metrics, models  # noqa: E402
 from floris_ekman_veer.studies.validation.cases import HORNS_REV, LILLGRUND  # noqa: E402

@@ -28,18 +28,13 @@ from __future__ import annotations
 
 import argparse
 import copy
-import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401
-except ImportError:
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401
 
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402

@@ -17,7 +17,6 @@ h, mu, alpha_0, the veer across the rotor, I_u(z_h) and k_w, and writes to DIR (
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -26,7 +25,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_cases import CASE_FILES, Case, arguments  # noqa: E402
 
 from floris_ekman_veer.atmosphere.turbulence import (  # noqa: E402

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -43,11 +42,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
 
 from floris import FlorisModel  # noqa: E402
 from floris.flow_visualization import visualize_cut_plane  # noqa: E402

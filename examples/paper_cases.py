@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import sys
 import time
 from pathlib import Path
 
@@ -50,11 +49,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
 
 from floris import FlorisModel  # noqa: E402
 from floris.cut_plane import rescale_axis  # noqa: E402
@@ -148,7 +143,7 @@ class Case:
         flow = config["flow_field"]
         self.reference_height = float(flow["reference_wind_height"])
         self.wind_speed = float(flow["wind_speeds"][0])
-        # the ABL FLORIS solves from the file's wind speed (G = 15 m/s, tests/test_inputs.py)
+        # the ABL FLORIS solves from the file's wind speed (G = 15 m/s, tests/plugin/test_inputs.py)
         self.abl = EkmanABL.from_reference_wind(self.wind_speed, self.reference_height,
                                                 **self.atmosphere)
         self.hub_speed = float(self.abl.speed(self.hub_height))

@@ -14,7 +14,7 @@ FLORIS gives the downstream ``actuator-disk`` turbine, 1/2 rho pi R^2 C_T' [(1 -
 U_d its rotor average of u (Eqs. P_hyp, Ud), so P/P0 = (U_d/U_h)^3, Eq. (P_ratio). FLORIS runs
 all cases and yaws as conditions of one model (per-condition atmospheres) and the y_T of one x_T as
 a few rows of downstream turbines at least ``ROW_SPACING`` apart, which do not interact (no wake
-reaches a turbine in the same rotor plane; tests/test_examples.py checks a row against two-turbine
+reaches a turbine in the same rotor plane; tests/docs/test_examples.py checks a row against two-turbine
 farms). The rotor average is
 FLORIS's, on the quadrature ``ROTOR_SOLVERS`` (the inputs' turbine grid, whose rotor cells
 integrate the disk, for M-1, M-2 and M-3; FLORIS's finest cubature for GCH and cc); it is checked against a direct disk integration of
@@ -22,7 +22,7 @@ Eq. (P_ratio): a polar Gauss rule (16 x 48 points) over the disk of the flow FLO
 the upstream turbine alone. For GCH and cc behind a yawed turbine the two differ by more than the
 quadrature: FLORIS computes their yaw-added recovery and secondary steering differently in its
 turbine solve and in its flow sampling, also without this package
-(tests/test_examples.py::test_floris_gch_turbine_solve_and_flow_sampling_differ_behind_yaw); the
+(tests/docs/test_examples.py::test_floris_gch_turbine_solve_and_flow_sampling_differ_behind_yaw); the
 P/P0 shown is the turbine solve's, what FLORIS gives a farm.
 
 Prints the minimum P/P0 and its y_T for each case, yaw, x_T and model, the differences between
@@ -33,7 +33,6 @@ FLORIS's rotor average and the disk integration. Writes to DIR (default ./output
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
@@ -43,7 +42,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_cases import (  # noqa: E402
     BETAS,
     MODELS,

@@ -20,13 +20,12 @@ Run it from anywhere (after ``pip install .``, or from a checkout):
 4. Writes the figure of measured vs fitted profiles and the FLORIS input with the per-record
    atmosphere block (PNG and YAML to DIR, default ./output).
 
-``run_example(reduced=True)`` is the same on four records (tests/test_site.py).
+``run_example(reduced=True)`` is the same on four records (tests/studies/test_site.py).
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -34,11 +33,7 @@ from pathlib import Path
 import numpy as np
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
 
 import pandas as pd  # noqa: E402
 import yaml  # noqa: E402

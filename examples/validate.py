@@ -25,7 +25,6 @@ docs/validation.md. Prints the tables. Takes 6 to 10 minutes on two (loaded) cor
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
@@ -37,7 +36,6 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from paper_cases import arguments, report  # noqa: E402
 
 from floris_ekman_veer.studies.validation.atmospheres import (  # noqa: E402

@@ -24,13 +24,12 @@ the NREL 5 MW rotor top, and its rows are flagged.
    wake steering.
 
 Figures (PNG) go to DIR (default ./output); tables are printed. ``run_study(reduced=True)`` is the
-same computation on a coarser grid (tests/test_yaw_study.py).
+same computation on a coarser grid (tests/docs/test_yaw_study_example.py).
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -38,11 +37,7 @@ from pathlib import Path
 import numpy as np
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer  # noqa: F401
+import floris_ekman_veer  # noqa: F401  (registers the models and the Ekman inflow hook)
 
 import pandas as pd  # noqa: E402
 from floris import FlorisModel, WindRose  # noqa: E402

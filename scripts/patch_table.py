@@ -4,7 +4,7 @@ docs/coupling.md#what-is-patched, between its two marker lines:
     python scripts/patch_table.py          # rewrite the table
     python scripts/patch_table.py --check  # exit 1 if the page's table is not the installed one
 
-``tests/test_patches.py`` runs the check.
+``tests/plugin/test_patches.py`` runs the check.
 """
 
 from __future__ import annotations

@@ -93,6 +93,10 @@ def make_config(
     config["flow_field"]["wind_directions"] = list(wind_directions)
     config["flow_field"]["turbulence_intensities"] = [0.06] * len(wind_speeds)
     config["flow_field"]["reference_wind_height"] = reference_wind_height
+    if atmosphere is not None and not gch:
+        # The atmosphere gives the inflow's shear and only GCH's terms read FLORIS's wind_shear:
+        # 0.0 says so, as the ModelSettingsWarning of FLORIS's default 0.12 asks.
+        config["flow_field"]["wind_shear"] = 0.0
     return config
 
 

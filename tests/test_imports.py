@@ -1,8 +1,9 @@
 """The package's imports point one way: no module imports, at module level or inside a function,
-a module that (directly or through others) imports it back; and the layers of
+a module that (directly or through others) imports it back; no module imports another
+dynamically (``importlib.import_module``, ``__import__``) or uses its private names; and the layers of
 docs/architecture.md#what-each-folder-may-import hold: the physics (``atmosphere/``, ``wake/``)
 imports no FLORIS and nothing of the plugin or the studies, the plugin (``plugin/``) nothing of
-the studies (``studies/``), and nothing imports the old paths (``coupling/``, ``validation/``).
+the studies (``studies/``).
 
 The graph is read from the source with ``ast``, so a cycle hidden in a function-level import
 counts as much as one at the top of a file. A package's own ``__init__`` that Python runs before
@@ -12,7 +13,6 @@ any of its modules is not an edge; an explicit ``import floris_ekman_veer`` is.
 from __future__ import annotations
 
 import ast
-import re
 from pathlib import Path
 
 PACKAGE = "floris_ekman_veer"
@@ -100,18 +100,18 @@ def test_physics_does_not_import_floris():
 # The layers, lowest first (docs/architecture.md#what-each-folder-may-import): a module may import
 # its own layer and the ones below it. The base is the package's shared helpers (input checks,
 # warnings, version, example inputs); the top is the package itself and the registry, which wire
-# the plugin and the studies into FLORIS; the old paths are aliases that nothing imports.
-LAYERS = ("base", "physics", "plugin", "studies", "top", "old paths")
-BASE = {f"{PACKAGE}._validation", f"{PACKAGE}._version", f"{PACKAGE}.warnings", f"{PACKAGE}.warning_classes",
-        f"{PACKAGE}.example_inputs", f"{PACKAGE}._old_paths"}
+# the plugin and the studies into FLORIS.
+LAYERS = ("base", "physics", "plugin", "studies", "top")
+BASE = {f"{PACKAGE}._validation", f"{PACKAGE}._version", f"{PACKAGE}.warnings",
+        f"{PACKAGE}.warning_classes", f"{PACKAGE}.example_inputs"}
 
 
 def layer(name: str) -> str:
     if name in BASE:
         return "base"
     part = name.split(".")[1] if "." in name else ""
-    return {"atmosphere": "physics", "wake": "physics", "plugin": "plugin", "studies": "studies",
-            "coupling": "old paths", "validation": "old paths"}.get(part, "top")
+    return {"atmosphere": "physics", "wake": "physics", "plugin": "plugin",
+            "studies": "studies"}.get(part, "top")
 
 
 def test_every_module_has_its_layer():
@@ -121,7 +121,6 @@ def test_every_module_has_its_layer():
     assert layers[f"{PACKAGE}.studies.optimization"] == "studies"
     assert layers[f"{PACKAGE}.studies.validation.cases"] == "studies"
     assert layers[f"{PACKAGE}.registry"] == layers[PACKAGE] == "top"
-    assert layers[f"{PACKAGE}.coupling"] == layers[f"{PACKAGE}.validation"] == "old paths"
     # every layer holds modules, so that no rule below passes on an empty layer
     assert set(layers.values()) == set(LAYERS)
 
@@ -129,33 +128,122 @@ def test_every_module_has_its_layer():
 def test_imports_point_down_the_layers():
     wrong = [f"{name} ({layer(name)}) imports {other} ({layer(other)})"
              for name, others in internal_edges().items() for other in sorted(others)
-             if LAYERS.index(layer(other)) > LAYERS.index(layer(name))
-             and not (layer(name) == "old paths" or other == f"{PACKAGE}._old_paths")]
+             if LAYERS.index(layer(other)) > LAYERS.index(layer(name))]
     assert not wrong, "\n".join(wrong)
 
 
-def test_nothing_imports_the_old_paths():
-    wrong = [f"{name} imports {other}" for name, others in internal_edges().items()
-             for other in others if layer(other) == "old paths" and layer(name) != "old paths"]
-    assert not wrong, "\n".join(wrong)
+
+# ------------------------------------------------------- no hidden channels between modules
+# A module reaches another only through its public names: no ``importlib.import_module`` or
+# ``__import__`` (an import the graph above cannot see), no ``from x import _name`` of another
+# module's private name, no ``module._name`` and no ``obj._name`` where ``_name`` is private to
+# another module of the package (a function, class, method or attribute it defines and this
+# module does not).
+
+def _is_private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__") and name != "_"
 
 
-def test_the_old_paths_are_the_new_modules():
-    """A user's old import gets the very module of the new path: a monkeypatch of one is a
-    monkeypatch of the other, and the classes are the same classes (docs/architecture.md#old-import-paths)."""
-    import importlib
+def private_definitions(tree: ast.AST) -> set[str]:
+    """The private names a module defines: functions, classes, methods, assigned names and
+    attributes (``self._cache = ...``, attrs fields)."""
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            found.add(node.name)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            found.add(node.id)
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+            found.add(node.attr)
+        elif isinstance(node, ast.arg):
+            found.add(node.arg)
+    return {name for name in found if _is_private(name)}
 
-    import floris_ekman_veer.coupling as coupling  # old path
-    import floris_ekman_veer.validation as validation  # old path
 
-    for package, shim in ((f"{PACKAGE}.coupling", coupling), (f"{PACKAGE}.validation", validation)):
-        text = MODULES[package].read_text()
-        old = sorted(set(re.findall(r'^    "(\w+)": "([\w.]+)",$', text, re.MULTILINE)))
-        assert len(old) == {"coupling": 20, "validation": 4}[package.rpartition(".")[2]]
-        for short, new in old:
-            module = importlib.import_module(f"{package}.{short}")
-            assert module is importlib.import_module(new) is getattr(shim, short)
-            assert layer(new) in ("plugin", "studies", "top")
-    from floris_ekman_veer.coupling.inflow import set_atmosphere  # old path
-    from floris_ekman_veer.plugin import inflow
-    assert set_atmosphere is inflow.set_atmosphere
+def hidden_channels(name: str, tree: ast.AST, private_elsewhere: dict[str, set[str]]) -> list[tuple[int, str]]:
+    """(line, what) of each dynamic import and each use of another module's private name in the
+    module ``name``; ``private_elsewhere`` maps each other module to the private names it defines."""
+    package = name if name in PACKAGES else name.rpartition(".")[0]
+    own = private_definitions(tree)
+    others = set().union(*private_elsewhere.values()) if private_elsewhere else set()
+    aliases: dict[str, str] = {}  # local name -> package module it is bound to
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == PACKAGE:
+                    aliases[alias.asname or alias.name.split(".")[0]] = alias.name if alias.asname else PACKAGE
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            if base.split(".")[0] != PACKAGE:
+                continue
+            for alias in node.names:
+                if f"{base}.{alias.name}" in MODULES or f"{base}.{alias.name}" in private_elsewhere:
+                    aliases[alias.asname or alias.name] = f"{base}.{alias.name}"
+                elif _is_private(alias.name):
+                    found.append((node.lineno, f"imports {alias.name} of {base}"))
+        elif isinstance(node, ast.Call):
+            func = node.func
+            called = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if called in ("import_module", "__import__"):
+                found.append((node.lineno, f"calls {called}"))
+    for node in ast.walk(tree):
+        if not (isinstance(node, ast.Attribute) and _is_private(node.attr)):
+            continue
+        value = node.value
+        if isinstance(value, ast.Name) and value.id in aliases:
+            if aliases[value.id] != name:
+                found.append((node.lineno, f"uses {node.attr} of {aliases[value.id]}"))
+        elif (not (isinstance(value, ast.Name) and value.id in ("self", "cls"))
+              and node.attr not in own and node.attr in others):
+            owners = sorted(m for m, names in private_elsewhere.items() if node.attr in names)
+            found.append((node.lineno, f"uses {node.attr} of {' or '.join(owners)}"))
+    return sorted(set(found))
+
+
+PACKAGES = {name for name, path in MODULES.items() if path.name == "__init__.py"}
+
+# Today's hidden channels, each "module: what" (the line numbers are in the failure message).
+# An entry that is no longer found fails the test too, so that the list only shrinks.
+KNOWN_VIOLATIONS: set[str] = set()
+
+
+def package_channels() -> dict[str, list[tuple[int, str]]]:
+    trees = {name: ast.parse(path.read_text(), filename=str(path)) for name, path in MODULES.items()}
+    defined = {name: private_definitions(tree) for name, tree in trees.items()}
+    return {name: hidden_channels(name, tree, {m: d for m, d in defined.items() if m != name})
+            for name, tree in trees.items()}
+
+
+def test_hidden_channels_are_found():
+    elsewhere = {f"{PACKAGE}.plugin.inflow": {"_patch", "_cache"},
+                 f"{PACKAGE}.atmosphere.ekman": {"_solved_at", "_state"}}
+    source = (
+        "import importlib\n"
+        "from floris_ekman_veer.plugin import inflow\n"
+        "from floris_ekman_veer.plugin.inflow import _cache, set_atmosphere\n"
+        "physics = importlib.import_module('floris_ekman_veer.atmosphere.ekman')\n"
+        "__import__('floris_ekman_veer.plugin.inflow')\n"
+        "inflow._patch()\n"
+        "def fit(abl):\n"
+        "    return abl._solved_at(1.0), abl._own(), _own(), abl.__class__, set_atmosphere\n"
+        "def _own():\n"
+        "    pass\n"
+    )
+    found = hidden_channels(f"{PACKAGE}.atmosphere.fit", ast.parse(source), elsewhere)
+    assert [what for _, what in found] == [
+        f"imports _cache of {PACKAGE}.plugin.inflow", "calls import_module", "calls __import__",
+        f"uses _patch of {PACKAGE}.plugin.inflow", f"uses _solved_at of {PACKAGE}.atmosphere.ekman"]
+    assert [line for line, _ in found] == [3, 4, 5, 6, 8]
+
+
+def test_no_dynamic_imports_or_private_names_across_modules():
+    found = {f"{name}: {what}": line for name, channels in package_channels().items()
+             for line, what in channels}
+    new = sorted(f"{key} (line {line})" for key, line in found.items() if key not in KNOWN_VIOLATIONS)
+    assert not new, "\n".join(new)
+    gone = sorted(KNOWN_VIOLATIONS - set(found))
+    assert not gone, "no longer found, remove from KNOWN_VIOLATIONS:\n" + "\n".join(gone)

@@ -34,7 +34,7 @@ What the hook sets
   +67 % at zero yaw; -0.25 K/h (h = 197 m, 25 deg): +2.7 %, and +7.8 % with the first turbine
   yawed 20 deg; neutral (0 K/h, 0.5 deg of backing): +0.1 to +1.1 %. Unwaked turbines do not
   change (wind direction 300 deg: 0 %), i.e. the effect is purely a spurious wake steering. See
-  ``tests/test_inflow.py::test_ambient_v_would_change_gch``. The veer reaches this package's own
+  ``tests/plugin/test_inflow.py::test_ambient_v_would_change_gch``. The veer reaches this package's own
   deflection model through :func:`solved_atmosphere` instead.
 * Turbulence intensities remain FLORIS's inputs (see
   :func:`floris_ekman_veer.studies.comparison.builtin_inflow_settings` for values consistent with

@@ -11,7 +11,7 @@ bar) on a model holding just those conditions with that atmosphere as scalars
 atmosphere follows its conditions through the optimiser's tiling (:func:`row_following_subset`),
 and puts the rows of FLORIS's ``df_opt`` frames back in the caller's order. The result is, by
 construction, the result of running each distinct atmosphere on its own
-(tests/test_optimization.py measures it). :func:`~floris_ekman_veer.optimize_yaw` and the
+(tests/studies/test_optimization.py measures it). :func:`~floris_ekman_veer.optimize_yaw` and the
 optimisers' own ``optimize()`` on a per-condition atmosphere
 (:mod:`~floris_ekman_veer.plugin.optimizer_hooks`) run it.
 """
@@ -207,7 +207,7 @@ def _reinitialize_conditions(self, **kwargs):
     already validated; the flow field, the wake
     models (with the atmosphere the subset now carries), the per-condition set-points and the
     grid are built as FLORIS builds them (``Core.__attrs_post_init__``). Results are bitwise
-    those of the full rebuild (tests/test_optimization.py).
+    those of the full rebuild (tests/studies/test_optimization.py).
     """
     given = {k for k, v in kwargs.items() if v is not None}
     core = self.core

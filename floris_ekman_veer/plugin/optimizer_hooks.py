@@ -89,7 +89,7 @@ def _dispatching_optimize(original):
     return wrapper
 
 
-_RECORD = ("keeps the options of the user's constructor call, with which {name}.optimize() "
+_RECORD = ("keeps the options of the user's constructor call, with which {name} "
            "rebuilds the optimiser per atmosphere on a per-condition atmosphere")
 _DISPATCH = ("the optimiser tiles, masks and re-orders its model's conditions, which a "
              "per-condition atmosphere cannot follow: on one, optimize() runs the optimiser "
@@ -98,9 +98,9 @@ _DISPATCH = ("the optimiser tiles, masks and re-orders its model's conditions, w
 #: FLORIS's yaw optimisers' patched attributes (FLORIS 4.7: the base class defines
 #: ``__init__``, each of its three optimisers ``__init__`` and ``optimize``).
 PATCHES: tuple[Patch, ...] = (
-    wrapped(YawOptimization, "__init__", _recording_init, _RECORD.format(name="a subclass's")),
+    wrapped(YawOptimization, "__init__", _recording_init, _RECORD.format(name="a subclass's optimize()")),
     *(row for cls in (YawOptimizationSR, YawOptimizationScipy, YawOptimizationGeometric)
-      for row in (wrapped(cls, "__init__", _recording_init, _RECORD.format(name=cls.__name__)),
+      for row in (wrapped(cls, "__init__", _recording_init, _RECORD.format(name=f"{cls.__name__}.optimize()")),
                   wrapped(cls, "optimize", _dispatching_optimize, _DISPATCH))),
 )
 

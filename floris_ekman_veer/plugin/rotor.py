@@ -34,7 +34,7 @@ _OVERLAP = (f"where((du > {WAKE_OVERLAP_VELOCITY!r}) & (abs(dy + centre) < reach
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
 #: rotor points can lie a round-off (~1e-13 m) downstream of x_i, where the wake is already 2a
-#: deep: without the margin a turbine sits in its own wake (tests/test_models.py). FLORIS's gauss
+#: deep: without the margin a turbine sits in its own wake (tests/plugin/test_models.py). FLORIS's gauss
 #: model uses the same 0.1 m.
 ROTOR_PLANE_MARGIN = 0.1
 

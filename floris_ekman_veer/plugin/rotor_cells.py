@@ -316,7 +316,7 @@ ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
 #: whatever the rotor, so a larger rotor needs more strips per point. 24 strips over the NREL
 #: 5 MW's 126 m (5.25 m) give its single wakes within 0.04 % of the converged reference; the IEA
 #: 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its
-#: 150 m hub), with 48 by 0.15 % (tests/test_multiwake.py).
+#: 150 m hub), with 48 by 0.15 % (tests/plugin/test_multiwake.py).
 MAX_ROW_SPACING = 126.0 / 24.0
 
 

@@ -14,7 +14,7 @@ atmosphere would be merged. The wrapper of ``_set_uncertain`` therefore
   (docs/coupling.md#yaw-optimisation).
 
 Results are those of one UncertainFlorisModel per distinct atmosphere
-(tests/test_optimization.py).
+(tests/studies/test_optimization.py).
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ Every condition's optimum depends on that condition alone, so :func:`optimize_ya
 optimiser once per distinct atmosphere (and per chunk of conditions, for the progress bar) on
 a model holding just those conditions with that atmosphere as scalars, and puts the rows of
 FLORIS's ``df_opt`` frames back in the caller's order. The result is, by construction, the
-result of running each distinct atmosphere on its own (tests/test_optimization.py measures it):
+result of running each distinct atmosphere on its own (tests/studies/test_optimization.py measures it):
 plugin/optimizer_conditions.py runs them, plugin/optimizer_options.py checks the options
 first. The default search over both signs of yaw is studies/yaw_search.py.
 """
@@ -68,8 +68,8 @@ def optimize_yaw(
     the serial refine batches its grids (studies/yaw_search.py,
     docs/yaw_steering.md#how-both-signs-are-searched): measured within 0.05 % of farm power of
     a brute-force 1-degree search refined by Nelder-Mead on held-out 3-turbine rows
-    (tests/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
-    own run on a 3 x 3 farm and on 3-turbine rows (tests/test_yaw_search.py,
+    (tests/studies/test_yaw_search.py), evaluating at most twice the conditions of the serial refine's
+    own run on a 3 x 3 farm and on 3-turbine rows (tests/studies/test_yaw_search.py,
     benchmarks/bench_yaw_search.py). Other
     optimisers reporting farm power (``YawOptimizationScipy``) run over the given bounds, over
     their negative and positive parts, and once more within +-:data:`REFINE_FRACTION` of each

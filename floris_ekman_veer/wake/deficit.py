@@ -34,7 +34,7 @@ WIDTH_FACTOR = 0.4
 # --------------------------------------------------------------------------------------------
 
 
-def _thrust_coefficient(ct) -> np.ndarray:
+def unyawed_thrust_coefficient(ct) -> np.ndarray:
     """C_T of an unyawed formula (M-3) as a float array, required in [0, 1) (momentum theory)."""
     ct = np.asarray(ct, dtype=float)
     require((ct >= 0.0) & (ct < 1.0), "ct", "in [0, 1) (un-yawed thrust coefficient)", ct)
@@ -63,7 +63,7 @@ def _momentum_root(ct, yaw) -> np.ndarray:
     return np.sqrt(1.0 - loading)
 
 
-def _initial_radius(radius, ct, yaw) -> np.ndarray:
+def initial_radius(radius, ct, yaw) -> np.ndarray:
     """R sqrt(A*), the radius of the expanded stream tube: the length unit of Eqs. (xi0_theta),
     (that) and (yhatc)."""
     return positive(radius, "radius") * np.sqrt(stream_tube_area_ratio(ct, yaw))
@@ -110,7 +110,7 @@ def sigma_tilde_squared(x, k_w, radius, ct, yaw):
     """
     x = np.asarray(x, dtype=float)
     k_w = positive(k_w, "k_w")
-    width0 = WIDTH_FACTOR * _initial_radius(radius, ct, yaw)
+    width0 = WIDTH_FACTOR * initial_radius(radius, ct, yaw)
     return (k_w * x + width0) * (k_w * x + width0 * np.cos(yaw))
 
 
@@ -131,7 +131,7 @@ def potential_core_length(k_w, radius, ct, yaw):
     """
     k_w = positive(k_w, "k_w")
     radius = positive(radius, "radius")
-    r_tube = _initial_radius(radius, ct, yaw)
+    r_tube = initial_radius(radius, ct, yaw)
     cos_b = np.cos(yaw)
     root = np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * radius**2 * cos_b)
     return (root + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * k_w)
@@ -199,7 +199,7 @@ def initial_wake_shape(sin_t, radius, ct, yaw):
     require(np.abs(sin_t) <= 1.0, "sin_t", "in [-1, 1]", sin_t)
     sin_b = np.sin(yaw)
     return (
-        _initial_radius(radius, ct, yaw)
+        initial_radius(radius, ct, yaw)
         * np.abs(np.cos(yaw))
         / np.sqrt(1.0 - sin_b**2 * sin_t**2)
     )

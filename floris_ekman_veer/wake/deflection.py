@@ -16,7 +16,7 @@ from floris_ekman_veer._validation import positive
 
 from .deficit import (
     WIDTH_FACTOR,
-    _initial_radius,
+    initial_radius,
     time_like_variable,
 )
 
@@ -62,7 +62,7 @@ def yaw_deflection(t_hat, z, hub_height, radius, ct, yaw, ground_image=True):
     if not ground_image:
         return vortex_pair * np.ones_like(np.asarray(z, dtype=float))
     hub_height = positive(hub_height, "hub_height")
-    r_tube = _initial_radius(radius, ct, yaw)
+    r_tube = initial_radius(radius, ct, yaw)
     eta = np.maximum((np.asarray(z, dtype=float) + hub_height) / r_tube, 1.0 + IMAGE_CORE)
     return vortex_pair - (2.0 / np.pi) * t_hat / (eta**2 - 1.0)
 
@@ -108,7 +108,7 @@ def wake_centre_offset(
     """
     t_hat = time_like_variable(x, friction_velocity, hub_speed, local_speed, radius, ct, yaw)
     y_hat = yaw_deflection(t_hat, z, hub_height, radius, ct, yaw, ground_image=ground_image)
-    offset = y_hat * _initial_radius(radius, ct, yaw)
+    offset = y_hat * initial_radius(radius, ct, yaw)
     if not veer:
         return offset
     if lateral_speed is None:

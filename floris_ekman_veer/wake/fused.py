@@ -5,7 +5,7 @@ this module evaluates the same formula where most factors are shared: per wake (
 the stream-tube radius, beta) and per height (t_hat and the three tanh of Eq. xi_emp depend on
 z only, through U(z)), leaving per point only the polar harmonics, the width and the Gaussian.
 numexpr (a FLORIS dependency) runs that per-point part in a single pass without temporaries.
-tests/test_rotor_average.py checks it against ``normalised_deficit`` to round-off.
+tests/plugin/test_rotor_average.py checks it against ``normalised_deficit`` to round-off.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 from .deficit import (
     CURL_ALPHA,
     WIDTH_FACTOR,
-    _initial_radius,
+    initial_radius,
     max_deficit,
     time_like_growth,
     time_like_strength,
@@ -89,7 +89,7 @@ _DEFICIT = f"amplitude * exp(-(dy**2 + dz**2) / (2 * {_SIGMA}**2))"
 def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True):
     """The per-wake factors of Eq. (du_model) (see :func:`rows_deficit_parameters`), evaluated
     once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor."""
-    r_tube = _initial_radius(radius, ct, yaw)
+    r_tube = initial_radius(radius, ct, yaw)
     parameters = {
         "amplitude": max_deficit(x, k_w, radius, ct, yaw),
         "kx": np.asarray(k_w) * np.asarray(x),

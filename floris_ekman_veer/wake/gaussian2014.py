@@ -19,7 +19,7 @@ import numpy as np
 
 from floris_ekman_veer._validation import positive
 
-from .deficit import _thrust_coefficient
+from .deficit import unyawed_thrust_coefficient
 
 def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     """Normalised deficit Delta u / U_inf of the Bastankhah & Porte-Agel (2014) Gaussian wake.
@@ -37,7 +37,7 @@ def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     x = np.asarray(x, dtype=float)
     dy = np.asarray(dy, dtype=float)
     dz = np.asarray(dz, dtype=float)
-    ct = _thrust_coefficient(ct)
+    ct = unyawed_thrust_coefficient(ct)
     diameter = positive(diameter, "diameter")
     k_star = positive(k_star, "k_star")
     root = np.sqrt(1.0 - ct)

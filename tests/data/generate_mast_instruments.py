@@ -1,5 +1,5 @@
 """A SYNTHETIC year of met-mast records with the effects of real instruments, seeded
-(docs/measurements.md#a-real-mast): the fixture of tests/test_mast_instruments.py and of
+(docs/measurements.md#a-real-mast): the fixture of tests/studies/test_mast_instruments.py and of
 examples/site_year.py.
 
 The mast is the usual one of a wind-resource campaign (IEC 61400-12-1 Annex G; the IEA Wind
@@ -48,7 +48,6 @@ The instruments, each effect seeded and recorded (module constants):
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +55,6 @@ import pandas as pd
 from scipy import stats
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1]))
 from floris_ekman_veer.atmosphere.ekman import EkmanABL  # noqa: E402
 
 SEED = 2026

@@ -1,6 +1,6 @@
 """Generate tests/data/mast_year.csv.gz: a SYNTHETIC year of hourly met-mast records (8,760) with
 every kind of record a real mast logs, for the site workflow's end-to-end test
-(tests/test_site_year.py, docs/measurements.md#a-year-of-records).
+(tests/studies/test_site_year.py, docs/measurements.md#a-year-of-records).
 
 A 150 m mast at 52 N over grass (z0 = 0.05 m), cup anemometers and vanes at 30, 70, 110 and
 150 m; the hub-height (90 m) wind speed is Weibull (k 2, scale 8.5 m/s), its direction a slow
@@ -26,14 +26,12 @@ speed and direction of a height together). Speeds are rounded to 0.01 m/s and di
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1]))
 from floris_ekman_veer.atmosphere.ekman import EkmanABL  # noqa: E402
 
 OUTPUT = HERE / "mast_year.csv.gz"

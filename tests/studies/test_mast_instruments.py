@@ -1,0 +1,264 @@
+"""A real mast's instruments through fit_site (docs/measurements.md#a-real-mast): vanes at their
+own heights, vane offsets, stuck vanes, two booms with mast shadow, cup spikes, the cups'
+standard deviations; the seeded year of tests/data/generate_mast_instruments.py fitted with the
+defaults; the site report (summary, energy by class and month, one warning per class)."""
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import floris_ekman_veer
+from floris_ekman_veer import fit_site
+from floris_ekman_veer.studies import mast
+from floris_ekman_veer.studies.site_records import neutral_turning as _neutral_turning
+from tests.data.generate_mast_instruments import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS,
+                                                  VANE_OFFSETS, mast_year, shadow_deficit)
+
+SITE = dict(latitude=53.3, roughness_length=0.05)
+
+
+@pytest.fixture(scope="module")
+def year():
+    return mast_year()
+
+
+@pytest.fixture(scope="module")
+def instruments(year):
+    return mast.read_instruments(year, mast.mast_columns(year, BOOMS), 80.0,
+                                 _neutral_turning(SITE), booms=BOOMS)
+
+
+@pytest.fixture(scope="module")
+def site(year):
+    """The year fitted as a site engineer would: the defaults and the mast's booms."""
+    # Five northerly records turn by less than a degree within 0 to 2 pi, as directions in
+    # radians would: said once, naming them.
+    with pytest.warns(floris_ekman_veer.DirectionUnitsWarning, match=r"the directions of 5 record\(s\)"):
+        return fit_site(year, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+
+
+# ---------------------------------------------------------------------------- the generator
+def test_the_generator_is_seeded_and_makes_what_it_documents(year):
+    again = mast_year()
+    pd.testing.assert_frame_equal(again, year)
+    assert len(year) == 8760
+    assert {f"speed_{h:.0f}m_{b}" for h in CUP_HEIGHTS for b in BOOMS} <= set(year.columns)
+    assert {f"speed_{h:.0f}m_{b}_std" for h in CUP_HEIGHTS for b in BOOMS} <= set(year.columns)
+    assert {f"direction_{h:.0f}m" for h in VANE_HEIGHTS} <= set(year.columns)
+    kinds = year["true_class"].value_counts()
+    assert set(kinds.index) == {"convective", "neutral", "stable"} and kinds.min() > 500
+    # Convective middays, stable nights: the diurnal cycle a fit should find.
+    hour = pd.to_datetime(year["time"]).dt.hour
+    assert (year["true_class"][hour == 13] == "convective").mean() > 0.2
+    assert (year["true_class"][hour.isin([0, 1, 2, 3])] == "stable").mean() > 0.6
+    assert year.loc[year["true_class"] == "convective", "true_obukhov_length"].between(-150, -10).all()
+    assert year.loc[year["true_class"] == "stable", "true_obukhov_length"].between(20, 200).all()
+    # Icing: N_ICING runs of one vane repeating its reading.
+    stuck = pd.concat([year[f"true_stuck_{h:.0f}m"] for h in VANE_HEIGHTS], ignore_index=True)
+    assert (stuck.astype(int).diff() == 1).sum() == N_ICING
+    # The mast's wake: the cup on the boom at 135 deg reads low when the wind comes from 315.
+    assert shadow_deficit(315.0, 135.0) == pytest.approx(0.25) and shadow_deficit(45.0, 135.0) < 1e-6
+    wake = np.abs((year["true_direction_80m"] - 315.0 + 180.0) % 360.0 - 180.0) < 5.0
+    ratio = (year["speed_80m_a"] / year["speed_80m_b"])[wake]
+    assert 0.72 < ratio.median() < 0.8
+    # Ten-minute records for two years: the same generator.
+    ten = mast_year(periods=200, freq="10min")
+    assert pd.to_datetime(ten["time"]).diff().iloc[1] == pd.Timedelta("10min")
+
+
+# ------------------------------------------------------------------------ the instruments
+def test_cups_out_of_the_mast_wake_are_chosen_and_both_averaged_where_clear():
+    frame = pd.DataFrame({"speed_40m_a": [7.0, 5.0, 7.0, 7.0], "speed_40m_b": [6.0, 6.0, 6.9, 9.5],
+                          "speed_80m": [8.0, 8.0, 8.0, 8.0],
+                          "direction_40m": [135.0, 315.0, 45.0, 45.0],
+                          "direction_80m": [135.0, 315.0, 45.0, 45.0]})
+    columns = mast.mast_columns(frame, {"a": 135.0, "b": 315.0})
+    got = mast.read_instruments(frame, columns, 80.0, _neutral_turning(SITE),
+                                booms={"a": 135.0, "b": 315.0}, direction_offsets=None)
+    # From 135 deg the cup on boom b (315) is behind the mast: a is used; from 315, b is used
+    # (a reads 17 % low behind the mast); from 45 neither is in the wake: the mean; a pair
+    # 2.5 m/s apart there disagrees and is named.
+    np.testing.assert_allclose(got.speeds[:, 0], [7.0, 6.0, 6.95, np.nan])
+    flags = got.flags
+    assert list(flags["row"]) == [3] and flags["kind"].iloc[0] == "cups disagree"
+    assert "speed_40m_a 7, speed_40m_b 9.5" in flags["reason"].iloc[0]
+
+
+def test_stuck_vanes_are_found_and_their_records_named(year, instruments):
+    flags = instruments.flags[instruments.flags["kind"] == "stuck vane"]
+    found = {(r, c) for r, c in zip(flags["row"], flags["column"])}
+    true = {(r, f"direction_{h:.0f}m") for h in VANE_HEIGHTS
+            for r in np.flatnonzero(year[f"true_stuck_{h:.0f}m"])}
+    # Every icing reading found (a run interrupted by a missing value may lose its last one),
+    # and no chance repeat of a turning vane taken for one.
+    assert len(true - found) <= 2 and found <= true
+    assert flags["reason"].str.contains(r"in \d+ records in a row .*\(icing\)").all()
+
+
+def test_vane_offsets_are_found_within_a_tenth_of_the_half_degree(instruments, site):
+    for table in (instruments.offsets, site.offsets):
+        for height, offset in VANE_OFFSETS.items():
+            row = table.loc[height]
+            assert row["offset_deg"] == pytest.approx(offset, abs=0.5)
+            if offset:
+                assert row["source"] == "estimated" and row["records"] > 300
+                assert 0.0 < row["uncertainty_deg"] < 0.15
+    # Given offsets are applied as given (the reading minus the truth).
+    given = fit_site(mast_year(periods=48), 80.0, on_misfit="drop", booms=BOOMS,
+                     direction_offsets={38: -4.1, 58: 2.6}, **SITE)
+    assert given.offsets["offset_deg"].tolist() == [-4.1, 2.6, 0.0]
+    assert given.offsets["source"].tolist() == ["given", "given", "reference"]
+    with pytest.raises(ValueError, match=r"direction_offsets names a vane at 40 m"):
+        fit_site(mast_year(periods=48), 80.0, booms=BOOMS, direction_offsets={40: 1.0}, **SITE)
+
+
+def test_cup_pairs_agree_within_their_calibration(instruments):
+    pairs = instruments.cup_pairs
+    assert list(pairs["height"]) == list(CUP_HEIGHTS)
+    assert (np.abs(pairs["median_ratio"] - 1.0) < 0.03).all() and not pairs["disagree"].any()
+
+
+def test_a_pair_that_disagrees_over_the_year_is_named(year):
+    drifted = year.head(500).copy()
+    drifted["speed_60m_b"] *= 1.06  # a cup calibrated 6 % high
+    site = fit_site(drifted, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    pairs = site.summary().cup_pairs.set_index("height")
+    assert pairs.loc[60.0, "disagree"] and not pairs.loc[40.0, "disagree"]
+    assert pairs.loc[60.0, "median_ratio"] == pytest.approx(1.06 * 1.015, abs=0.01)
+
+
+def test_one_inf_reading_is_named_by_its_time_stamp_and_aborts_nothing(year):
+    records = year.head(24).copy()
+    records.loc[3, "speed_80m_a"] = np.inf
+    records.loc[5, "direction_58m"] = -np.inf
+    site = fit_site(records, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    bad = site.flags[site.flags["kind"] == "infinite reading"]
+    assert list(bad["time"]) == [records["time"][3], records["time"][5]]
+    assert records["time"][3] in site.labels and records["time"][5] in site.labels
+
+
+def test_the_cups_standard_deviations_are_the_fits_turbulence(year):
+    records = year.head(48)
+    with_std = fit_site(records, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    without = fit_site(records.drop(columns=[c for c in records if c.endswith("_std")]), 80.0,
+                       on_misfit="drop", booms=BOOMS, **SITE)
+    common = sorted(set(with_std.labels) & set(without.labels))
+    assert len(common) > 40
+    # The measured I_u at 80 m: the fit with it lands nearer it than the fit without.
+    truth = {t: i for t, i in zip(records["time"], (records["speed_80m_a_std"] + records[
+        "speed_80m_b_std"]) / (records["speed_80m_a"] + records["speed_80m_b"]))}
+
+    def error(site):
+        fitted = dict(zip(site.labels, site.abl.turbulence_intensity(80.0)))
+        return np.nanmedian([abs(fitted[t] / truth[t] - 1.0) for t in common])
+
+    assert error(with_std) < 0.8 * error(without)
+
+
+@pytest.mark.parametrize("reference_height, match", [
+    ("90", r"reference_height must be a number > 0 m \(not a string\); got '90'"),
+    (1e4, r"reference_height must be at most 2 times the highest measurement \(80 m"),
+    (True, r"reference_height must be a number"),
+])
+def test_bad_reference_heights_are_named(year, reference_height, match):
+    with pytest.raises(ValueError, match=match):
+        fit_site(year.head(5), reference_height, booms=BOOMS, **SITE)
+
+
+def test_bad_columns_and_options_are_named(year):
+    records = year.head(5)
+    with pytest.raises(ValueError, match=r"time_column 'nope' is not a column of records"):
+        fit_site(records, 80.0, booms=BOOMS, time_column="nope", **SITE)
+    with pytest.raises(ValueError, match=r"columns \['speed_-30m'\] are named like measurements"):
+        fit_site(records.assign(**{"speed_-30m": 1.0}), 80.0, booms=BOOMS, **SITE)
+    with pytest.raises(ValueError, match=r"name booms without an orientation: give fit_site"):
+        fit_site(records, 80.0, **SITE)
+    with pytest.raises(ValueError, match=r"booms\['a'\] must be the boom's orientation"):
+        fit_site(records, 80.0, booms={"a": "SE", "b": 315.0}, **SITE)
+    with pytest.raises(ValueError, match=r"direction_offsets must be 'estimate', None or"):
+        fit_site(records, 80.0, booms=BOOMS, direction_offsets=[1.0], **SITE)
+    # Other statistics of a record (Task 43's min, max, a vane's sd) are left alone.
+    plain = fit_site(records, 80.0, booms=BOOMS, on_misfit="drop", **SITE)
+    more = fit_site(records.assign(speed_80m_a_max=30.0, speed_40m_b_min=0.0,
+                                   direction_78m_std=3.0), 80.0, booms=BOOMS, on_misfit="drop",
+                    **SITE)
+    np.testing.assert_array_equal(more.wind_speeds, plain.wind_speeds)
+
+
+# ------------------------------------------------------------------- the year, with defaults
+def test_the_year_is_kept_its_offsets_found_and_its_classes_read(year, site):
+    """The acceptance of docs/measurements.md#a-real-mast: with the defaults, at least 95 % of
+    the non-calm records kept, the offsets within 0.5 deg, and the fitted classes the
+    generator's for at least 85 % of the kept records."""
+    not_calm = ~year["true_calm"].to_numpy()
+    assert np.sum(not_calm[site.rows]) >= 0.95 * np.sum(not_calm)
+    truth = year["true_class"].to_numpy()[site.rows]
+    assert list(site.labels) == list(year["time"].iloc[site.rows])
+    matched = np.mean(truth == site.stability_classes)
+    assert matched >= 0.85
+    # Each class is read, not one swallowing the others.
+    for name in ("convective", "neutral", "stable"):
+        assert np.mean(site.stability_classes[truth == name] == name) >= 0.8, name
+
+
+def test_the_summary_reads_like_a_site_report(year, site, tmp_path):
+    summary = site.summary()
+    assert summary.records == 8760 and summary.fitted == len(site.labels)
+    assert summary.kept_fraction == pytest.approx(len(site.labels) / 8760)
+    assert summary.exclusions.loc["fitted", "records"] == len(site.labels)
+    assert summary.exclusions["records"].sum() == 8760
+    by_hour = summary.class_by_hour
+    assert by_hour.shape == (24, 3) and by_hour.to_numpy().sum() == len(site.labels)
+    # Convective by day, stable by night.
+    share = by_hour.div(by_hour.sum(axis=1), axis=0)
+    assert share.loc[13, "convective"] > 0.3 > share.loc[2, "convective"]
+    assert share.loc[2, "stable"] > 0.6 > share.loc[13, "stable"]
+    text = str(summary)
+    assert "vane offsets applied" in text and "class mix by hour of day" in text
+    assert "stuck vane" in text and "cups disagree" in text
+    import matplotlib
+
+    matplotlib.use("Agg")
+    ax = summary.plot_class_by_hour()
+    ax.figure.savefig(tmp_path / "classes.png")
+    assert (tmp_path / "classes.png").stat().st_size > 1000
+
+
+def test_annual_energy_of_a_fitted_year_is_by_class_and_month_with_one_warning_each(year):
+    from floris import FlorisModel
+
+    records = year.iloc[np.r_[0:60, 4400:4460]]  # January and July
+    site = fit_site(records, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        energy = site.annual_energy(fmodel, models=("ekman_veer",), chunk_size=16)
+    table = energy.table.set_index("stability")
+    assert set(table.index) == {"convective", "neutral", "stable", "all"}
+    counts = pd.Series(site.stability_classes).value_counts()
+    for name, n in counts.items():
+        assert table.loc[name, "n_conditions"] == n
+    by_month = energy.by_month.set_index("period")
+    assert list(by_month.index) == ["2025-01", "2025-07"]
+    assert by_month["aep_baseline_gwh"].sum() == pytest.approx(table.loc["all", "aep_baseline_gwh"],
+                                                               rel=1e-12)
+    # Eight chunks, one warning per class, located at this line, with speeds to 0.01 m/s.
+    ours = [w for w in caught if issubclass(w.category, floris_ekman_veer.FlorisEkmanVeerWarning)]
+    assert len(ours) == len({w.category for w in ours}) >= 1
+    assert all(w.filename == __file__ for w in ours)
+    for w in ours:
+        speeds = str(w.message).partition("wind speeds ")[2].partition(" m/s")[0]
+        assert not any(len(v.partition(".")[2]) > 2 for v in speeds.replace(",", " ").split()
+                       if v[0].isdigit()), speeds
+
+
+def test_site_report_example_reduced(tmp_path, capsys):
+    """examples/site_report.py on ten days of records: the report, the truth and the PNG."""
+    import site_report  # examples/ is on pytest's pythonpath (pyproject.toml)
+
+    site_report.main(["--output", str(tmp_path), "--periods", "240", "--no-energy"])
+    out = capsys.readouterr().out
+    assert "class mix by hour of day" in out and "vane offsets found (given)" in out
+    assert (tmp_path / "site_classes_by_hour.png").stat().st_size > 10_000
