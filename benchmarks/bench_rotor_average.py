@@ -1,6 +1,6 @@
 """Convergence of the rotor average on single and multiple wakes (hand-run study, not a test):
 
-    python benchmarks/bench_rotor_average.py [--reference 48x192] [--quick] [--multiwake]
+    python -m benchmarks.bench_rotor_average [--reference 48x192] [--quick] [--multiwake]
 
 ``--multiwake`` prints only the multi-wake table (below).
 
@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import sys
 import warnings
 from pathlib import Path
 
@@ -48,10 +47,10 @@ import floris_ekman_veer  # noqa: F401
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-sys.path.insert(0, str(REPOSITORY / "tests" / "plugin"))  # the tests' reference, not the package
-from multiwake_reference import (  # noqa: E402
+from tests.plugin.multiwake_reference import (  # noqa: E402  (the tests' reference)
     FARM_3X3,
     SIDE_BY_SIDE,
+    disk_quadrature,
     farm_config,
     power_errors,
     row,
@@ -61,16 +60,6 @@ INPUTS = {"CNBL disk": "cnbl.yaml", "SBL-4 disk": "sbl4.yaml", "SBL-6 disk": "sb
           "NREL 5 MW, farm input": "farm_sbl6.yaml"}
 YAWS = (0.0, 20.0, -20.0)
 QUADRATURES = ("3x3 points", "3x3 cells", "cubature 3", "cubature 5")
-
-
-def disk_quadrature(n_radial: int, n_angle: int):
-    """Unit-disk nodes (y, z) and weights (summing to 1): Gauss-Legendre in r^2, uniform angle."""
-    x, w = np.polynomial.legendre.leggauss(n_radial)
-    r = np.sqrt(0.5 * (x + 1.0))
-    theta = (np.arange(n_angle) + 0.5) * 2.0 * np.pi / n_angle
-    rr, tt = np.meshgrid(r, theta, indexing="ij")
-    weight = np.outer(0.5 * w, np.full(n_angle, 1.0 / n_angle))
-    return (rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel(), weight.ravel()
 
 
 def mean(u, weight, moment):

@@ -1,7 +1,7 @@
 """Cost and accuracy of optimize_yaw's both-signs search against FLORIS's serial refine
 (docs/yaw_steering.md#finding-the-optimum). Hand-run script, not a test:
 
-    PYTHONPATH=. python benchmarks/bench_yaw_search.py [--repeats 3] [--skip-shortfall]
+    python -m benchmarks.bench_yaw_search [--repeats 3] [--skip-shortfall]
 
 1. Cost: the 3 x 3 night farm (inputs/farm_night.yaml, NREL 5 MW at 7 D, L = 100 m), 24
    conditions (wind 255-285 deg in 12 steps x 7 and 9 m/s, TI 6 %), yaw -25..25 deg: FLORIS's
@@ -25,7 +25,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -40,8 +39,7 @@ from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
 from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "studies"))  # the tests' reference, not the package
-import test_yaw_search as reference  # noqa: E402
+from tests.studies import test_yaw_search as reference  # the tests' brute-force reference
 
 OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5, 4])
 

@@ -1,6 +1,6 @@
 """A real mast's year as a site report (docs/measurements.md#a-real-mast).
 
-Makes the SYNTHETIC year of tests/data/generate_mast_instruments.py (seeded: 8,760 hourly
+Makes the SYNTHETIC year of examples/instrumented_mast_year.py (seeded: 8,760 hourly
 records of a 40-80 m mast at 53.3 N with cups on two booms and their standard deviations, vanes
 at 38, 58 and 78 m with offsets, mast shadow, icing, cup spikes, convective days and stable
 nights), fits it with ``fit_site``'s defaults (only the site and the booms given), prints the
@@ -16,7 +16,6 @@ year's energy on the 3 x 3 NREL 5 MW farm of ``inputs/farm_night.yaml`` by class
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -25,8 +24,7 @@ import pandas as pd
 
 import floris_ekman_veer
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.data.generate_mast_instruments import BOOMS, VANE_OFFSETS, mast_year  # noqa: E402
+from instrumented_mast_year import BOOMS, VANE_OFFSETS, mast_year
 
 SITE = dict(latitude=53.3, roughness_length=0.05)
 

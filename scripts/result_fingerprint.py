@@ -20,23 +20,19 @@ from __future__ import annotations
 
 import copy
 import hashlib
-import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-REPOSITORY = Path(__file__).resolve().parent.parent
-try:
-    import floris_ekman_veer
-except ImportError:  # run from a checkout without installing
-    sys.path.insert(0, str(REPOSITORY))
-    import floris_ekman_veer
+import pandas as pd
+from floris import FlorisModel
+from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
+from floris.utilities import load_yaml
 
-import pandas as pd  # noqa: E402
-from floris import FlorisModel  # noqa: E402
-from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR  # noqa: E402
-from floris.utilities import load_yaml  # noqa: E402
+import floris_ekman_veer  # the tree on PYTHONPATH, else the installed one (printed at the end)
+
+REPOSITORY = Path(__file__).resolve().parent.parent
 
 FARM = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 MAST = REPOSITORY / "inputs" / "site" / "synthetic_mast.csv"

@@ -247,3 +247,16 @@ def test_no_dynamic_imports_or_private_names_across_modules():
     assert not new, "\n".join(new)
     gone = sorted(KNOWN_VIOLATIONS - set(found))
     assert not gone, "no longer found, remove from KNOWN_VIOLATIONS:\n" + "\n".join(gone)
+
+
+def test_nothing_edits_the_import_path():
+    """Examples, benchmarks, scripts and tests import the installed package (and the repository's
+    modules through pytest's pythonpath or ``python -m``), never by inserting into sys.path."""
+    repository = ROOT.parent
+    edits = [f"{path.relative_to(repository)}:{number}"
+             for folder in ("examples", "benchmarks", "scripts", "tests")
+             for path in sorted((repository / folder).rglob("*.py"))
+             for number, line in enumerate(path.read_text().splitlines(), 1)
+             if "sys.path." in line and not line.lstrip().startswith(("#", '"', "'"))
+             and path != Path(__file__).resolve()]
+    assert not edits, edits

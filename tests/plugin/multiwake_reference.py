@@ -37,6 +37,16 @@ TURBINE_LIBRARY = Path(floris.__file__).parent / "turbine_library"
 ATMOSPHERES = {"SBL-6": "farm_sbl6.yaml", "SBL-4": "sbl4.yaml", "neutral": "cnbl.yaml"}
 
 
+def disk_quadrature(n_radial: int = 24, n_angle: int = 96):
+    """Unit-disk nodes (y, z) and weights (summing to 1): Gauss-Legendre in r^2, uniform angle."""
+    x, w = np.polynomial.legendre.leggauss(n_radial)
+    r = np.sqrt(0.5 * (x + 1.0))
+    theta = (np.arange(n_angle) + 0.5) * 2.0 * np.pi / n_angle
+    rr, tt = np.meshgrid(r, theta, indexing="ij")
+    weight = np.outer(0.5 * w, np.full(n_angle, 1.0 / n_angle))
+    return (rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel(), weight.ravel()
+
+
 def equal_area_disk(rings: int, angles: int):
     """Unit-disk points (y, z) of equal area: ``rings`` annuli of equal area, ``angles`` uniform
     sectors each (the point at the area-halving radius and the sector's middle angle)."""

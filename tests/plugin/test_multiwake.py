@@ -19,7 +19,7 @@ import pytest
 
 from floris_ekman_veer.plugin.rotor_cells import rotor_cells
 from floris_ekman_veer.plugin.rotor_wakes import RotorWakes
-from multiwake_reference import (
+from tests.plugin.multiwake_reference import (
     extrapolated_powers,
     farm_config,
     power_errors,

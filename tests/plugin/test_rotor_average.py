@@ -27,6 +27,7 @@ import floris_ekman_veer  # noqa: F401  (registers the models)
 from floris_ekman_veer.plugin.rotor_cells import grid_offsets, rotor_cells
 from floris_ekman_veer.wake.deficit import normalised_deficit
 from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
+from tests.plugin.multiwake_reference import disk_quadrature
 
 INPUTS = Path(__file__).resolve().parents[2] / "inputs"
 
@@ -75,15 +76,6 @@ def test_cells_of_the_3x3_grid():
 
 
 # ---------------------------------------------------------------------------- 2. convergence
-
-
-def disk_quadrature(n_radial=24, n_angle=96):
-    x, w = np.polynomial.legendre.leggauss(n_radial)
-    r = np.sqrt(0.5 * (x + 1.0))
-    theta = (np.arange(n_angle) + 0.5) * 2.0 * np.pi / n_angle
-    rr, tt = np.meshgrid(r, theta, indexing="ij")
-    weight = np.outer(0.5 * w, np.full(n_angle, 1.0 / n_angle))
-    return (rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel(), weight.ravel()
 
 
 YAWS = (0.0, 20.0, -20.0)

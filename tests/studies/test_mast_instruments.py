@@ -1,6 +1,6 @@
 """A real mast's instruments through fit_site (docs/measurements.md#a-real-mast): vanes at their
 own heights, vane offsets, stuck vanes, two booms with mast shadow, cup spikes, the cups'
-standard deviations; the seeded year of tests/data/generate_mast_instruments.py fitted with the
+standard deviations; the seeded year of examples/instrumented_mast_year.py fitted with the
 defaults; the site report (summary, energy by class and month, one warning per class)."""
 
 import warnings
@@ -13,8 +13,8 @@ import floris_ekman_veer
 from floris_ekman_veer import fit_site
 from floris_ekman_veer.studies import mast
 from floris_ekman_veer.studies.site_records import neutral_turning as _neutral_turning
-from tests.data.generate_mast_instruments import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS,
-                                                  VANE_OFFSETS, mast_year, shadow_deficit)
+from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS, VANE_OFFSETS,
+                                     mast_year, shadow_deficit)
 
 SITE = dict(latitude=53.3, roughness_length=0.05)
 

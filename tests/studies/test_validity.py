@@ -13,9 +13,9 @@ import pytest
 from floris import FlorisModel
 from floris.utilities import load_yaml
 
+import day_and_night  # examples/ is on pytest's pythonpath (pyproject.toml)
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
 from floris_ekman_veer.studies.validity import (
     MIN_H_OVER_ROTOR_TOP,
     MU_ENVELOPE,
@@ -30,12 +30,8 @@ SPEEDS = [6.0, 8.0, 10.0, 12.0]
 
 
 def farm(name, speeds=SPEEDS):
-    fmodel = FlorisModel(INPUTS / f"{name}.yaml")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
-        fmodel.set(wind_speeds=speeds, wind_directions=[270.0] * len(speeds),
-                   turbulence_intensities=[0.06] * len(speeds))
-    return fmodel
+    """The shipped input ``name`` at ``speeds`` from 270 deg, as examples/day_and_night.py runs it."""
+    return day_and_night.farm(name, speeds)
 
 
 def test_the_shipped_night_keeps_the_nrel_rotor_below_h_at_6_to_12_m_s():

@@ -1,6 +1,6 @@
 """A SYNTHETIC year of met-mast records with the effects of real instruments, seeded
-(docs/measurements.md#a-real-mast): the fixture of tests/studies/test_mast_instruments.py and of
-examples/site_year.py.
+(docs/measurements.md#a-real-mast): the year examples/site_report.py fits and the fixture of
+tests/studies/test_mast_instruments.py.
 
 The mast is the usual one of a wind-resource campaign (IEC 61400-12-1 Annex G; the IEA Wind
 Task 43 data model's measurement points): cup anemometers on two booms at 40, 60 and 80 m, one
@@ -43,19 +43,16 @@ The instruments, each effect seeded and recorded (module constants):
   36 hours (``true_stuck_<h>m``: the vane at h m is stuck);
 * missing values: 0.5 % of each column NaN.
 
-    python tests/data/generate_mast_instruments.py   # prints what it makes
+    python examples/instrumented_mast_year.py   # prints what it makes
 """
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy import stats
 
-HERE = Path(__file__).resolve().parent
-from floris_ekman_veer.atmosphere.ekman import EkmanABL  # noqa: E402
+from floris_ekman_veer.atmosphere.ekman import EkmanABL
 
 SEED = 2026
 SITE = dict(latitude=53.3, roughness_length=0.05)
