@@ -2,7 +2,7 @@
 
 Usage::
 
-    PYTHONPATH=. python benchmarks/abl_robustness.py [n_per_kind] [seed]
+    python -m benchmarks.abl_robustness [n_per_kind] [seed]
 
 Draws ``n_per_kind`` random inputs for each stability input kind (neutral, stability parameter,
 cooling rate, surface heat flux, Obukhov length) over the ranges a user meets: reference wind

@@ -1,6 +1,6 @@
 """Time the EkmanABL solver. Hand-run script, not a test:
 
-    PYTHONPATH=. python benchmarks/bench_abl.py
+    python -m benchmarks.bench_abl
 
 1. 100,000 distinct conditions solved at once (random G, z0, cooling rate; then with mu given),
    reported as conditions per second, best of 3.

@@ -1,7 +1,7 @@
 """Time EkmanABL.fit_profile and measure its recovery of the model's own profiles. Hand-run
 script, not a test:
 
-    PYTHONPATH=. python benchmarks/bench_fit_profile.py
+    python -m benchmarks.bench_fit_profile
 
 1. Fit time per 1,000 records: 1,000 random atmospheres (hub wind 4-14 m/s at 90 m, Obukhov
    length 40-800 m or neutral, latitude 52, z0 0.05 m) sampled at 30, 50, ..., 150 m, fitted in

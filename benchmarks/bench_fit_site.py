@@ -1,6 +1,6 @@
 """Time ``fit_site`` with the defaults on a year of records. Hand-run script, not a test:
 
-    PYTHONPATH=. python benchmarks/bench_fit_site.py [n_records] [option=value ...]
+    python -m benchmarks.bench_fit_site [n_records] [option=value ...]
 
 Records: the SYNTHETIC year of ``tests/data/mast_year.csv.gz`` (8,760 hourly records,
 docs/measurements.md#a-year-of-records); more records (e.g. 105,120, a year of 10-minute

@@ -1,7 +1,7 @@
 """Time the Ekman inflow initialisation: 1000 conditions x 100 turbines (3 x 3 rotor grid).
 
 Hand-run script (not a test), from the repository root with the package importable
-(``pip install -e .`` or ``PYTHONPATH=. python benchmarks/bench_inflow.py``). Goal: < 0.1 s per
+(``pip install -e .`` or ``python -m benchmarks.bench_inflow``). Goal: < 0.1 s per
 ``FlowField.initialize_velocity_field`` with the hook (the ABL solve happens once, when the model
 is built, and is cached; it is timed separately). For reference it also times FLORIS's power law
 and FLORIS's native 3-D heterogeneous inflow carrying the same profile.

@@ -1,7 +1,7 @@
 """Speed and peak memory of the ekman_veer models against FLORIS's GCH and gauss on the same farm,
 inflow and conditions, in one process (hand-run script, not a test):
 
-    python benchmarks/bench_models.py [--conditions 100] [--repeats 3] [--seed 1] [--profile]
+    python -m benchmarks.bench_models [--conditions 100] [--repeats 3] [--seed 1] [--profile]
 
 Farm: 10 x 10 NREL 5 MW at 7 D (882 m), the wake settings of ``inputs/farm_sbl6.yaml`` (sosfs
 combination, crespo_hernandez turbulence) and its SBL-6 atmosphere (Ekman inflow for every

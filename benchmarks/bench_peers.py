@@ -2,7 +2,7 @@
 farms and conditions, in one process (hand-run script, not a test):
 
     pip install '.[peers]'    # PyWake, optional
-    python benchmarks/bench_peers.py [--sides 3,10,20] [--conditions 100] [--repeats 3]
+    python -m benchmarks.bench_peers [--sides 3,10,20] [--conditions 100] [--repeats 3]
                                      [--profile] [--threads N]
 
 Farms: side x side NREL 5 MW at 7 D, ``--conditions`` random yawed conditions (seeded as in
@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-import bench_models  # noqa: E402  (the farm, the inputs and the conditions)
+from benchmarks import bench_models  # the farm, the inputs and the conditions
 
 import numexpr  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402

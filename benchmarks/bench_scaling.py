@@ -1,6 +1,6 @@
 """Cost of one ``FlorisModel.run()`` against the number of turbines (hand-run study, not a test):
 
-    python benchmarks/bench_scaling.py [--turbines 16 49 100 225 400] [--conditions 10 100]
+    python -m benchmarks.bench_scaling [--turbines 16 49 100 225 400] [--conditions 10 100]
                                        [--repeats 2] [--seed 1]
 
 Square farms of NREL 5 MW at 7 D (4 x 4 to 20 x 20), the wake settings and SBL-6 atmosphere of
@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from bench_models import REPOSITORY, configuration  # noqa: F401  (puts the package on the path)
+from benchmarks.bench_models import REPOSITORY, configuration  # noqa: F401
 from floris import FlorisModel
 
 MODELS = ("M-1", "M-2", "gauss", "GCH", "jensen", "none")

@@ -1,7 +1,7 @@
 """A year of per-record atmospheres: the study's cost against plain FLORIS runs (issue: year perf).
 
 Hand-run script (not a test), from the repository root, e.g.
-``PYTHONPATH=. python benchmarks/bench_year.py --side 3 --records 8760 --repeats 3``,
+``python -m benchmarks.bench_year --side 3 --records 8760 --repeats 3``,
 ``... --lines ekman_veer,gch --records 52560``, or a steered year
 ``... --lines none --steered 96 --steered-chunk 24 --dask-workers 2``.
 

@@ -1,6 +1,6 @@
 """Why M-1's wakes recovered too fast in tight arrays: its farm couplings on the measured farms.
 
-    python benchmarks/deep_array_coupling.py
+    python -m benchmarks.deep_array_coupling
 
 Runs M-1 through ``floris_ekman_veer.studies.validation`` (matched atmosphere, the measurements'
 direction bins and direction uncertainty, as examples/validate.py) on Horns Rev 1 (rows 7 D

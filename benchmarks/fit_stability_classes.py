@@ -1,7 +1,7 @@
 """Which stability class ``EkmanABL.fit_profile(..., stability="either")`` gives records of a known
 class. Hand-run script, not a test:
 
-    PYTHONPATH=. python benchmarks/fit_stability_classes.py [n_per_class]
+    python -m benchmarks.fit_stability_classes [n_per_class]
 
 Records: n_per_class (default 200) per class of the model's own profiles driven by 5-12 m/s at
 90 m (uniform), f_c = 1e-4 1/s, z0 = 0.1 m, N = 6.1e-3 1/s: convective (the surface sensible

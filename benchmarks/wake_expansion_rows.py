@@ -1,6 +1,6 @@
 """How the farm couplings of M-1 change a farm's rows: power by row of a 10 x 10 farm (hand-run script).
 
-    python benchmarks/wake_expansion_rows.py [--speed 8] [--direction 270]
+    python -m benchmarks.wake_expansion_rows [--speed 8] [--direction 270]
 
 Farm: 10 x 10 NREL 5 MW at 7 D (882 m), the wake settings of ``inputs/farm_sbl6.yaml``
 (ekman_veer velocity and deflection, M-1; crespo_hernandez added turbulence; 3 x 3 rotor
