@@ -55,14 +55,22 @@ def check_option_names(abl_class, fixed_inputs):
 #: directions in radians: a warning.
 RADIANS_VEER = 0.5
 
+#: [deg] Winds within this of north, read beyond 2 pi in degrees (6.3 to 30 deg, 330 to 360
+#: deg), show that a table's winds blow from the north: its records within 0 to 2 pi are
+#: northerly winds too, not directions in radians.
+NORTHERLY_SECTOR = 30.0
+
 
 def warn_if_radians(fit):
     """:class:`DirectionUnitsWarning`, once, naming the records whose directions all lie within
     0 to 2 pi and turn by less than :data:`RADIANS_VEER` between their vanes: a real veer of a
     few degrees and a vane's noise, given in radians, are a few hundredths of a "degree" (in
     degrees a vane's noise alone spreads them wider). Two records or more all in radians are
-    refused (`check_degrees`); a northerly wind within 6.3 deg of north, steady to 0.5 deg, is
-    warned about too."""
+    refused (`check_degrees`). A northerly wind within 6.3 deg of north, steady to 0.5 deg,
+    looks alike: it is warned about alone, or among records of other directions, but not in a
+    table that also holds northerly winds beyond 2 pi in degrees (within
+    :data:`NORTHERLY_SECTOR` of north): there the wind has turned through north, as a mast's
+    year does a few times."""
     if fit.directions is None:
         return
     d = np.atleast_2d(fit.directions)
@@ -70,6 +78,10 @@ def warn_if_radians(fit):
     within = measured & np.all(~np.isfinite(d) | ((d >= 0.0) & (d <= 2.0 * np.pi)), axis=1)
     if not np.any(within):
         return
+    from_north = np.abs(np.mod(d + 180.0, 360.0) - 180.0)
+    with np.errstate(invalid="ignore"):
+        if np.any((np.abs(d) > 2.0 * np.pi) & (from_north <= NORTHERLY_SECTOR)):
+            return
     rows = np.flatnonzero(within)
     spread = np.nanmax(d[rows], axis=1) - np.nanmin(d[rows], axis=1)
     small = spread < RADIANS_VEER

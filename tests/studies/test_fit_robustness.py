@@ -155,6 +155,28 @@ def test_one_record_in_radians_is_fitted_with_a_warning():
         assert EkmanABL.fit_profile(Z, s, d, **SITE).profile_fit.fits
 
 
+def test_a_northerly_wind_among_northerly_winds_is_not_taken_for_radians():
+    """A record 2-3 deg from north, its vanes within 0.5 deg, looks like radians alone (warned)
+    and beside westerly records (warned); in a table whose winds also blow 342 and 20 deg from
+    north, in degrees beyond 2 pi, the wind has turned through north: no warning."""
+    import warnings
+
+    from floris_ekman_veer import DirectionUnitsWarning
+
+    s, d = model_record()
+    north = d - d[0] + 2.0           # the record's veer, 2 deg at its lowest vane
+    steady = np.full_like(d, 2.0) + np.linspace(0.0, 0.4, d.size)  # steady to 0.4 deg
+    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(0\)"):
+        EkmanABL.fit_profile(Z, s, steady, **SITE)
+    with pytest.warns(DirectionUnitsWarning, match=r"directions of 1 record\(s\) \(1\)"):
+        EkmanABL.fit_profile(Z, np.vstack([s, s]), np.vstack([d, steady]), **SITE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        EkmanABL.fit_profile(Z, np.vstack([s, s, s]),
+                             np.vstack([north + 340.0, steady, north + 18.0]),
+                             **SITE)
+
+
 def test_unclear_inputs_get_messages_naming_them():
     s, d = model_record()
     with pytest.raises(ValueError, match=r"speeds hold no records"):
