@@ -78,12 +78,8 @@ from floris_ekman_veer.wake.deficit import (
     stream_tube_area_ratio,
 )
 from floris_ekman_veer.wake.deflection import veer_deflection
-from floris_ekman_veer.wake.fused import (
-    deficit_on_rows,
-    rows_deficit_parameters,
-    wake_deficit_parameters,
-)
-from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit
+from floris_ekman_veer.wake.fused import GAUSSIAN_SHAPE, wake_deficit_parameters
+from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit, bastankhah2014_wake
 
 __all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "EkmanWakeModel",
            "Gaussian2014VelocityDeficit"]
@@ -245,15 +241,13 @@ class EkmanWakeModel(BaseModel):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
-    def wake_parameters(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
-        """The factors of :meth:`sub_point_deficit` that depend on the wake only, evaluated once
-        per wake (1-D arrays, one per wake and rotor reached): none here."""
-        return {}
-
-    def sub_point_deficit(self, wake: TurbineWake, parameters: dict | None = None) -> np.ndarray:
-        """Delta u / U_h of the wake at the sub-points (each model's normalised deficit);
-        ``parameters``: :meth:`wake_parameters` gathered to the sub-point rows."""
-        return self.normalised_deficit(wake)
+    def kernel_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
+        """The deficit's factors that depend on the wake only, for the rotor-cell kernel
+        (plugin/rotor_kernel.py ``WAKE_COLUMNS``: Delta u / U_h = amplitude
+        exp(-(rho^2 / (2 sigma^2))^(shape / 2)) with sigma = kx + xi0 xi_hat(theta) /
+        sqrt(1 - sin2b sin^2 theta), xi_hat of Eq. xi_emp with t_hat's prefactor ``strength``),
+        per wake and rotor reached (1-D arrays or scalars); each model defines them."""
+        raise NotImplementedError("EkmanWakeModel.kernel_table")
 
     def amplitude_bound(self, x, k_w, radius, ct, yaw):
         """The largest deficit Delta u / U_h of the wake at x: C(x), Eq. (Cx)."""
@@ -320,22 +314,14 @@ class EkmanVeerVelocityDeficit(EkmanWakeModel):
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
 
-    def wake_parameters(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
-        if self.polar_angle_centre != "wake_centre":
-            return {}
-        return wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
-                                       curl=self.curl)
-
-    def sub_point_deficit(self, wake: TurbineWake, parameters: dict | None = None) -> np.ndarray:
-        if self.polar_angle_centre != "wake_centre":
-            return super().sub_point_deficit(wake)
+    def kernel_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
         # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
-        parameters = rows_deficit_parameters(
-            wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw, wake.friction_velocity,
-            wake.hub_speed, np.where(wake.local_u > 0, wake.local_u, 1.0), curl=self.curl,
-            wake=parameters or None,
-        )
-        return deficit_on_rows(wake.dy, wake.dz, parameters)
+        table = wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
+                                        curl=self.curl)
+        table.setdefault("strength", 0.0)  # (t_hat = 0: xi_hat = 1)
+        table["polar_veer"] = float(self.polar_angle_centre == "yaw_centre")
+        table["shape"] = GAUSSIAN_SHAPE
+        return table
 
     def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0
@@ -386,6 +372,12 @@ class Gaussian2014VelocityDeficit(EkmanWakeModel):
     def width_bound(self, x, k_w, radius, ct, yaw):
         k_star = k_w if self.k_star is None else self.k_star
         return k_star * x + WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, 0.0))
+
+    def kernel_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
+        sigma, magnitude = bastankhah2014_wake(
+            x, ct=ct, diameter=2.0 * radius, k_star=k_w if self.k_star is None else self.k_star)
+        return {"amplitude": magnitude, "kx": sigma, "xi0": 0.0, "sin2b": 0.0, "strength": 0.0,
+                "polar_veer": 0.0, "shape": GAUSSIAN_SHAPE}
 
     def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         k_star = wake.k_w if self.k_star is None else self.k_star

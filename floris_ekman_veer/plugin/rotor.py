@@ -2,34 +2,25 @@
 grid (docs/coupling.md#rotor-average).
 
 :func:`rotor_cell_deficit` integrates the wake over the cells of plugin/rotor_cells.py that it can
-reach: the culling of the rotors and sub-point rows out of reach, the chunking of the sub-points
-(on numexpr's threads, :func:`map_pieces`), the superposition on the other wakes
-(plugin/rotor_wakes.py) and the wake-added turbulence. Pure geometry and numpy (numexpr for the
-sub-points): no FLORIS import.
+reach: the culling of the rotors and sub-point rows out of reach, the wake's centre at the rows,
+the compiled kernel that superposes the wake on the others at the rows' sub-points and sums the
+cells (plugin/rotor_kernel.py) and the wake-added turbulence. Pure geometry and numpy (numba in
+the kernel): no FLORIS import.
 """
 
 from __future__ import annotations
 
-import concurrent.futures
 import functools
-import os
-import threading
 import warnings
 
 import attrs
-import numexpr as ne
 import numpy as np
 
-from floris_ekman_veer.plugin.rotor_cells import ROWS_PER_POINT, column_sums, row_interpolation
+from floris_ekman_veer.plugin.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
-from floris_ekman_veer.plugin.rotor_wakes import WAKE_OVERLAP_VELOCITY
+from floris_ekman_veer.plugin.rotor_kernel import PAIR_COLUMNS, WAKE_COLUMNS, integrate_wake
 from floris_ekman_veer.plugin.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
-from floris_ekman_veer.wake.fused import program
-
-# The area weight of a sub-point in the wake's overlap (rotor_cell_deficit): velocity above
-# WAKE_OVERLAP_VELOCITY, within ``reach`` (2 D) of the wake's rotor laterally.
-_OVERLAP = (f"where((du > {WAKE_OVERLAP_VELOCITY!r}) & (abs(dy + centre) < reach), weight, 0)")
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -56,42 +47,9 @@ ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
 #: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
 DEFICIT_VELOCITIES = ("incoming", "free_stream")
 
-#: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
-#: about 0.3 MB each.
-ROW_CHUNK = 4096
-
 #: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
 #: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
 MIN_BAND_PER_ROW = 0.4
-
-
-#: The thread pool of :func:`map_pieces`, per process (a forked worker makes its own: the
-#: parent's threads do not exist in it) and number of threads.
-_POOL: dict = {}
-_POOL_LOCK = threading.Lock()
-
-
-def worker_threads() -> int:
-    """Threads a wake's pieces run on: numexpr's, i.e. the cores FLORIS's gauss runs its sums
-    on (``numexpr.set_num_threads`` or NUMEXPR_NUM_THREADS set both)."""
-    return ne.get_num_threads()
-
-
-def map_pieces(function, pieces) -> list:
-    """``[function(piece) for piece in pieces]``, on :func:`worker_threads` threads (numpy and
-    numexpr release the GIL). A piece's numbers do not depend on the thread that runs it or on
-    what runs beside it: the results are the same bit for bit with 1 or N threads."""
-    threads = min(worker_threads(), len(pieces))
-    if threads <= 1:
-        return [function(piece) for piece in pieces]
-    key = (os.getpid(), threads)
-    with _POOL_LOCK:  # (solves in several threads of a process share the pool)
-        pool = _POOL.get(key)
-        if pool is None:
-            _POOL.clear()  # (another process's or size's pool: not ours to use)
-            pool = _POOL[key] = concurrent.futures.ThreadPoolExecutor(
-                threads, thread_name_prefix="floris_ekman_veer")
-    return list(pool.map(function, pieces))
 
 
 @attrs.define(frozen=True)
@@ -216,9 +174,8 @@ def rotor_cell_deficit(
                         * row_interpolation(cells.n, cells.row_z), axis=1)
     else:
         # In chunks of rotors, so that the deflection's temporaries stay small.
-        centre = np.concatenate(map_pieces(
-            lambda k: rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK]),
-            range(0, f.size, PAIR_CHUNK)))
+        centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
+                                 for k in range(0, f.size, PAIR_CHUNK)])
     lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
     dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
     kind = rotor.kind[f, j]
@@ -233,78 +190,21 @@ def rotor_cell_deficit(
                       radius_j[reached], cells, rotor.warned)
     flat = f * n_turbines + j
     moment = rotor.moment[f, j]
-    n2 = cells.n**2
-    # Per entry (a pair's row): the moment removed on each cell stretch the row crosses
-    # and the row's overlap, summed into the pairs' cells once after the loop, in entry
-    # order (a pair's rows in ascending order): a condition's sums then do not depend on
-    # the grouping and chunking below, which depend on the whole batch.
-    nodes = cells.nodes
-    stretches = np.zeros((p.size, cells.sub_y.shape[1] // nodes))
-    row_overlap = np.zeros(p.size) if track else None
-    # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
-    # padding; few: all at once (the padding costs less than more calls).
-    widths = cells.row_width[r]
-    if p.size <= ROW_CHUNK:
-        groups = [np.arange(p.size)]
-    else:
-        order = np.argsort(widths, kind="stable")
-        groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
-    # The deficit's factors that depend on the wake only, once per rotor reached.
-    wake_parameters = model.wake_parameters(x_pair, *(per_pair[k] for k in (
+    # The kernel's tables (plugin/rotor_kernel.py): the deficit's factors that depend on the
+    # wake only (the velocity model's), and the solver's, once per rotor reached.
+    table = model.kernel_table(x_pair, *(per_pair[k] for k in (
         "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
-    pieces = [(group[start:start + ROW_CHUNK], int(np.max(widths[group])))
-              for group in groups for start in range(0, group.size, ROW_CHUNK)]
-
-    def integrate(piece):
-        """Superpose the wake on one piece of (pair, row) entries: pieces touch disjoint
-        entries and sub-points, so they run at once (:func:`map_pieces`). The sub-points are
-        held column-major, (width, entries): the per-entry factors then run along numexpr's
-        inner loop without being copied out to every sub-point."""
-        chunk, width = piece
-        pe, re = p[chunk], r[chunk]
-        fe = f[pe]
-        pair = {k: v[pe][None, :] for k, v in per_pair.items()}
-        u_rows = rotor.kind_u[fe, kind[pe], re][None, :]
-        v_rows = rotor.kind_v[fe, kind[pe], re][None, :]
-        dy = lateral[pe, re][None, :] + radius_j[pe, 0][None, :] * cells.sub_y_columns[:width, re]
-        wake = TurbineWake(
-            dx=x_pair[pe][None, :],
-            dy=dy,
-            dz=dz[pe, re][None, :],
-            yaw=pair["yaw"],
-            ct=pair["ct"],
-            radius=pair["radius"],
-            hub_speed=pair["hub_speed"],
-            k_w=pair["k_w"],
-            local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
-            local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
-            friction_velocity=pair["friction_velocity"],
-        )
-        # No flow (at and below z0): no wake.
-        ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
-        du = model.sub_point_deficit(
-            wake, {k: v[pe][None, :] for k, v in wake_parameters.items()},
-        ) * (pair["hub_speed"] * pair["speed_fraction"])
-        removed = wakes.superpose_columns(flat[pe], re, du, ambient_u, moment[pe][None, :])
-        # Each stretch's nodes added in turn.
-        stretch = removed[::nodes]
-        for node in range(1, nodes):
-            stretch = stretch + removed[node::nodes]
-        stretches[chunk, :width // nodes] = stretch.T
-        if track:
-            # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
-            # rotor laterally, here as the area of the disk where it holds.
-            row_overlap[chunk] = column_sums(program(_OVERLAP)(
-                du=du, dy=dy, centre=centre[pe, re][None, :], reach=4.0 * pair["radius"],
-                weight=cells.weight_columns[:width, re]))
-
-    map_pieces(integrate, pieces)
-    removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
-                          weights=stretches.ravel(), minlength=f.size * n2)
-    overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None
+    per_pair["velocity_scale"] = per_pair["hub_speed"] * per_pair["speed_fraction"]
+    per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0], radius_j=radius_j[:, 0],
+                    hub_height=hub_height_i[f, 0, 0, 0], moment=moment)
+    removed, overlap = integrate_wake(
+        np.searchsorted(p, np.arange(f.size + 1)), r,
+        np.stack([np.broadcast_to(table[k], f.shape) for k in WAKE_COLUMNS], axis=1),
+        np.stack([per_pair[k] for k in PAIR_COLUMNS], axis=1), centre, flat, kind, rotor,
+        wakes, track)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
-        flat[reached], removed.reshape(f.size, n2)[reached], u_cell,
+        flat[reached], removed[reached], u_cell,
         moment[reached][:, None])
     if track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,

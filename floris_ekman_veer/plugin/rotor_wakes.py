@@ -9,16 +9,19 @@ at the sub-points by FLORIS's own rule (:class:`RotorWakes`; each call returns t
 FLORIS's combination of the point values turns into the combined cell deficit). FLORIS's
 equal-weight cubic mean of ``U_k (1 - d_k)`` is then the sub-quadrature of the disk integral of
 u^3 (ambient and all wakes), and its thrust and power follow (the first moment for the actuator
-disk, plugin/rotor_cells.py ``TURBINE_MOMENTS``). numpy and numexpr: no FLORIS import.
+disk, plugin/rotor_cells.py ``TURBINE_MOMENTS``). The point-wise rules are compiled (numba:
+:func:`superposed`, :func:`removed_moment`, called by the rotor-cell kernel,
+plugin/rotor_kernel.py, at every sub-point); numpy elsewhere; no FLORIS import.
 """
 
 from __future__ import annotations
 
 import attrs
+import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor_cells import RotorCells
-from floris_ekman_veer.wake.fused import program
+from floris_ekman_veer.wake.fused import JIT
 
 
 def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
@@ -43,20 +46,56 @@ def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
 #: velocities du [m/s] at the cells' sub-points: sum of squares (sosfs), linear sum (fls), max.
 COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
 
+#: Each rule's number in the compiled kernel (:func:`superposed`; 0: no rule, each wake alone).
+#: A new rule is a row here and a branch there.
+RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3}
+
 #: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
 #: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
 WAKE_OVERLAP_VELOCITY = 0.05
 
-_SUPERPOSED = {"sosfs": "sqrt(old**2 + du**2)", "fls": "old + du",
-               "max": "where(du > old, du, old)", None: "du"}
-#: The same rules in numpy, for the stored combination (the same bits as numexpr's).
-_SUPERPOSE = {"sosfs": lambda old, du: np.sqrt(old**2 + du**2), "fls": np.add,
-              "max": lambda old, du: np.where(du > old, du, old)}
-# weight (u_old^m - u_new^m) with u = U - wake: the moment the new wake removes at a sub-point,
-# per rule with the combined wake ``new`` written out (one pass over the sub-points).
-_REMOVED = {rule: ("where(U > 0, weight * where(m > 2, (new - old) * ((U - old)**2 + (U - old) * "
-                   "(U - new) + (U - new)**2), new - old), 0)").replace("new", f"({combined})")
-            for rule, combined in _SUPERPOSED.items()}
+
+@numba.njit(**JIT)
+def superposed(rule, old, du):
+    """The combined wake velocity at a sub-point after adding ``du`` to ``old`` by the rule
+    numbered ``rule`` (:data:`RULE_CODES`): sqrt(old^2 + du^2), old + du, max(old, du), or du
+    alone."""
+    if rule == 1:
+        return np.sqrt(old * old + du * du)
+    if rule == 2:
+        return old + du
+    if rule == 3:
+        return du if du > old else old
+    return du
+
+
+@numba.njit(**JIT)
+def removed_moment(weight, ambient_u, old, new, moment):
+    """weight (u_old^m - u_new^m) with u = U - wake: the moment a wake removes at a sub-point
+    whose combined wake goes from ``old`` to ``new`` (m = 3 written as one product, so that it
+    keeps its precision for small increments); 0 where there is no flow (U = 0)."""
+    if not ambient_u > 0.0:
+        return 0.0
+    if moment > 2.0:
+        before, after = ambient_u - old, ambient_u - new
+        return weight * ((new - old) * (before * before + before * after + after * after))
+    return weight * (new - old)
+
+
+@numba.njit(**JIT)
+def _superpose_rows(rule, combined, index, du, ambient_u, moment, weight, rows):
+    """:meth:`RotorWakes.superpose` compiled: entry e's sub-points in row ``rows[e]`` of block
+    ``index[e]`` of ``combined``."""
+    removed = np.zeros(du.shape)
+    for e in range(du.shape[0]):
+        for s in range(du.shape[1]):
+            old = np.float64(combined[index[e], s]) if rule else 0.0
+            new = superposed(rule, old, du[e, s])
+            removed[e, s] = removed_moment(weight[rows[e], s], ambient_u[e], old, new,
+                                           moment[e])
+            if rule:
+                combined[index[e], s] = new
+    return removed
 
 
 @attrs.define(eq=False)
@@ -113,35 +152,24 @@ class RotorWakes:
         return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
                    np.zeros((pairs, cells.n**2)), turbulence, turbulence_model)
 
-    def superpose(self, pair, row, du, ambient_u, moment) -> np.ndarray:
-        """Add one wake at sub-point rows: ``pair`` (entries,) flat rotor index (condition *
-        n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the wake's velocity
-        deficit [m/s] at the row's first w sub-points (w at least each row's width; beyond it,
-        the zero-weight padding), ``ambient_u`` (entries, 1) U at
-        the row (0 where there is no flow), ``moment`` (entries, 1). Returns (entries, w) the
-        moment the wake removes at each sub-point, weight (u_before^m - u_after^m)."""
-        return self.superpose_columns(pair, row, du.T, np.transpose(ambient_u),
-                                      np.transpose(moment)).T
+    @property
+    def rule_code(self) -> int:
+        """The rule's number in the compiled kernel (:data:`RULE_CODES`)."""
+        return RULE_CODES[self.rule]
 
-    def superpose_columns(self, pair, row, du, ambient_u, moment) -> np.ndarray:
-        """:meth:`superpose` with the sub-points column-major: ``du`` (w, entries),
-        ``ambient_u`` and ``moment`` (1, entries); returns (w, entries)."""
-        cells = self.cells
-        width = du.shape[0]
-        if self.rule is None:
-            old = np.zeros_like(du)
-        else:
-            # The rows' stored blocks, padding included: a padding sub-point's weight is 0, so
-            # what it holds never reaches a cell.
-            # (Stored row-major: each block's values are together in memory.)
-            index = pair * cells.rows + row
-            old = np.take(self.combined, index, axis=0)[:, :width].T.astype(float, order="C")
-        removed = program(_REMOVED[self.rule])(old=old, du=du, U=ambient_u,
-                                               weight=cells.weight_columns[:width, row],
-                                               m=moment)
-        if self.rule is not None:
-            self.combined[index, :width] = _SUPERPOSE[self.rule](old, du).T
-        return removed
+    def superpose(self, pair, row, du, ambient_u, moment) -> np.ndarray:
+        """Add one wake at sub-point rows (what the rotor-cell kernel does at each sub-point,
+        plugin/rotor_kernel.py, here on given arrays): ``pair`` (entries,) flat rotor index
+        (condition * n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the
+        wake's velocity deficit [m/s] at the row's first w sub-points (beyond each row's width,
+        the zero-weight padding), ``ambient_u`` (entries, 1) U at the row (0 where there is no
+        flow), ``moment`` (entries, 1). Returns (entries, w) the moment the wake removes at each
+        sub-point, weight (u_before^m - u_after^m)."""
+        pair, row = np.asarray(pair), np.asarray(row)
+        return _superpose_rows(
+            self.rule_code, self.combined, pair * self.cells.rows + row,
+            np.ascontiguousarray(du, dtype=float), np.ravel(ambient_u).astype(float),
+            np.ravel(moment).astype(float), self.cells.weight, row)
 
     def cell_returns(self, pair, removed, u_cell, moment) -> np.ndarray:
         """What the velocity model returns at the cells of rotors ``pair`` (flat indices, each

@@ -1,18 +1,21 @@
-"""Eq. (du_model) fused into one pass over many points, for rotor-cell averages.
+"""Eq. (du_model) fused for the rotor cells' sub-points, compiled (numba).
 
 The readable form of the deficit is :func:`floris_ekman_veer.wake.deficit.normalised_deficit`;
 this module evaluates the same formula where most factors are shared: per wake (C(x), k_w x,
-the stream-tube radius, beta) and per height (t_hat and the three tanh of Eq. xi_emp depend on
-z only, through U(z)), leaving per point only the polar harmonics, the width and the Gaussian.
-numexpr (a FLORIS dependency) runs that per-point part in a single pass without temporaries.
-tests/plugin/test_rotor_average.py checks it against ``normalised_deficit`` to round-off.
+the stream-tube radius, beta: :func:`wake_deficit_parameters`, numpy) and per height (t_hat and
+the three tanh of Eq. xi_emp depend on z only, through U(z): :func:`curl_polynomial`), leaving
+per point only the polar harmonics, the width and the Gaussian (:func:`point_deficit`). The
+compiled functions are called by the rotor-cell kernel (plugin/rotor_kernel.py) once per
+sub-point; :func:`deficit_on_rows` runs them on arrays (tests/plugin/test_rotor_average.py
+checks it against ``normalised_deficit`` to round-off). ``cache=True``: compiled once per
+installation (numba's cache next to the module, or its user cache directory where the
+package's folder is read-only; NUMBA_CACHE_DIR moves it), no fastmath (IEEE results, the same
+on every thread).
 """
 
 from __future__ import annotations
 
-import threading
-
-import numexpr as ne
+import numba
 import numpy as np
 
 from .deficit import (
@@ -24,66 +27,65 @@ from .deficit import (
     time_like_strength,
 )
 
+#: How the compiled functions are compiled: cached on disk, IEEE arithmetic (no fastmath).
+JIT = {"cache": True, "fastmath": False, "error_model": "numpy"}
 
-class Program:
-    """A numexpr expression compiled once, for float64 operands (``ne.evaluate`` without its
-    per-call parsing, validation and cache look-up: the same compiled program, the same bits).
-    Call it with the operands by name; they broadcast as in ``ne.evaluate``."""
-
-    #: ``ne.evaluate``'s context in a module without ``from __future__ import division``.
-    CONTEXT = {"optimization": "aggressive", "truediv": False}
-
-    def __init__(self, expression: str):
-        self.names, self.uses_vml = ne.necompiler.getExprNames(expression, self.CONTEXT)
-        self.compiled = ne.NumExpr(expression, [(name, np.double) for name in self.names],
-                                   **self.CONTEXT)
-
-    def __call__(self, **operands) -> np.ndarray:
-        return self.compiled(*(np.asarray(operands[name], dtype=float) for name in self.names),
-                             out=None, order="K", casting="same_kind",
-                             ex_uses_vml=self.uses_vml)
+#: The Gaussian's radial exponent n of the shape exp(-(rho^2 / (2 sigma^2))^(n / 2)): 2 is the
+#: paper's Gaussian (the only shape of Eq. du_model); the kernel takes n per wake and rotor, so
+#: that another radial shape (a near wake's super-Gaussian) plugs into the same code.
+GAUSSIAN_SHAPE = 2.0
 
 
-#: The compiled programs of each thread: a compiled numexpr program holds its temporaries, so
-#: threads never share one (as numexpr's own cache).
-_PROGRAMS = threading.local()
-
-
-def program(expression: str) -> Program:
-    """The compiled :class:`Program` of ``expression`` (compiled once per thread)."""
-    programs = getattr(_PROGRAMS, "programs", None)
-    if programs is None:
-        programs = _PROGRAMS.programs = {}
-    compiled = programs.get(expression)
-    if compiled is None:
-        compiled = programs[expression] = Program(expression)
-    return compiled
-
-
-def curl_coefficients(t_hat, alpha=CURL_ALPHA):
-    """(a2, a3, a4) with xi_hat = 1 - (a2 cos 2theta + a3 cos 3theta + a4 cos 4theta), Eq. (xi_emp):
-
+@numba.njit(**JIT)
+def curl_polynomial(t_hat, alpha):
+    """(q0, ..., q4) with xi_hat = sum_k q_k cos(theta)^k, Eq. (xi_emp):
+    xi_hat = 1 - (a2 cos 2theta + a3 cos 3theta + a4 cos 4theta) with
     a2 = alpha (tanh(t^2/4alpha)/2 - 5/48 tanh(t^4/16alpha)), a3 = -alpha/4 tanh(t^3/8alpha),
-    a4 = 7 alpha/48 tanh(t^4/16alpha).
-    """
-    t = np.asarray(t_hat, dtype=float)
-    tanh2, tanh3, tanh4 = (program(f"tanh(t**{k} / ({2.0**k} * alpha))")(t=t, alpha=alpha)
-                           for k in (2, 3, 4))
-    return (
-        alpha * (0.5 * tanh2 - 5.0 / 48.0 * tanh4),
-        -0.25 * alpha * tanh3,
-        7.0 / 48.0 * alpha * tanh4,
-    )
+    a4 = 7 alpha/48 tanh(t^4/16alpha), and (Chebyshev) cos 2t = 2c^2 - 1, cos 3t = 4c^3 - 3c,
+    cos 4t = 8c^4 - 8c^2 + 1. t_hat = 0: (1, 0, 0, 0, 0)."""
+    t2 = t_hat * t_hat
+    tanh2 = np.tanh(t2 / (4.0 * alpha))
+    tanh3 = np.tanh(t2 * t_hat / (8.0 * alpha))
+    tanh4 = np.tanh(t2 * t2 / (16.0 * alpha))
+    a2 = alpha * (0.5 * tanh2 - 5.0 / 48.0 * tanh4)
+    a3 = -0.25 * alpha * tanh3
+    a4 = 7.0 / 48.0 * alpha * tanh4
+    return 1.0 + a2 - a4, 3.0 * a3, 8.0 * a4 - 2.0 * a2, -4.0 * a3, -8.0 * a4
 
 
-# Per point, with c = cos(theta) (theta := 0 at the centre, where the Gaussian is 1 whatever the
-# width) and sin^2(theta) = 1 - c^2: xi_hat of Eq. (xi_emp) as the quartic in c of
-# :func:`rows_deficit_parameters` (Chebyshev: cos 2t = 2c^2 - 1, cos 3t = 4c^3 - 3c,
-# cos 4t = 8c^4 - 8c^2 + 1), the width of Eqs. (sigma_width), (xi0_theta) and the Gaussian.
-_COSINE = "where(dy**2 + dz**2 > 0, dy / sqrt(where(dy**2 + dz**2 > 0, dy**2 + dz**2, 1)), 1)"
-_CURL = "(q0 + c * (q1 + c * (q2 + c * (q3 + c * q4))))"
-_SIGMA = f"(kx + xi0 / sqrt(1 - sin2b * (1 - c**2)) * {_CURL})"
-_DEFICIT = f"amplitude * exp(-(dy**2 + dz**2) / (2 * {_SIGMA}**2))"
+@numba.njit(**JIT)
+def point_deficit(dy, dz, polar_dy, amplitude, kx, xi0, sin2b, q0, q1, q2, q3, q4, shape):
+    """Delta u / U_h of Eq. (du_model) at one point (dy, dz) from the wake's centre: the width
+    sigma = k_w x + xi0 xi_hat(theta) / sqrt(1 - sin^2 beta sin^2 theta) of Eqs.
+    (sigma_width), (xi0_theta), the polar angle theta measured at (polar_dy, dz)
+    (docs/wake_model.md#polar-angle; theta := 0 at the centre, where the Gaussian is 1 whatever
+    the width), and the radial shape exp(-(rho^2 / (2 sigma^2))^(shape / 2)) (2: the Gaussian).
+    ``xi0`` = 0.4 R sqrt(A*) |cos beta|; (q0, ..., q4) of :func:`curl_polynomial`."""
+    squared = polar_dy * polar_dy + dz * dz
+    c = polar_dy / np.sqrt(squared) if squared > 0.0 else 1.0
+    curl = q0 + c * (q1 + c * (q2 + c * (q3 + c * q4)))
+    sigma = kx + xi0 / np.sqrt(1.0 - sin2b * (1.0 - c * c)) * curl
+    exponent = (dy * dy + dz * dz) / (2.0 * sigma * sigma)
+    if shape != GAUSSIAN_SHAPE:
+        exponent = exponent ** (0.5 * shape)
+    return amplitude * np.exp(-exponent)
+
+
+@numba.njit(**JIT)
+def _deficits(dy, dz, amplitude, kx, xi0, sin2b, q):
+    out = np.empty(dy.size)
+    for k in range(dy.size):
+        out[k] = point_deficit(dy[k], dz[k], dy[k], amplitude[k], kx[k], xi0[k], sin2b[k],
+                               q[k, 0], q[k, 1], q[k, 2], q[k, 3], q[k, 4], GAUSSIAN_SHAPE)
+    return out
+
+
+@numba.njit(**JIT)
+def _curl_polynomials(t_hat, alpha):
+    q = np.empty((t_hat.size, 5))
+    for k in range(t_hat.size):
+        q[k, 0], q[k, 1], q[k, 2], q[k, 3], q[k, 4] = curl_polynomial(t_hat[k], alpha)
+    return q
 
 
 def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True):
@@ -113,21 +115,22 @@ def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
     if wake is None:
         wake = wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
                                        curl)
+    t_hat = np.zeros(1)
     if curl:
         t_hat = wake["strength"] * time_like_growth(x, friction_velocity, local_speed, radius)
-        a2, a3, a4 = curl_coefficients(t_hat)
-    else:
-        a2 = a3 = a4 = np.zeros(1)
-    # xi_hat = 1 - (a2 (2c^2 - 1) + a3 (4c^3 - 3c) + a4 (8c^4 - 8c^2 + 1)) = sum_k q_k c^k.
-    return {
-        **{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b")},
-        "q0": 1.0 + a2 - a4, "q1": 3.0 * a3, "q2": 8.0 * a4 - 2.0 * a2, "q3": -4.0 * a3,
-        "q4": -8.0 * a4,
-    }
+    q = _curl_polynomials(np.ravel(t_hat).astype(float), CURL_ALPHA).T.reshape(
+        (5, *np.shape(t_hat)))
+    return {**{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b")},
+            **{f"q{k}": q[k] for k in range(5)}}
 
 
 def deficit_on_rows(dy, dz, parameters):
     """Delta u / U_h of Eq. (du_model) at points (dy, dz) from the factors of
-    :func:`rows_deficit_parameters` (two numexpr passes: cos(theta), then the deficit)."""
-    c = program(_COSINE)(dy=dy, dz=dz)
-    return program(_DEFICIT)(dy=dy, dz=dz, c=c, **parameters)
+    :func:`rows_deficit_parameters` (:func:`point_deficit` at every point of the broadcast
+    arrays)."""
+    names = ("amplitude", "kx", "xi0", "sin2b", "q0", "q1", "q2", "q3", "q4")
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (
+        dy, dz, *(parameters[k] for k in names))))
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    q = np.stack(flat[6:], axis=1)
+    return _deficits(*flat[:6], q).reshape(arrays[0].shape)

@@ -21,6 +21,24 @@ from floris_ekman_veer._validation import positive
 
 from .deficit import unyawed_thrust_coefficient
 
+def bastankhah2014_wake(x, *, ct, diameter, k_star):
+    """The Gaussian's width sigma (m) and its magnitude C(x) at x (C capped at 2a, module
+    docstring): Delta u / U_inf = C exp(-(dy^2 + dz^2) / (2 sigma^2)) for x > 0
+    (:func:`bastankhah2014_deficit`)."""
+    x = np.asarray(x, dtype=float)
+    ct = unyawed_thrust_coefficient(ct)
+    diameter = positive(diameter, "diameter")
+    k_star = positive(k_star, "k_star")
+    root = np.sqrt(1.0 - ct)
+    beta_bp = 0.5 * (1.0 + root) / root
+    # Upstream points carry no wake; evaluating them at the rotor plane keeps every term finite.
+    sigma_d = k_star * np.maximum(x, 0.0) / diameter + 0.2 * np.sqrt(beta_bp)
+    # The cap: 8 (sigma/D)^2 floored at 1 (sigma/D = 1/sqrt(8)) makes q = C_T there, C = 2a.
+    q = ct / np.maximum(8.0 * sigma_d**2, 1.0)
+    # = 1 - sqrt(1 - q) without the cancellation for small q; q <= C_T < 1.
+    return sigma_d * diameter, q / (1.0 + np.sqrt(1.0 - q))
+
+
 def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     """Normalised deficit Delta u / U_inf of the Bastankhah & Porte-Agel (2014) Gaussian wake.
 
@@ -37,16 +55,6 @@ def bastankhah2014_deficit(x, dy, dz, *, ct, diameter, k_star):
     x = np.asarray(x, dtype=float)
     dy = np.asarray(dy, dtype=float)
     dz = np.asarray(dz, dtype=float)
-    ct = unyawed_thrust_coefficient(ct)
-    diameter = positive(diameter, "diameter")
-    k_star = positive(k_star, "k_star")
-    root = np.sqrt(1.0 - ct)
-    beta_bp = 0.5 * (1.0 + root) / root
-    # Upstream points carry no wake; evaluating them at the rotor plane keeps every term finite.
-    sigma_d = k_star * np.maximum(x, 0.0) / diameter + 0.2 * np.sqrt(beta_bp)
-    # The cap: 8 (sigma/D)^2 floored at 1 (sigma/D = 1/sqrt(8)) makes q = C_T there, C = 2a.
-    q = ct / np.maximum(8.0 * sigma_d**2, 1.0)
-    # = 1 - sqrt(1 - q) without the cancellation for small q; q <= C_T < 1.
-    magnitude = q / (1.0 + np.sqrt(1.0 - q))
-    gaussian = np.exp(-(dy**2 + dz**2) / (2.0 * (sigma_d * diameter) ** 2))
+    sigma, magnitude = bastankhah2014_wake(x, ct=ct, diameter=diameter, k_star=k_star)
+    gaussian = np.exp(-(dy**2 + dz**2) / (2.0 * sigma**2))
     return np.where(x > 0.0, magnitude * gaussian, 0.0)

@@ -5,9 +5,10 @@ models on rotor cells.
 The cells' sums used to follow the batch: the rows a wake reaches were grouped by width and cut
 into chunks over all conditions together, and each chunk's rows added into the cells in turn;
 a condition alone (one group) summed its rows in another order than inside a batch (6 of 40
-conditions differed in the last bits, <= 1.3e-15 relative). Now each row's stretches are summed
-per row and added into the cells in row order (plugin/rotor.py), and the inflow's cell means
-are segment sums, not a BLAS matrix product (plugin/rotor_cells.py).
+conditions differed in the last bits, <= 1.3e-15 relative). Now the compiled kernel sums each
+rotor's rows into its cells in row and sub-point order, whatever the batch
+(plugin/rotor_kernel.py), and the inflow's cell means are segment sums, not a BLAS matrix
+product (plugin/rotor_cells.py).
 """
 
 from __future__ import annotations
@@ -51,9 +52,7 @@ def test_condition_alone_equals_it_in_a_batch(velocity_model, monkeypatch):
     for i in range(n):
         alone = powers(fmodel, speeds[i:i + 1], directions[i:i + 1], yaw[i:i + 1])
         np.testing.assert_array_equal(alone[0], batch[i], err_msg=f"condition {i}")
-    # Smaller chunks of rows (what a bigger batch gets): the same bits.
-    monkeypatch.setattr(rotor, "ROW_CHUNK", 97)
-    np.testing.assert_array_equal(powers(fmodel, speeds, directions, yaw), batch)
+    # Smaller chunks of rotors for the wake centre (what a bigger batch gets): the same bits.
     monkeypatch.setattr(rotor, "PAIR_CHUNK", 5)
     np.testing.assert_array_equal(powers(fmodel, speeds[::-1], directions[::-1], yaw[::-1]),
                                   batch[::-1])
