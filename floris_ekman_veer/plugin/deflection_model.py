@@ -22,7 +22,9 @@ from floris_ekman_veer.plugin.wake_inputs import (
     from_input_block,
     unyawed_thrust_coefficient,
 )
+from floris_ekman_veer.wake.deficit import initial_radius, time_like_strength
 from floris_ekman_veer.wake.deflection import wake_centre_offset
+from floris_ekman_veer.wake.fused import centre_offsets
 
 
 @define
@@ -76,8 +78,9 @@ class EkmanVeerVelocityDeflection(BaseModel):
                                 local_v, ambient.abl.friction_velocity)
         # Turbine grid: the centre depends on height only, so it is evaluated at the grid's point
         # heights, downstream of turbine i only (upstream there is no wake: 0), and at the rows
-        # of the rotor cells (plugin/rotor.py) only for the rotors the velocity model
-        # integrates (RotorDeflection.rows_at).
+        # of the rotor cells (plugin/rotor.py) by the rotor-cell kernel, from the per-wake
+        # factors of RotorDeflection.kernel_table, only for the rotors the velocity model
+        # integrates.
         rotor = ambient.rotor
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
         dx = rotor.x - x_i[:, 0, 0]
@@ -85,21 +88,27 @@ class EkmanVeerVelocityDeflection(BaseModel):
             cos_a, sin_a, hub_height, radius, ct, yaw, hub_speed,
             ambient.abl.friction_velocity)]
 
-        def centre(f, j, heights, u, v):
-            """The centre at ``heights`` (pairs, h) of rotors (f, j) downstream, from the ambient
-            (u, v) there in FLORIS's frame."""
-            cos_p, sin_p, *pair = (a[f][:, None] for a in per_condition)
-            return self._offset(dx[f, j][:, None], heights, *pair[:5],
-                                u * cos_p + v * sin_p, v * cos_p - u * sin_p, pair[5])
+        def kernel_table(f):
+            """The centre's per-wake factors for the rotor-cell kernel, conditions ``f``."""
+            _, _, hub, radius_f, ct_f, yaw_f, hub_speed_f, u_star = (a[f] for a in per_condition)
+            return {"strength": time_like_strength(u_star, hub_speed_f, ct_f, yaw_f),
+                    "r_tube": initial_radius(radius_f, ct_f, yaw_f), "image_height": hub,
+                    "veer": float(self.veer), "ground_image": float(self.ground_image)}
 
         points = np.zeros(z[:, :, 0, :].shape)
         f, j = np.nonzero(dx > 0.0)
         if f.size:
-            u = np.broadcast_to(ambient.u[:, :, 0, :], points.shape)
-            v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)
-            points[f, j] = centre(f, j, z[f, j, 0, :], u[f, j], v[f, j])
+            # The compiled centre of the rotor-cell kernel (wake/fused.py centre_offset).
+            table = kernel_table(f)
+            cos_p, sin_p, _, radius_f, _, _, _, u_star = (a[f][:, None] for a in per_condition)
+            u = np.broadcast_to(ambient.u[:, :, 0, :], points.shape)[f, j]
+            v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)[f, j]
+            points[f, j] = centre_offsets(
+                dx[f, j][:, None], z[f, j, 0, :], u * cos_p + v * sin_p, v * cos_p - u * sin_p,
+                table["strength"][:, None], table["r_tube"][:, None],
+                table["image_height"][:, None], radius_f, u_star, self.veer, self.ground_image)
         field_ = np.broadcast_to(points[:, :, None, :], z.shape).view(RotorDeflection)
-        field_.rows_at = lambda f, j: centre(f, j, *rotor.rows(f, j))  # noqa: E731
+        field_.kernel_table = kernel_table
         return field_
 
     def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):
@@ -115,13 +124,14 @@ class EkmanVeerVelocityDeflection(BaseModel):
 
 
 class RotorDeflection(np.ndarray):
-    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``rows_at(f, j)``:
-    the centre at the rows of the rotor cells' sub-quadrature of rotors (f, j) downstream
-    (index arrays; returns (pairs, rows)), for the velocity model's rotor-cell average, which
-    evaluates it only where the wake can reach. Arithmetic on it gives plain arrays (FLORIS's
-    own velocity models read it as the point field it is)."""
+    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``kernel_table(f)``:
+    the wake's factors of its centre (t_hat's prefactor, R sqrt(A*), the veer and ground-image
+    switches) for conditions ``f``, from which the rotor-cell kernel evaluates the centre at the
+    rows of the rotors the wake can reach (plugin/rotor_kernel.py, wake/fused.py
+    ``centre_offset``). Arithmetic on it gives plain arrays (FLORIS's own velocity models read
+    it as the point field it is)."""
 
-    rows_at = None
+    kernel_table = None
 
     def __array_wrap__(self, array, context=None, return_scalar=False):
         result = array.view(np.ndarray)

@@ -18,7 +18,12 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
-from floris_ekman_veer.plugin.rotor_kernel import PAIR_COLUMNS, WAKE_COLUMNS, integrate_wake
+from floris_ekman_veer.plugin.rotor_kernel import (
+    CENTRE_COLUMNS,
+    PAIR_COLUMNS,
+    WAKE_COLUMNS,
+    integrate_wake,
+)
 from floris_ekman_veer.plugin.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 
@@ -34,9 +39,6 @@ ROTOR_PLANE_MARGIN = 0.1
 #: (a power change of at most 3e-5 of a turbine that sees no other wake, far less where wakes
 #: combine).
 NEGLIGIBLE_DEFICIT = 1e-5
-
-#: Rotors whose wake centre is evaluated at their sub-point rows at once.
-PAIR_CHUNK = 1024
 
 #: The velocity models' ``wake_expansion`` choices (plugin/models.py): the paper's ambient k_w,
 #: and the two that add the upstream wakes' turbulence at a rotor (its largest, as FLORIS
@@ -145,8 +147,8 @@ def rotor_cell_deficit(
                                      per_pair["ct"], per_pair["yaw"])
     reach_squared = 2.0 * width**2 * np.log(
         np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
-    rows_at = getattr(deflection_field_i, "rows_at", None)
-    if rows_at is not None and cells.n > 1:
+    centre_table = getattr(deflection_field_i, "kernel_table", None)
+    if centre_table is not None and cells.n > 1:
         # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
         # widened by its spread plus R/4 on either side (the centre at the rows beyond
         # +-R/2, twice the linear extrapolation, and between them) are not integrated and
@@ -166,42 +168,39 @@ def rotor_cell_deficit(
         per_pair = {k: v[near] for k, v in per_pair.items()}
         if f.size == 0:
             return result.reshape(u_initial.shape)
-    if rows_at is None:
+    centre = None
+    if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
         # (A sum over the n points, not a matrix product: BLAS would block the product by
         # the number of pairs, i.e. by the batch.)
         centre = np.sum(deflection_field_i[f, j, 0, :, None]
                         * row_interpolation(cells.n, cells.row_z), axis=1)
+        centre_table = {"strength": 0.0, "r_tube": 1.0, "image_height": 0.0, "veer": 0.0,
+                        "ground_image": 0.0}
     else:
-        # In chunks of rotors, so that the deflection's temporaries stay small.
-        centre = np.concatenate([rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK])
-                                 for k in range(0, f.size, PAIR_CHUNK)])
-    lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
-    dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
-    kind = rotor.kind[f, j]
-    radius_j = rotor.radius[f, j][:, None]
-    gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
-    # Row by row: only the rows the wake reaches are integrated.
-    p, r = np.nonzero(gap < reach_squared[:, None])  # (pair, row) entries
-    if p.size == 0:
-        return result.reshape(u_initial.shape)
-    reached = p[np.flatnonzero(np.diff(p, prepend=-1))]  # p is sorted
-    _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
-                      radius_j[reached], cells, rotor.warned)
+        centre_table = centre_table(f)
     flat = f * n_turbines + j
+    kind = rotor.kind[f, j]
     moment = rotor.moment[f, j]
-    # The kernel's tables (plugin/rotor_kernel.py): the deficit's factors that depend on the
-    # wake only (the velocity model's), and the solver's, once per rotor reached.
+    # The kernel's tables (plugin/rotor_kernel.py): the deficit's and the centre's factors
+    # that depend on the wake only (the velocity and deflection models'), and the solver's,
+    # once per rotor within reach.
     table = model.kernel_table(x_pair, *(per_pair[k] for k in (
         "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
     per_pair["velocity_scale"] = per_pair["hub_speed"] * per_pair["speed_fraction"]
-    per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0], radius_j=radius_j[:, 0],
-                    hub_height=hub_height_i[f, 0, 0, 0], moment=moment)
-    removed, overlap = integrate_wake(
-        np.searchsorted(p, np.arange(f.size + 1)), r,
-        np.stack([np.broadcast_to(table[k], f.shape) for k in WAKE_COLUMNS], axis=1),
-        np.stack([per_pair[k] for k in PAIR_COLUMNS], axis=1), centre, flat, kind, rotor,
-        wakes, track)
+    per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0],
+                    radius_j=rotor.radius[f, j], hub_height=hub_height_i[f, 0, 0, 0],
+                    moment=moment, reach_squared=reach_squared)
+    columns = lambda table, names: np.stack(  # noqa: E731
+        [np.broadcast_to(table[k], f.shape) for k in names], axis=1)
+    removed, overlap, reached, centre = integrate_wake(
+        columns(table, WAKE_COLUMNS), columns(per_pair, PAIR_COLUMNS),
+        columns(centre_table, CENTRE_COLUMNS), centre, flat, kind, rotor, wakes, track)
+    reached = np.flatnonzero(reached)
+    if reached.size == 0:
+        return result.reshape(u_initial.shape)
+    _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
+                      rotor.radius[f, j][reached, None], cells, rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell,

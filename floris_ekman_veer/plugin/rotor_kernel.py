@@ -25,15 +25,18 @@ from floris_ekman_veer.plugin.rotor_wakes import (
     superposed,
 )
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
-from floris_ekman_veer.wake.fused import JIT, curl_polynomial, point_deficit
+from floris_ekman_veer.wake.fused import JIT, centre_offset, curl_polynomial, point_deficit
 
-#: The per-wake columns of the kernel's wake table, one row per (wake, rotor reached): the
+#: The per-wake columns of the kernel's tables, one row per (wake, rotor within reach): the
 #: velocity model's (``kernel_table``: C(x), k_w x, 0.4 R sqrt(A*) |cos beta|, sin^2 beta, t_hat's
 #: prefactor (0: no curl), 1 if the polar angle is measured from the yaw-only centre, the
-#: radial shape exponent) then the solver's.
+#: radial shape exponent), the deflection model's (its ``kernel_table``: the centre's t_hat
+#: prefactor, R sqrt(A*), the image vortex's hub height, the veer and ground-image switches)
+#: and the solver's.
 WAKE_COLUMNS = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape")
+CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 PAIR_COLUMNS = ("x", "velocity_scale", "cos", "sin", "friction_velocity", "radius",
-                "offset", "radius_j", "hub_height", "moment")
+                "offset", "radius_j", "hub_height", "moment", "reach_squared")
 
 #: numba's threading layer where the user has not chosen one: one that survives a fork
 #: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
@@ -46,20 +49,33 @@ _LAUNCH = threading.Lock()
 
 
 @numba.njit(parallel=True, **JIT)
-def _integrate(start, rows, wake, pair, centre, condition, kind, kind_u, kind_v, kind_heights,
-               sub_y, weight, cell, width, rule, combined, block, track, removed, overlap):
-    for k in numba.prange(start.size - 1):
+def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind, kind_u,
+               kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
+               block, track, removed, overlap, reached):
+    for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b, strength, polar_veer, shape = wake[k]
-        (x, scale, cos_a, sin_a, u_star, radius, offset, radius_j, hub_height,
-         moment) = pair[k]
+        (x, scale, cos_a, sin_a, u_star, radius, offset, radius_j, hub_height, moment,
+         reach_squared) = pair[k]
+        strength_c, r_tube, image_height, veer, ground_image = centre_table[k]
         f, kk = condition[k], kind[k]
         reach = 4.0 * radius
         area = 0.0
-        for e in range(start[k], start[k + 1]):
-            r = rows[e]
+        for r in range(row_chord.size):
             u, v = kind_u[f, kk, r], kind_v[f, kk, r]
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
+            if compute_centre:
+                centre[k, r] = centre_offset(x, kind_heights[kk, r], local_u, local_v,
+                                             strength_c, r_tube, image_height, radius, u_star,
+                                             veer, ground_image)
+            lateral = offset - centre[k, r]
+            dz = kind_heights[kk, r] - hub_height
+            # Only the rows the wake reaches are integrated (plugin/rotor.py
+            # NEGLIGIBLE_DEFICIT): the row's nearest point within reach.
+            gap = max(abs(lateral) - radius_j * row_chord[r], 0.0) ** 2 + dz * dz
+            if not gap < reach_squared:
+                continue
+            reached[k] = True
             # No flow (at and below z0): no wake.
             flowing = local_u > 0.0
             ambient_u = u if flowing else 0.0
@@ -68,8 +84,6 @@ def _integrate(start, rows, wake, pair, centre, condition, kind, kind_u, kind_v,
                 strength * -np.expm1(-0.35 * (u_star / speed) * x / radius), CURL_ALPHA)
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
-            lateral = offset - centre[k, r]
-            dz = kind_heights[kk, r] - hub_height
             index = block[k] + r
             for s in range(width[r]):
                 dy = lateral + radius_j * sub_y[r, s]
@@ -88,28 +102,32 @@ def _integrate(start, rows, wake, pair, centre, condition, kind, kind_u, kind_v,
         overlap[k] = area
 
 
-def integrate_wake(start, rows, wake, pair, centre, flat, kind, rotor, wakes, track):
+def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, track):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
-    in each cell, sum_{s in k} w_s (u_before^m - u_after^m), and (pairs,) the overlap (the area
-    fraction of the disk where FLORIS counts the wake; 0 unless ``track``).
+    in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
+    fraction of the disk where FLORIS counts the wake; 0 unless ``track``), (pairs,) whether
+    the wake reached a row of the rotor, and (pairs, rows) the wake's centre at the rows.
 
-    ``start`` (pairs + 1,): each rotor's first entry of ``rows`` (the rows reached, ascending
-    per rotor); ``wake`` (pairs, WAKE_COLUMNS) and ``pair`` (pairs, PAIR_COLUMNS) the tables;
-    ``centre`` (pairs, rows) the wake centre at the rows; ``flat`` (pairs,) each rotor's flat
-    index (condition * n_turbines + turbine), ``kind`` its kind (plugin/ambient.py
-    ``RotorAmbient``); ``wakes`` the solve's
+    ``wake``, ``pair`` and ``centre_table`` (pairs, WAKE_COLUMNS, PAIR_COLUMNS, CENTRE_COLUMNS):
+    the tables, one row per rotor within reach; ``centre`` (pairs, rows) the wake's centre at
+    the rows, or None: the kernel evaluates it from ``centre_table`` (the ekman_veer
+    deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
+    ``kind`` its kind (plugin/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor_wakes.RotorWakes`, whose stored combination is
     updated in place.
     """
     cells = wakes.cells
-    n_pairs = start.size - 1
+    n_pairs = flat.size
     removed = np.zeros((n_pairs, cells.n**2))
     overlap = np.zeros(n_pairs)
-    condition = flat // rotor.x.shape[1]
+    reached = np.zeros(n_pairs, dtype=bool)
+    compute_centre = centre is None
+    centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     with _LAUNCH:
-        _integrate(start, rows, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(centre), condition, kind, rotor.kind_u, rotor.kind_v,
-                   rotor.kind_heights, cells.sub_y, cells.weight, cells.cell_grid,
-                   cells.row_width, wakes.rule_code, wakes.combined, flat * cells.rows,
-                   bool(track), removed, overlap)
-    return removed, overlap
+        _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
+                   np.ascontiguousarray(centre_table), compute_centre, centre,
+                   flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
+                   rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
+                   cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,
+                   flat * cells.rows, bool(track), removed, overlap, reached)
+    return removed, overlap, reached, centre

@@ -26,6 +26,7 @@ from .deficit import (
     time_like_growth,
     time_like_strength,
 )
+from .deflection import IMAGE_CORE
 
 #: How the compiled functions are compiled: cached on disk, IEEE arithmetic (no fastmath).
 JIT = {"cache": True, "fastmath": False, "error_model": "numpy"}
@@ -69,6 +70,50 @@ def point_deficit(dy, dz, polar_dy, amplitude, kx, xi0, sin2b, q0, q1, q2, q3, q
     if shape != GAUSSIAN_SHAPE:
         exponent = exponent ** (0.5 * shape)
     return amplitude * np.exp(-exponent)
+
+
+@numba.njit(**JIT)
+def centre_offset(x, z, local_u, local_v, strength, r_tube, hub_height, radius, friction_velocity,
+                  veer, ground_image):
+    """y_c(x, z) of Eq. (yc_xz) at one height z (x > 0), as wake/deflection.py's
+    ``wake_centre_offset`` (the readable form): the vortex pair's y_hat_c of Eq. (yhatc) with
+    its ground image (``ground_image`` 1, eta floored at 1 + IMAGE_CORE) times R sqrt(A*)
+    (``r_tube``), t_hat = ``strength`` (1 - exp(-0.35 (u*/U(z)) x/R)) (Eq. that), plus
+    ``veer`` times x V(z)/U(z) (Eq. yc_veer); 0 where there is no flow (U(z) <= 0)."""
+    if not local_u > 0.0:
+        return 0.0
+    t_hat = strength * -np.expm1(-0.35 * (friction_velocity / local_u) * x / radius)
+    abs_t = abs(t_hat)
+    pm1 = np.pi - 1.0
+    numerator = (pm1 * abs_t * abs_t * abs_t + 2.0 * np.sqrt(3.0) * np.pi**2 * abs_t * abs_t
+                 + 48.0 * pm1**2 * abs_t)
+    denominator = (2.0 * np.pi * pm1 * abs_t * abs_t + 4.0 * np.sqrt(3.0) * np.pi**2 * abs_t
+                   + 96.0 * pm1**2)
+    y_hat = np.sign(t_hat) * numerator / denominator
+    if ground_image:
+        eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
+        y_hat -= (2.0 / np.pi) * t_hat / (eta * eta - 1.0)
+    return y_hat * r_tube + veer * (x * local_v / local_u)
+
+
+@numba.njit(**JIT)
+def _centre_offsets(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
+                    friction_velocity, veer, ground_image):
+    out = np.empty(x.size)
+    for k in range(x.size):
+        out[k] = centre_offset(x[k], z[k], local_u[k], local_v[k], strength[k], r_tube[k],
+                               hub_height[k], radius[k], friction_velocity[k], veer,
+                               ground_image)
+    return out
+
+
+def centre_offsets(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
+                   friction_velocity, veer=True, ground_image=True):
+    """:func:`centre_offset` on broadcast arrays (for the tests' comparison)."""
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (
+        x, z, local_u, local_v, strength, r_tube, hub_height, radius, friction_velocity)))
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    return _centre_offsets(*flat, float(veer), float(ground_image)).reshape(arrays[0].shape)
 
 
 @numba.njit(**JIT)

@@ -8,7 +8,8 @@
    quadrature of ``sample_flow_at_points`` (point values) over the disk normal to the wind,
    averaged as the turbine averages (cubic mean for a power curve, plain mean for the disk).
    benchmarks/bench_rotor_average.py runs the full grid of cases (the README's table).
-3. The fused deficit kernel equals the readable Eq. (du_model) (wake/fused.py).
+3. The compiled deficit and wake centre of the rotor-cell kernel equal the readable Eqs.
+   (du_model) and (yc_xz) (wake/fused.py).
 4. The guard: a grid too coarse for a sheared band warns once, naming the setting.
 """
 
@@ -26,7 +27,9 @@ from floris.utilities import load_yaml
 import floris_ekman_veer  # noqa: F401  (registers the models)
 from floris_ekman_veer.plugin.rotor_cells import grid_offsets, rotor_cells
 from floris_ekman_veer.wake.deficit import normalised_deficit
-from floris_ekman_veer.wake.fused import deficit_on_rows, rows_deficit_parameters
+from floris_ekman_veer.wake.deficit import initial_radius, time_like_strength
+from floris_ekman_veer.wake.deflection import wake_centre_offset
+from floris_ekman_veer.wake.fused import centre_offsets, deficit_on_rows, rows_deficit_parameters
 from tests.plugin.multiwake_reference import disk_quadrature
 
 INPUTS = Path(__file__).resolve().parents[2] / "inputs"
@@ -159,6 +162,35 @@ def test_fused_deficit_equals_eq_du_model():
                                       curl=curl)
         np.testing.assert_allclose(fused, readable, rtol=1e-12, atol=1e-15)
         assert readable.max() > 0.1
+
+
+def test_compiled_centre_equals_eq_yc_xz():
+    """The kernel's centre at the rows (wake/fused.py centre_offset) against the readable
+    y_c(x, z) of Eq. (yc_xz): yaw (both signs, with and without the ground image, hubs low
+    enough for the image core's floor) and veer, and no flow (U <= 0) giving 0."""
+    rng = np.random.default_rng(5)
+    pairs = 60
+    x = rng.uniform(50.0, 2500.0, (pairs, 1))
+    yaw = rng.uniform(-0.5, 0.5, (pairs, 1))
+    ct = rng.uniform(0.2, 0.95, (pairs, 1))
+    hub = rng.uniform(40.0, 150.0, (pairs, 1))
+    z = hub + rng.uniform(-60.0, 60.0, (pairs, 7))
+    u = rng.uniform(3.0, 12.0, (pairs, 7))
+    v = rng.uniform(-2.0, 2.0, (pairs, 7))
+    u[0, :2] = (0.0, -0.5)  # no flow
+    strength = time_like_strength(0.35, 9.0, ct, yaw)
+    r_tube = initial_radius(60.0, ct, yaw)
+    for veer in (True, False):
+        for image in (True, False):
+            compiled = centre_offsets(x, z, u, v, strength, r_tube, hub, 60.0, 0.35, veer,
+                                      image)
+            flowing = u > 0
+            readable = np.where(flowing, wake_centre_offset(
+                x, z, hub_height=hub, radius=60.0, ct=ct, yaw=yaw, friction_velocity=0.35,
+                hub_speed=9.0, local_speed=np.where(flowing, u, 1.0),
+                lateral_speed=np.where(flowing, v, 0.0), veer=veer, ground_image=image), 0.0)
+            np.testing.assert_allclose(compiled, readable, rtol=1e-12, atol=1e-12)
+            assert np.abs(readable).max() > 20.0 and np.all(compiled[0, :2] == 0.0)
 
 
 # -------------------------------------------------------------------------------- 4. guard
