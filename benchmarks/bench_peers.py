@@ -30,7 +30,8 @@ the shared machine weighs on all alike, best of ``--repeats`` after a warm-up (f
 measured in a separate run. Scaling: the exponent b of a least-squares fit of
 CPU time = a n_turbines^b over the farms. ``--profile`` adds a cProfile of M-1 on the 10 x 10
 farm on one thread (top functions by internal time). ``--threads`` sets numexpr's threads (FLORIS's gauss sums
-and the package's superposition run on them; default: numexpr's, all cores).
+run on them) and numba's (the package's rotor-cell kernel, plugin/rotor_kernel.py); default: each
+library's own, all cores.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ import numpy as np
 
 from benchmarks import bench_models  # the farm, the inputs and the conditions
 
+import numba  # noqa: E402
 import numexpr  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
@@ -176,6 +178,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     if args.threads:
         numexpr.set_num_threads(args.threads)
+        numba.set_num_threads(args.threads)
     contenders = [c.strip() for c in args.contenders.split(",")]
     try:
         import py_wake
@@ -188,7 +191,8 @@ def main(argv=None) -> None:
     load = os.getloadavg()
     print(f"NREL 5 MW farms at 7 D, {args.conditions} random yawed conditions (seed {args.seed}), "
           f"interleaved, best of {args.repeats}; {pywake}; numexpr threads "
-          f"{numexpr.get_num_threads()} of {os.cpu_count()} CPUs; load average "
+          f"{numexpr.get_num_threads()}, numba threads {numba.get_num_threads()} of "
+          f"{os.cpu_count()} CPUs; load average "
           f"{load[0]:.1f} at the start\n")
     results = {}
     print("| farm | contender | wall [s] | / gauss | CPU [s] | / gauss | peak memory [MB] |")
@@ -216,6 +220,7 @@ def main(argv=None) -> None:
     if args.profile:
         # On one thread: cProfile sees the main thread only.
         numexpr.set_num_threads(1)
+        numba.set_num_threads(1)
         directions, speeds, yaw = bench_models.conditions(args.conditions, args.seed, 10)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
