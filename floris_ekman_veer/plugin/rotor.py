@@ -87,8 +87,9 @@ def rotor_cell_deficit(
     increment FLORIS's combination turns into the combined cell deficit; the rest 0.
 
     ``model`` is the velocity model (plugin/models.py): its ``expansion_rate`` (k_w),
-    ``width_bound`` and ``amplitude_bound`` (how far its wake reaches), ``sub_point_deficit``
-    (Delta u / U_h of a :class:`TurbineWake`), ``wake_expansion`` and ``deficit_velocity``
+    ``width_bound`` and ``amplitude_bound`` (how far its wake reaches), ``kernel_table`` (the
+    deficit's per-wake factors for the kernel, plugin/rotor_kernel.py), ``wake_expansion`` and
+    ``deficit_velocity``
     (with "incoming" the wake's velocity is scaled by turbine i's U_i / U_i,0 of the wakes
     superposed so far, docs/coupling.md#wakes-deep-in-an-array). ``ambient`` is the grid's
     :class:`~floris_ekman_veer.plugin.ambient.Ambient` with its ``rotor``, ``wakes`` the solve's
