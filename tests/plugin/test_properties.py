@@ -354,7 +354,7 @@ def near_ground_flow(fmodel, x):
     ))
     u = fmodel.sample_flow_at_points(x, y, z)[0]
     abl = floris_ekman_veer.plugin.inflow.inflow.solved_atmosphere(fmodel.core.flow_field)
-    ambient, _ = floris_ekman_veer.plugin.inflow.inflow_profile(abl, z, 100.0)
+    ambient, _ = floris_ekman_veer.plugin.inflow.inflow.inflow_profile(abl, z, 100.0)
     return u, np.ravel(ambient), z
 
 
