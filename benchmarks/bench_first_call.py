@@ -1,4 +1,4 @@
-"""The first call's cost of the compiled rotor-cell kernel (plugin/rotor_kernel.py), each case in
+"""The first call's cost of the compiled rotor-cell kernel (plugin/rotor/rotor_kernel.py), each case in
 a fresh process (hand-run script, not a test):
 
     python -m benchmarks.bench_first_call [--repeats 2] [--reference PATH]

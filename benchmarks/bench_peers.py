@@ -30,7 +30,7 @@ the shared machine weighs on all alike, best of ``--repeats`` after a warm-up (f
 measured in a separate run. Scaling: the exponent b of a least-squares fit of
 CPU time = a n_turbines^b over the farms. ``--profile`` adds a cProfile of M-1 on the 10 x 10
 farm on one thread (top functions by internal time). ``--threads`` sets numexpr's threads (FLORIS's gauss sums
-run on them) and numba's (the package's rotor-cell kernel, plugin/rotor_kernel.py); default: each
+run on them) and numba's (the package's rotor-cell kernel, plugin/rotor/rotor_kernel.py); default: each
 library's own, all cores.
 """
 

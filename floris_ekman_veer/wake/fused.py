@@ -5,8 +5,8 @@ this module evaluates the same formula where most factors are shared: per wake (
 the stream-tube radius, beta: :func:`wake_deficit_parameters`, numpy) and per height (t_hat and
 the three tanh of Eq. xi_emp depend on z only, through U(z): :func:`curl_polynomial`), leaving
 per point only the polar harmonics, the width and the Gaussian (:func:`point_deficit`). The
-compiled functions are called by the rotor-cell kernel (plugin/rotor_kernel.py) once per
-sub-point; :func:`deficit_on_rows` runs them on arrays (tests/plugin/test_rotor_average.py
+compiled functions are called by the rotor-cell kernel (plugin/rotor/rotor_kernel.py) once per
+sub-point; :func:`deficit_on_rows` runs them on arrays (tests/plugin/rotor/test_rotor_average.py
 checks it against ``normalised_deficit`` to round-off). ``cache=True``: compiled once per
 installation (numba's cache next to the module, or its user cache directory where the
 package's folder is read-only; NUMBA_CACHE_DIR moves it), no fastmath (IEEE results, the same
