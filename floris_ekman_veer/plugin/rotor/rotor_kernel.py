@@ -1,4 +1,5 @@
-"""The compiled kernel of one wake step on the rotor cells (docs/performance.md#the-kernel).
+"""The compiled kernel of one wake step on the rotor cells
+(docs/performance.md#the-compiled-kernel).
 
 :func:`integrate_wake` does, for every rotor a wake reaches and every sub-point row of it that
 the wake reaches (plugin/rotor/rotor.py chooses them), in one pass over the row's sub-points: the
