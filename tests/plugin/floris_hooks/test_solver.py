@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer.plugin.floris_hooks import solver
 
-INPUTS = Path(__file__).resolve().parents[2] / "inputs"
+INPUTS = Path(__file__).resolve().parents[3] / "inputs"
 FARMS = ("farm_sbl6", "farm_night", "farm_day")
 #: (velocity model, veer): M-1, M-2, M-3.
 MODELS = (("ekman_veer", True), ("ekman_veer", False), ("bastankhah2014", False))

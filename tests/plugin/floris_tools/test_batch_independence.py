@@ -24,7 +24,7 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401
 
-FARM = Path(__file__).resolve().parents[2] / "inputs" / "farm_sbl6.yaml"
+FARM = Path(__file__).resolve().parents[3] / "inputs" / "farm_sbl6.yaml"
 
 
 def powers(fmodel, speeds, directions, yaw):

@@ -32,7 +32,7 @@ from floris_ekman_veer.wake.deflection import wake_centre_offset
 from floris_ekman_veer.wake.fused import centre_offsets, deficit_on_rows, rows_deficit_parameters
 from tests.plugin.rotor.multiwake_reference import disk_quadrature
 
-INPUTS = Path(__file__).resolve().parents[2] / "inputs"
+INPUTS = Path(__file__).resolve().parents[3] / "inputs"
 
 
 # ---------------------------------------------------------------------------------- 1. cells
