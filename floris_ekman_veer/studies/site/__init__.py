@@ -3,7 +3,8 @@ per-record FLORIS inputs (docs/measurements.md#a-real-mast).
 
 ``pipeline.py`` runs the stages in order, each a module a user can call and inspect:
 ``columns`` (1. the instruments the records hold) -> ``readings`` (2. the cleaned readings; the
-vanes' part in ``vanes``) -> ``offsets`` (3. the vane offsets) -> ``record_fit`` (4. the
+vanes' part in ``vanes``) -> ``baseline`` and ``offsets`` (3. the site's neutral baseline and
+the vane offsets) -> ``record_fit`` (4. the
 per-record fit) -> ``atmospheres`` (5. FLORIS's inputs per record: ``SiteAtmosphere``).
 ``shear_and_veer`` gives the atmosphere of FLORIS's simpler inflow inputs (a shear exponent and
 a veer).
