@@ -23,6 +23,7 @@ from floris_ekman_veer.studies.energy import energy_by_month, record_energy
 from floris_ekman_veer.studies.site.baseline import NeutralBaseline
 from floris_ekman_veer.studies.site.readings import Instruments
 from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS, RecordFit
+from floris_ekman_veer.studies.site.wra_file import MastMetadata
 
 #: The fitted records' classes, by their Obukhov length (ProfileFit.stability_class).
 STABILITY_CLASSES = ("convective", "neutral", "stable")
@@ -151,6 +152,8 @@ class SiteAtmosphere:
     flags: pd.DataFrame | None = None
     #: The site's neutral baseline (baseline.py): the roughness rose and neutral turbulence.
     baseline: NeutralBaseline | None = None
+    #: The mast's metadata file as read (wra_file.py: location, logger's UTC offset, columns).
+    metadata: MastMetadata | None = None
 
     @property
     def neutral_roughness_lengths(self) -> np.ndarray | None:

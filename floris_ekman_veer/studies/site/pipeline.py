@@ -7,7 +7,8 @@ Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with
 deviations and vanes at their own heights (columns.py), and optionally a ``time`` column naming
 the records. :func:`fit_site` runs, each stage a module a user can call and inspect:
 
-1. the instruments the columns hold (:func:`.columns.mast_columns`);
+1. the instruments the columns hold (:func:`.columns.mast_columns`), named by the mast's IEA
+   Wind Task 43 metadata file where one is given (:func:`.wra_file.read_wra_file`);
 2. the cleaned readings: bad and stuck readings removed and named, redundant cups out of the
    mast's wake (:func:`.readings.read_instruments`);
 3. the site's neutral baseline (its roughness rose and neutral turbulence,
@@ -20,6 +21,7 @@ the records. :func:`fit_site` runs, each stage a module a user can call and insp
 
 from __future__ import annotations
 
+import attrs
 import numpy as np
 import pandas as pd
 
@@ -29,6 +31,7 @@ from floris_ekman_veer.studies.site.columns import mast_columns
 from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
 from floris_ekman_veer.studies.site.readings import SHADOW_HALF_WIDTH, read_instruments
 from floris_ekman_veer.studies.site.record_fit import fit_records
+from floris_ekman_veer.studies.site.wra_file import read_wra_file
 
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")
@@ -41,7 +44,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
              stability_input: str = "stability_parameter", on_misfit: str = "raise",
              time_column: str | None = None, booms: dict | None = None,
              direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
-             roughness_length="estimate", **fit_options_and_inputs) -> SiteAtmosphere:
+             roughness_length="estimate", metadata=None,
+             **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
     The mast's instruments are read first (columns.py, readings.py, offsets.py;
@@ -80,6 +84,11 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             30-deg sector from its strong-wind, near-neutral records, baseline.py and
             docs/measurements.md#the-sites-neutral-baseline), a number [m], one per record, or
             ``{sector centre deg: z0 m}`` (each record takes the sector nearest its direction).
+        metadata: the path of the mast's IEA Wind Task 43 WRA data model file (JSON; wra_file.py,
+            docs/measurements.md#the-masts-own-metadata): its logger columns are read as the
+            records' columns, its booms as ``booms`` and its location as ``latitude``; given
+            ``booms`` or ``latitude`` that contradict it, or a column it names that the records
+            lack, are refused naming both.
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
     """
@@ -95,7 +104,21 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             or not np.isfinite(reference_height) or reference_height <= 0):
         raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
                          f"got {reference_height!r}")
-    # 1. the instruments
+    # 1. the instruments (from the mast's metadata file where given)
+    mast = None
+    if metadata is not None:
+        mast = read_wra_file(metadata)
+        records = mast.named_records(records)
+        if booms is not None and mast.booms and dict(booms) != mast.booms:
+            raise ValueError(f"fit_site: booms={booms} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose booms are {mast.booms}; give one of them")
+        booms = booms if booms is not None else (mast.booms or None)
+        given = fit_options_and_inputs.get("latitude", mast.latitude)
+        if np.ndim(given) or not np.isclose(given, mast.latitude, atol=1e-6):
+            raise ValueError(f"fit_site: latitude={given!r} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose location is at {mast.latitude:g} deg; "
+                             "give one of them")
+        fit_options_and_inputs = {**fit_options_and_inputs, "latitude": mast.latitude}
     columns = mast_columns(records, booms)
     if time_column is not None and time_column not in records.columns:
         raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
@@ -131,5 +154,6 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     record_fit = fit_records(instruments, columns, labels, z_ref, fit_inputs,
                              stability_input=stability_input, on_misfit=on_misfit)
     # 5. the atmospheres
-    return site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
+    site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
                            stability_input=stability_input)
+    return site if mast is None else attrs.evolve(site, metadata=mast)
