@@ -18,8 +18,8 @@ from floris.wind_data import TimeSeries
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.plugin.inflow import set_atmosphere
-from floris_ekman_veer.studies.energy import energy_by_month, record_energy
+from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
+from floris_ekman_veer.studies.energy.energy import energy_by_month, record_energy
 from floris_ekman_veer.studies.site.baseline import NeutralBaseline
 from floris_ekman_veer.studies.site.readings import Instruments
 from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS, RecordFit

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.site.readings import Instruments
 from floris_ekman_veer.studies.site.vanes import (OFFSET_MIN_SPEED, direction_near,
                                                   median_and_error, reference_index,

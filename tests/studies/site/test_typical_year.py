@@ -1,4 +1,4 @@
-"""A fitted record set's energy by calendar month as a typical year (studies/energy.py
+"""A fitted record set's energy by calendar month as a typical year (studies/energy/energy.py
 ``energy_by_month``, docs/measurements.md#the-site-report): January to December, each month the
 mean power of the years present averaged over those years, with its data coverage."""
 
@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from floris_ekman_veer.studies.energy import energy_by_month
-from floris_ekman_veer.studies.energy_results import AnnualEnergy
+from floris_ekman_veer.studies.energy.energy import energy_by_month
+from floris_ekman_veer.studies.energy.energy_results import AnnualEnergy
 
 
 def energy_of(times, power):
