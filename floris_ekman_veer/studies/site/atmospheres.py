@@ -144,9 +144,9 @@ class SiteAtmosphere:
     #: Per fitted record its row in the records, and the count of records given.
     rows: np.ndarray | None = None
     n_records: int | None = None
-    #: What the mast's instruments gave (stages 2-3, readings.py and offsets.py): the vane offsets applied, the cup
-    #: pairs' agreement, and the values removed (``row``, ``time``, ``column``, ``kind``,
-    #: ``reason``).
+    #: What the mast's instruments gave (stages 2-3, readings.py and offsets.py): the vane
+    #: offsets applied, the cup pairs' agreement, and the values removed (``row``, ``time``,
+    #: ``column``, ``kind``, ``reason``).
     offsets: pd.DataFrame | None = None
     cup_pairs: pd.DataFrame | None = None
     flags: pd.DataFrame | None = None

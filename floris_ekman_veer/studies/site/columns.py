@@ -72,9 +72,10 @@ def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
         # Two names of one instrument (speed_90m and speed_90.0m): which one is the reading
         # is unknown, and keeping either would drop the other silently.
         if where in table:
+            height = where[0] if isinstance(where, tuple) else where
             raise ValueError(f"records: columns {table[where]!r} and {column!r} name the same "
-                             f"instrument (height {where[0] if isinstance(where, tuple) else where:g}"
-                             " m): keep one of them (or name the booms, speed_<h>m_<boom>)")
+                             f"instrument (height {height:g} m): keep one of them (or name the "
+                             "booms, speed_<h>m_<boom>)")
         table[where] = column
 
     for column in map(str, records.columns):
