@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from floris_ekman_veer.atmosphere.constants import ENTRAINMENT_RATIO
-from floris_ekman_veer.atmosphere.input_ranges import SENSIBLE_HEAT_FLUX_RANGE
-from floris_ekman_veer.atmosphere.stability_inputs import STABILITY_INPUTS
+from floris_ekman_veer.atmosphere.inputs.input_ranges import SENSIBLE_HEAT_FLUX_RANGE
+from floris_ekman_veer.atmosphere.inputs.stability_inputs import STABILITY_INPUTS
 
 #: What a reference-wind solve does with conditions whose state leaves the physical domain:
 #: "refuse" (the default: ValueError naming them) or "limit" (their stability limited toward

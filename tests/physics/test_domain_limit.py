@@ -11,7 +11,7 @@ import pytest
 from floris_ekman_veer.atmosphere.constants import air_heat_capacity
 from floris_ekman_veer.atmosphere.domain_limit import LIMIT_MARGIN
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.input_ranges import SENSIBLE_HEAT_FLUX_RANGE
+from floris_ekman_veer.atmosphere.inputs.input_ranges import SENSIBLE_HEAT_FLUX_RANGE
 
 FORCING = dict(coriolis_parameter=1e-4, roughness_length=0.1, brunt_vaisala_frequency=6.1e-3,
                reference_potential_temperature=265.0)
