@@ -430,7 +430,8 @@ class EkmanABL(WindProfile):
 
     # ----------------------------------------------------------------------------- drivers
     @classmethod
-    def from_reference_wind(cls, speed, height, tolerance=1e-13, **inputs):
+    def from_reference_wind(cls, speed, height, tolerance=1e-13, outside_domain="refuse",
+                            **inputs):
         """Solve the ABL whose wind speed at ``height`` is ``speed`` (instead of giving G).
 
         FLORIS drives farms by the wind speed at a reference height. The solve is one scalar
@@ -444,11 +445,16 @@ class EkmanABL(WindProfile):
         leaves the bracket, converge whenever a solution exists. When none does (the speed is
         below the slowest wind the atmosphere supports at that height), the ValueError gives
         the condition, the speed and height asked for and that slowest speed.
+        A state outside the physical domain is refused naming every speed that leaves it
+        (``outside_domain="refuse"``, the default); ``outside_domain="limit"`` carries the
+        conditions that leave it by their heat flux with their stability limited toward
+        neutral to the bound (``domain_limited`` marks them,
+        docs/atmosphere.md#a-fixed-stability-across-wind-speeds).
         Vectorised over arrays of speeds, heights and inputs (distinct conditions solved once).
         """
         if "geostrophic_wind" in inputs:
             raise ValueError("from_reference_wind takes speed and height instead of geostrophic_wind")
-        return solve_reference_wind(cls, speed, height, tolerance, inputs)
+        return solve_reference_wind(cls, speed, height, tolerance, inputs, outside_domain)
 
     @classmethod
     def fit_profile(cls, heights, speeds, directions=None, **options_and_fixed_inputs):

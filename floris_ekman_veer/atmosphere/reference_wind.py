@@ -20,6 +20,11 @@ from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     checked,
     require_broadcastable,
 )
+from floris_ekman_veer.atmosphere.domain_limit import (
+    check_policy,
+    heat_flux_outside,
+    limited_stability,
+)
 from floris_ekman_veer.atmosphere.root_finding import secant_root
 
 #: The tightest tolerance of the reference-wind solve (in ln speed): a few times the spacing of
@@ -31,9 +36,10 @@ _SCAN_POINTS = 64
 _ROUNDOFF_ACCEPTANCE = 1e-7
 
 
-def solve_reference_wind(abl_class, speed, height, tolerance, inputs):
+def solve_reference_wind(abl_class, speed, height, tolerance, inputs, outside_domain="refuse"):
     """The solved ``abl_class`` of ``inputs`` whose wind speed at ``height`` is ``speed``
     (`EkmanABL.from_reference_wind`, which documents the method and the arguments)."""
+    check_policy(outside_domain)
     speed = checked("speed", speed, lambda s: s > 0, "> 0 m/s")
     tolerance = float(checked(
         "tolerance", tolerance,
@@ -115,8 +121,23 @@ def solve_reference_wind(abl_class, speed, height, tolerance, inputs):
         "units of the inputs (cooling rate in K/h, heat flux in K m/s, lapse rate in K/m) or "
         "give weaker stratification",
     ))
+    if outside_domain == "limit":
+        outside = heat_flux_outside(abl)
+        if np.any(outside):
+            # Their stability limited toward neutral to the heat-flux bound (atmosphere/
+            # domain_limit.py), handed back in the input given; the others keep theirs.
+            name, values = limited_stability(
+                lambda s, h, given: solve_reference_wind(abl_class, s, h, tolerance, given),
+                abl, outside, speed, height, inputs)
+            limited = solve_reference_wind(abl_class, speed, height, tolerance,
+                                           {**inputs, name: values})
+            #: The conditions whose stability was limited to the domain's heat-flux bound.
+            limited.domain_limited = outside[()]
+            return limited
     abl.require_domain(lambda mask, reason: _reference_wind_refusal(
-        abl, mask, speed, height, inputs, f"leaves the physical domain: {reason}"))
+        abl, mask, speed, height, inputs, f"leaves the physical domain: {reason}"
+        + _outside_speeds(mask, speed, height)))
+    abl.domain_limited = np.zeros(np.shape(abl.friction_velocity), dtype=bool)[()]
     residual = np.abs(log_speed_error(log_u_star))
     #: |ln(speed at height / speed asked)| of each condition's solution
     abl.reference_wind_residual = residual[inverse.ravel()].reshape(shape)[()]
@@ -200,6 +221,23 @@ def _largest_root(log_speed_error, exists, abl, target, height, p, tolerance):
     # _ROUNDOFF_ACCEPTANCE in ln speed (a true step of the profile stays refused).
     converged |= np.abs(log_speed_error(root)) <= max(tolerance, _ROUNDOFF_ACCEPTANCE)
     return np.where(found & converged, root, np.nan), slowest
+
+
+def _outside_speeds(mask, speed, height):
+    """Which speeds leave the physical domain, and what holds at every speed instead."""
+    shape = mask.shape
+    speeds = np.broadcast_to(np.asarray(speed, dtype=float), shape)[mask]
+    heights = np.broadcast_to(np.asarray(height, dtype=float), shape)[mask]
+    return (
+        f". {np.count_nonzero(mask)} of {mask.size} conditions leave it: wind speeds "
+        f"{package_warnings.speeds_text(speeds)} at {package_warnings.range_text(heights, 'm')}. "
+        "A fixed L or mu (or a strong cooling rate) implies a heat flux growing like u*^3/L: "
+        "a night whose L grows with the wind is given by its heat flux or cooling rate "
+        "(sensible_heat_flux, cooling_rate); or outside_domain 'limit' (a keyword of "
+        "from_reference_wind, a key of the FLORIS atmosphere block) carries these conditions "
+        "with their stability limited toward neutral to the heat-flux bound "
+        "(docs/atmosphere.md#a-fixed-stability-across-wind-speeds)"
+    )
 
 
 def _reference_wind_refusal(abl, mask, speed, height, inputs, reason):

@@ -154,7 +154,9 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     highest rotor top, positive veering), ``turbulence_intensity`` (the ABL's I_u at the farm's
     mean hub height, Eq. Iu_model, with the convective variance in a convective layer),
     ``stability_parameter`` mu, ``obukhov_length`` L [m], ``sensible_heat_flux`` [W/m^2, upward
-    > 0] (the surface heat flux the condition implies), ``friction_rossby_number`` u*/(f z0),
+    > 0] (the surface heat flux the condition implies), ``stability_limited`` (bool: carried
+    with its stability limited to the heat-flux bound by the atmosphere block's
+    ``outside_domain: limit``), ``friction_rossby_number`` u*/(f z0),
     ``stability_class`` (:func:`stability_class`), and the four checks
     ``wake_validated_stability`` (:func:`wake_validated_stability`), ``deep_enough``
     (h / rotor top >= :data:`MIN_H_OVER_ROTOR_TOP`), ``rossby_in_range`` (within
@@ -213,6 +215,10 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         "h_over_rotor_top": h / top,
         "obukhov_length": per_condition(abl.obukhov_length),
         "sensible_heat_flux": per_condition(abl.sensible_heat_flux),
+        # Conditions the atmosphere block's outside_domain: limit carried at the heat-flux
+        # bound (docs/atmosphere.md#a-fixed-stability-across-wind-speeds).
+        "stability_limited": np.broadcast_to(np.asarray(
+            getattr(abl, "domain_limited", False), dtype=bool).reshape(-1), h.shape),
         "friction_rossby_number": rossby,
         "stability_class": stability_class(mu),
         "wake_validated_stability": validated,

@@ -20,6 +20,7 @@ import functools
 from collections.abc import Callable
 
 import attrs
+import floris.core.core as floris_core
 import floris.par_floris_model as floris_parallel
 from floris.core import Core, FlowField
 from floris.core.farm import Farm
@@ -40,7 +41,7 @@ from floris_ekman_veer.plugin.floris_hooks.patching import (
     reinstall,
     uninstall,
 )
-from floris_ekman_veer.plugin.floris_hooks.solver import install_solver_hook
+from floris_ekman_veer.plugin.floris_hooks.solver import handing_full_flow, install_solver_hook
 from floris_ekman_veer.plugin.floris_tools.uncertain_conditions import per_condition_set_uncertain
 from floris_ekman_veer.plugin.wake_models.wake_settings import converting_post_init
 
@@ -144,8 +145,15 @@ PATCHES: tuple[Patch, ...] = (
     Patch(owner="floris.core.core.sequential_solver", why=_SOLVER + ": FLORIS's dispatch of a run",
           checked_against=CHECKED_AGAINST, install=install_solver_hook),
     Patch(owner="floris.core.solver.sequential_solver",
-          why=_SOLVER + ": the turbine-grid solve inside FLORIS's full-flow solvers",
+          why=_SOLVER + ": the turbine-grid solve inside FLORIS's full-flow solvers; on a "
+                        "cubature grid the package's wakes take a turbine-grid solve's rotor "
+                        "states (plugin/rotor/turbine_states.py)",
           checked_against=CHECKED_AGAINST, install=install_solver_hook),
+    wrapped(floris_core, "full_flow_sequential_solver", handing_full_flow,
+            "FLORIS hands its turbine-grid solve's thrust and turbulence to the flow-field grid "
+            "but not the package's rotor states (incoming speeds, array turbulence): its planes "
+            "and points take them too, so that they show the wakes the powers have "
+            "(plugin/rotor/turbine_states.py)"),
 )
 
 

@@ -24,21 +24,26 @@ wake is zero on a rotor, FLORIS's update leaves that rotor's values unchanged bi
 Used by FLORIS's solver dispatch (``floris.core.core``, and the turbine-grid solve inside
 FLORIS's full-flow solver) when the velocity model is one of the package's on a turbine grid
 without GCH's terms (secondary steering, transverse velocities, yaw-added recovery, which read
-and write whole-farm fields); FLORIS's own solver otherwise.
+and write whole-farm fields); FLORIS's own solver otherwise. Its rotors' incoming speeds and array
+turbulence are handed to the wakes of FLORIS's other grids (cubature grids, planes, points:
+plugin/rotor/turbine_states.py, docs/coupling.md#one-physics-on-every-grid).
 """
 
 from __future__ import annotations
 
+import copy
 import functools
 
 import numpy as np
-from floris.core import axial_induction, thrust_coefficient
+from floris.core import TurbineCubatureGrid, TurbineGrid, axial_induction, thrust_coefficient
 from floris.core import core as floris_core
 from floris.core import solver as floris_solver
 
 from floris_ekman_veer.plugin.floris_hooks import patching
 from floris_ekman_veer.plugin.inflow import inflow
 from floris_ekman_veer.plugin.inflow.ambient import is_rotor_grid
+from floris_ekman_veer.plugin.rotor import turbine_states
+from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE
 from floris_ekman_veer.plugin.wake_models.models import EkmanWakeModel
 
 #: GCH's switches: each makes FLORIS's solver read or write whole-farm fields per turbine.
@@ -170,6 +175,52 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         )
     flow_field.turbulence_intensity_field_sorted_avg = np.mean(
         turbine_turbulence_intensity, axis=(2, 3), keepdims=True)
+    if turbine_states.collecting():
+        turbine_states.hand(_states(model_manager.velocity_model, deficit_model_args,
+                                    flow_field.turbulence_intensity_field_sorted_avg))
+
+
+def _states(model, deficit_model_args, floris_turbulence) -> turbine_states.TurbineStates:
+    """The rotors' states after a turbine-grid solve, as its wakes took them: U_i / U_i,0 and the
+    turbulence of each rotor (plugin/rotor/turbine_states.py). A rotor's values are final once the
+    wakes upstream of it are in, i.e. when its own wake was computed."""
+    ambient, wakes = deficit_model_args["ambient"], deficit_model_args["wakes"]
+    rotor = ambient.rotor
+    n_findex, n_turbines = rotor.x.shape
+    fraction = np.ones((n_findex, n_turbines))
+    if model.deficit_velocity == "incoming" and wakes.rule is not None:
+        u_cells = deficit_model_args["u_initial"].reshape(n_findex * n_turbines, -1)
+        fraction = wakes.incoming_fraction(np.arange(n_findex * n_turbines),
+                                           u_cells).reshape(n_findex, n_turbines)
+    tracked = (ADDED_TURBULENCE.get(model.wake_expansion) is not None
+               and wakes.rule is not None and wakes.turbulence_model is not None)
+    turbulence = (wakes.turbulence.copy() if tracked
+                  else np.asarray(floris_turbulence)[:, :, 0, 0].copy())
+    return turbine_states.TurbineStates(rotor.x, rotor.y, fraction, turbulence)
+
+
+def hands_turbine_states(model) -> bool:
+    """Whether the velocity model's wakes need the turbine grid's states on other grids: the
+    rotors' incoming speeds (``deficit_velocity: incoming``) or their array turbulence
+    (``wake_expansion: array_turbulence``), which FLORIS's point-wise solvers do not carry.
+    (``local_turbulence`` and ``free_stream`` they express themselves.)"""
+    return isinstance(model, EkmanWakeModel) and (
+        model.deficit_velocity == "incoming" or model.wake_expansion == "array_turbulence")
+
+
+def turbine_grid_states(farm, flow_field, model_manager) -> turbine_states.TurbineStates:
+    """The states of a turbine-grid solve of the same farm and conditions, on copies (as
+    FLORIS's ``full_flow_sequential_solver`` makes its turbine-grid solve)."""
+    turbine_farm, turbine_flow = copy.deepcopy(farm), copy.deepcopy(flow_field)
+    grid = TurbineGrid(turbine_coordinates=turbine_farm.coordinates,
+                       turbine_diameters=turbine_farm.rotor_diameters,
+                       wind_directions=turbine_flow.wind_directions, grid_resolution=3)
+    turbine_farm.expand_farm_properties(turbine_flow.n_findex, grid.sorted_coord_indices)
+    turbine_flow.initialize_velocity_field(grid)
+    turbine_farm.initialize(grid.sorted_indices)
+    with turbine_states.handing():
+        rotor_solver(turbine_farm, turbine_flow, grid, model_manager)
+        return turbine_states.handed()
 
 
 def _dispatching(original):
@@ -180,10 +231,31 @@ def _dispatching(original):
     def sequential_solver(farm, flow_field, grid, model_manager):
         if uses_rotor_solver(grid, model_manager):
             return rotor_solver(farm, flow_field, grid, model_manager)
+        if (isinstance(grid, TurbineCubatureGrid)
+                and hands_turbine_states(model_manager.velocity_model)
+                and not any(getattr(model_manager, flag, False) for flag in WHOLE_FARM_TERMS)):
+            # The cubature points' wakes take the turbine grid's rotor states
+            # (plugin/rotor/turbine_states.py), as the flow-field grids do.
+            states = turbine_grid_states(farm, flow_field, model_manager)
+            with turbine_states.handing():
+                turbine_states.hand(states)
+                return original(farm, flow_field, grid, model_manager)
         return original(farm, flow_field, grid, model_manager)
 
     sequential_solver.floris_solver = original
     return sequential_solver
+
+
+def handing_full_flow(original):
+    """FLORIS's ``full_flow_sequential_solver`` with a slot open for its turbine-grid solve's
+    rotor states, which the flow-field grid's wakes then take (plugin/rotor/turbine_states.py)."""
+
+    @functools.wraps(original)
+    def full_flow_sequential_solver(farm, flow_field, flow_field_grid, model_manager):
+        with turbine_states.handing():
+            return original(farm, flow_field, flow_field_grid, model_manager)
+
+    return full_flow_sequential_solver
 
 
 def floris_sequential_solver():

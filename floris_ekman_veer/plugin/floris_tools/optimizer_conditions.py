@@ -116,6 +116,7 @@ def row_following_subset(fmodel, index):
     subset = condition_subset(fmodel, index, spec.sliced(index))
     subset._atmosphere_rows = {k: v if isinstance(v, float) else v.reshape(-1)[index]
                                for k, v in spec.inputs.items()}
+    subset._atmosphere_policy = spec.policy
     _mark_rows(subset, np.arange(index.size))
     subset.set = types.MethodType(_set_following_rows, subset)
     return subset
@@ -135,8 +136,8 @@ def _set_following_rows(self, **kwargs):
     if n != rows.size:
         raise ValueError(f"optimize_yaw: the optimiser set {n} conditions on a model "
                          f"carrying the atmospheres of {rows.size}")
-    atmosphere = {k: v if isinstance(v, float) else v[rows].tolist()
-                  for k, v in self._atmosphere_rows.items()}
+    atmosphere = {**{k: v if isinstance(v, float) else v[rows].tolist()
+                     for k, v in self._atmosphere_rows.items()}, **self._atmosphere_policy}
     object.__setattr__(self.core.flow_field, "heterogeneous_inflow_config", None)
     set_atmosphere(_Plain(self), atmosphere, **kwargs)
     _mark_rows(self, rows)

@@ -69,8 +69,9 @@ def per_condition_set_uncertain(original):
             del self._get_unique_inputs
         rows = unique_labels[-1]
         atmosphere = {
-            name: value if isinstance(value, float) else [groups[k][0][name] for k in rows]
-            for name, value in spec.inputs.items()
+            **{name: value if isinstance(value, float) else [groups[k][0][name] for k in rows]
+               for name, value in spec.inputs.items()},
+            **spec.policy,
         }
         set_atmosphere(self.fmodel_expanded, atmosphere)
 

@@ -38,12 +38,17 @@ import attrs
 import numpy as np
 from floris.core import Core
 
+from floris_ekman_veer.atmosphere.domain_limit import check_policy
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.inputs.stability_inputs import STABILITY_INPUTS
 
 PARAMETER_BLOCK = "ekman_veer"
 ATMOSPHERE_KEY = "atmosphere"
 CONFIG_PATH = f"wake.wake_velocity_parameters.{PARAMETER_BLOCK}.{ATMOSPHERE_KEY}"
+#: The block's one key that is no EkmanABL input: what the reference-wind solve does with
+#: conditions whose state leaves the physical domain, "refuse" (default) or "limit"
+#: (docs/atmosphere.md#a-fixed-stability-across-wind-speeds).
+OUTSIDE_DOMAIN_KEY = "outside_domain"
 
 # Inputs of which at most one may be given (EkmanABL's contract).
 EXCLUSIVE_INPUTS = (
@@ -89,12 +94,15 @@ class AtmosphereSpec:
         inputs: EkmanABL keyword inputs; scalars as floats, per-condition lists as arrays shaped
             ``(n_conditions, 1, 1, 1)`` so that they broadcast against FLORIS's 4-D grids.
         n_conditions: Length of the per-condition lists, or None if every value is a scalar.
-        key: Hashable fingerprint of ``inputs`` (for the solve cache).
+        key: Hashable fingerprint of ``inputs`` and the policy (for the solve cache).
+        outside_domain: What the solve does with conditions outside the physical domain,
+            "refuse" (the default) or "limit" (the block's ``outside_domain`` key).
     """
 
     inputs: dict
     n_conditions: int | None
     key: tuple
+    outside_domain: str = "refuse"
     #: Wind speeds at or below this one may be at rest (calm; below every turbine's cut-in):
     #: see :func:`floris_ekman_veer.plugin.inflow.solve_cache.solve`. Set from the Core's turbines by :func:`atmosphere_of`.
     rest_below: float = 0.0
@@ -103,6 +111,8 @@ class AtmosphereSpec:
     def from_mapping(cls, atmosphere: Mapping) -> AtmosphereSpec:
         """Validate keys and values (not yet against FLORIS's conditions)."""
         given = {k: v for k, v in atmosphere.items() if v is not None}
+        outside_domain = check_policy(given.pop(OUTSIDE_DOMAIN_KEY, "refuse"),
+                                      f"{CONFIG_PATH}.{OUTSIDE_DOMAIN_KEY}")
         if "geostrophic_wind" in given:
             raise ValueError(
                 f"{CONFIG_PATH}.geostrophic_wind is not allowed: FLORIS's wind speed at "
@@ -111,7 +121,8 @@ class AtmosphereSpec:
         allowed, required = _abl_inputs()
         unknown = sorted(set(given) - allowed)
         if unknown:
-            raise ValueError(f"{CONFIG_PATH}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+            raise ValueError(f"{CONFIG_PATH}: unknown key(s) {unknown}; allowed: "
+                             f"{sorted(allowed | {OUTSIDE_DOMAIN_KEY})}")
         missing = sorted(required - set(given))
         if missing:
             raise ValueError(f"{CONFIG_PATH}: missing required key(s) {missing}")
@@ -137,8 +148,15 @@ class AtmosphereSpec:
         n_conditions = next(iter(lengths.values()), None)
         key = tuple(sorted(
             (k, v if isinstance(v, float) else v.tobytes()) for k, v in inputs.items()
-        ))
-        return cls(inputs=inputs, n_conditions=n_conditions, key=key)
+        )) + ((OUTSIDE_DOMAIN_KEY, outside_domain),)
+        return cls(inputs=inputs, n_conditions=n_conditions, key=key,
+                   outside_domain=outside_domain)
+
+    @property
+    def policy(self) -> dict:
+        """The block's policy key as given (empty for the default), for a block rebuilt from
+        ``inputs``."""
+        return {} if self.outside_domain == "refuse" else {OUTSIDE_DOMAIN_KEY: self.outside_domain}
 
     def check_conditions(self, n_findex: int) -> None:
         """Raise ValueError if per-condition lists do not have length ``n_findex``.
@@ -160,8 +178,9 @@ class AtmosphereSpec:
     def sliced(self, index) -> dict:
         """A plain atmosphere mapping (lists, YAML-safe) restricted to conditions ``index``."""
         return {
-            k: v if isinstance(v, float) else v.reshape(-1)[index].tolist()
-            for k, v in self.inputs.items()
+            **{k: v if isinstance(v, float) else v.reshape(-1)[index].tolist()
+               for k, v in self.inputs.items()},
+            **self.policy,
         }
 
 

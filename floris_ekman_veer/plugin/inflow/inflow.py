@@ -66,6 +66,7 @@ from floris_ekman_veer.plugin.floris_hooks import patching
 from floris_ekman_veer.plugin.inflow.atmosphere_block import (
     ATMOSPHERE_KEY,
     CONFIG_PATH,
+    OUTSIDE_DOMAIN_KEY,
     PARAMETER_BLOCK,
     AtmosphereSpec,
     atmosphere_groups,
@@ -83,7 +84,8 @@ from floris_ekman_veer.plugin.inflow.shallow import warn_shallow
 from floris_ekman_veer.plugin.inflow.solve_cache import solve
 
 __all__ = [
-    "ACTIVE_ATMOSPHERE", "ATMOSPHERE_KEY", "CONFIG_PATH", "PARAMETER_BLOCK", "AtmosphereSpec",
+    "ACTIVE_ATMOSPHERE", "ATMOSPHERE_KEY", "CONFIG_PATH", "OUTSIDE_DOMAIN_KEY", "PARAMETER_BLOCK",
+    "AtmosphereSpec",
     "ambient_rows", "ambient_velocity", "atmosphere_groups", "atmosphere_of", "farm_atmosphere",
     "inflow_profile", "initialize_velocity_field", "install_inflow_hook", "is_installed",
     "set_atmosphere", "solve", "solved_atmosphere", "uninstall_inflow_hook", "warn_shallow",

@@ -77,11 +77,14 @@ def _solve_moving(spec: AtmosphereSpec, wind_speeds, reference_height: float, at
         )
     try:
         abl = EkmanABL.from_reference_wind(
-            wind_speeds[:, None, None, None], reference_height, **spec.inputs
+            wind_speeds[:, None, None, None], reference_height,
+            outside_domain=spec.outside_domain, **spec.inputs
         )
     except ValueError as error:
         raise ValueError(
             f"{CONFIG_PATH} driven by flow_field.wind_speeds at flow_field.reference_wind_height: "
-            f"{error}"
+            f"{error}".replace("outside_domain 'limit' (a keyword of from_reference_wind, a key "
+                               "of the FLORIS atmosphere block)",
+                               f"{CONFIG_PATH}.outside_domain: limit")
         ) from error
     return abl

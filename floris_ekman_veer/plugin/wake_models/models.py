@@ -61,6 +61,7 @@ from floris_ekman_veer.plugin.rotor.rotor import (
     rotor_cell_deficit,
 )
 from floris_ekman_veer.plugin.inflow.shallow import POLICIES as SHALLOW_POLICIES
+from floris_ekman_veer.plugin.rotor.turbine_states import handed as handed_turbine_states
 from floris_ekman_veer.plugin.wake_models.wake_inputs import (
     GLAUERT_THRUST_COEFFICIENT,
     MERGE_EXPONENT_RANGE,
@@ -170,6 +171,9 @@ class EkmanWakeModel(BaseModel):
             "u_initial": flow_field.u_initial_sorted,
             "ambient": ambient,
             "wakes": wakes,
+            # Other grids: the turbine grid's rotor states, when the solve hands them
+            # (plugin/rotor/turbine_states.py, docs/coupling.md#one-physics-on-every-grid).
+            "states": None if ambient.rotor is not None else handed_turbine_states(),
         }
 
     def function(
@@ -191,11 +195,13 @@ class EkmanWakeModel(BaseModel):
         u_initial: np.ndarray,
         ambient: Ambient,
         wakes: RotorWakes | None = None,
+        states=None,
     ) -> np.ndarray:
         """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid.
 
         On a turbine grid, the rotor-cell deficit d_k of each point (docs/coupling.md#rotor-average);
-        on other grids (planes, points, cubature), the point value.
+        on other grids (planes, points, cubature), the point value, with the turbine grid's
+        rotor states where the solve hands them (``states``, plugin/rotor/turbine_states.py).
         """
         abl = ambient.abl
         yaw = np.deg2rad(yaw_angle_i)
@@ -207,6 +213,17 @@ class EkmanWakeModel(BaseModel):
                 ambient, wakes,
             )
         hub_speed, local_u, local_v = ambient.at_hub(hub_height_i)
+        # One expansion rate per wake, from its rotor's mean turbulence (FLORIS's cubature
+        # grids carry the turbulence per point), and C(x) scaled with the free stream, unless
+        # the turbine grid's solve hands its rotors' array turbulence and incoming speeds.
+        turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
+        speed_fraction = 1.0
+        if states is not None:
+            fraction, tracked = states.at(x_i, y_i)
+            if self.deficit_velocity == "incoming":
+                speed_fraction = fraction
+            if self.wake_expansion == "array_turbulence":
+                turbulence = tracked
         dx = x - x_i
         wake = TurbineWake(
             dx=np.where(dx > ROTOR_PLANE_MARGIN, dx, 0.0),  # dx = 0 means "no wake"
@@ -216,12 +233,8 @@ class EkmanWakeModel(BaseModel):
             ct=ct,
             radius=0.5 * rotor_diameter_i,
             hub_speed=hub_speed,
-            # One expansion rate per wake, from its rotor's mean turbulence (FLORIS's cubature
-            # grids carry the turbulence per point).
-            k_w=self.expansion_rate(
-                abl, hub_height_i, hub_speed,
-                np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True),
-                ambient.floris_turbulence),
+            k_w=self.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
+                                    ambient.floris_turbulence),
             local_u=local_u,
             local_v=local_v,
             friction_velocity=abl.friction_velocity,
@@ -235,7 +248,8 @@ class EkmanWakeModel(BaseModel):
         # the ground, where U(z) -> 0) Delta u is limited to U(z) (docs/wake_model.md#which-velocity-goes-where).
         flowing = (u_initial > 0) & (local_u > 0)
         safe_u = np.where(flowing, u_initial, 1.0)
-        return np.where(flowing, np.minimum(deficit * hub_speed / safe_u, 1.0), 0.0)
+        return np.where(
+            flowing, np.minimum(deficit * (hub_speed * speed_fraction) / safe_u, 1.0), 0.0)
 
     def wake_thrust_coefficient(self, ct_i, yaw):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""

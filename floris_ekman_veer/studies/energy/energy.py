@@ -57,7 +57,7 @@ from floris.wind_data import TimeSeries
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import require_floris_model
-from floris_ekman_veer.plugin.inflow.inflow import AtmosphereSpec
+from floris_ekman_veer.plugin.inflow.inflow import OUTSIDE_DOMAIN_KEY, AtmosphereSpec
 from floris_ekman_veer.plugin.wake_models.names import VELOCITY_MODEL_NAME as MODEL_NAME
 from floris_ekman_veer.plugin.floris_tools.optimizer_options import (
     check_optimizer_options,
@@ -146,7 +146,14 @@ def annual_energy(
             atmosphere = classes[members[0]].atmosphere
         else:
             atmosphere = {name: np.array([classes[k].atmosphere[name] for k in members])[
-                np.searchsorted(members, owner)] for name in classes[members[0]].atmosphere}
+                np.searchsorted(members, owner)] for name in classes[members[0]].atmosphere
+                if name != OUTSIDE_DOMAIN_KEY}
+            # The policy is one per model: the classes' own (refused below if they differ).
+            policies = {classes[k].atmosphere.get(OUTSIDE_DOMAIN_KEY, "refuse") for k in members}
+            if len(policies) > 1:
+                raise ValueError(f"annual energy: the stability classes' {OUTSIDE_DOMAIN_KEY} "
+                                 f"must agree; got {sorted(policies)}")
+            atmosphere.update({OUTSIDE_DOMAIN_KEY: p for p in policies if p != "refuse"})
         freq = np.concatenate([classes[k].condition_frequencies[i]
                                for k, i in zip(members, index)])
         conditions.append(_Conditions(atmosphere, wind_index, owner, freq))
@@ -201,7 +208,8 @@ def record_energy(fmodel, series: TimeSeries, atmosphere: Mapping, labels: Seque
                    for k in range(first.size)]
     keep = np.flatnonzero(wind_frequencies > 0.0)
     conditions = _Conditions(
-        {k: v if isinstance(v, float) else v.reshape(-1)[keep] for k, v in spec.inputs.items()},
+        {**{k: v if isinstance(v, float) else v.reshape(-1)[keep]
+            for k, v in spec.inputs.items()}, **spec.policy},
         keep, owner[keep], wind_frequencies[keep])
     return _run_study(fmodel, series, names, frequencies, [conditions], optimizer_class, study,
                       progress, optimizer_kwargs)

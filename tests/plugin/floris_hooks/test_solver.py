@@ -128,14 +128,25 @@ def test_dispatch_picks_the_solver_for_the_package_models_on_turbine_grids(monke
     gch["wake"]["enable_secondary_steering"] = True
     cubature = copy.deepcopy(sbl6)
     cubature["solver"] = {"type": "turbine_cubature_grid", "turbine_grid_points": 3}
-    for config in (gauss, gch, cubature):
+    point_wise = copy.deepcopy(cubature)
+    point_wise["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        wake_expansion="local_turbulence", deficit_velocity="free_stream")
+    for config in (gauss, gch, point_wise):
         assert _solver_calls(config, monkeypatch) == 0
+    # With the defaults the cubature grid's wakes take the rotor states of a turbine-grid solve
+    # (plugin/turbine_states.py), solved once first.
+    assert _solver_calls(cubature, monkeypatch) == 1
 
 
 def test_full_flow_solver_gives_the_same_values(monkeypatch):
     """FLORIS's plane and point solvers solve the turbine grid first (with this solver now):
-    the same plane and points as with FLORIS's own solver."""
+    the same plane and points as with FLORIS's own solver, with the settings FLORIS's
+    point-wise solver expresses (with the defaults the planes also take the rotor states only
+    this solver tracks: tests/plugin/floris_hooks/test_one_physics_on_every_grid.py)."""
     config = load_yaml(INPUTS / "farm_night.yaml")
+    config["wake"]["model_strings"]["combination_model"] = "sosfs"
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        wake_expansion="local_turbulence", deficit_velocity="free_stream")
 
     def outputs():
         with warnings.catch_warnings():
