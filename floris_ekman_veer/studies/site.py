@@ -35,6 +35,13 @@ from floris_ekman_veer.studies.site_records import (
     screen_records,
 )
 from floris_ekman_veer.studies.energy import energy_by_period, record_energy
+from floris_ekman_veer.studies.site_stability import (
+    checked_site_type,
+    sonic_inverse_length,
+    sun_bound,
+    temperature_richardson,
+    turbulence_departure,
+)
 from floris_ekman_veer.plugin.inflow import set_atmosphere
 
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
@@ -271,11 +278,26 @@ class SiteAtmosphere:
         return energy
 
 
+def ambient_turbulence(abl, reference_height, measured, rows):
+    """FLORIS's turbulence intensity per fitted record: the measured TI (``measured``: (height,
+    values per record), or None) carried to the reference height by the fitted profile's own
+    I_u shape (I_u(z_ref)/I_u(z_meas); the same height: the measured TI itself); the fitted
+    I_u where none is measured (docs/measurements.md#reading-stability)."""
+    model = np.asarray(abl.turbulence_intensity(reference_height), float).reshape(-1)
+    if measured is None:
+        return model
+    height, values = measured
+    at_height = np.asarray(abl.turbulence_intensity(height), float).reshape(-1)
+    value = np.asarray(values, float)[rows]
+    return np.where(np.isfinite(value), value * model / at_height, model)
+
+
 def fit_site(records: pd.DataFrame, reference_height: float, *,
              stability_input: str = "stability_parameter", on_misfit: str = "raise",
              time_column: str | None = None, booms: dict | None = None,
              direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
-             **fit_options_and_inputs) -> SiteAtmosphere:
+             site_type: str | None = None, longitude: float | None = None,
+             time_zone: str | None = None, **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
     The mast's instruments are read first (studies/mast.py, docs/measurements.md#a-real-mast):
@@ -309,6 +331,13 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             nearest ``reference_height``, from the strong-wind records), ``{vane height:
             offset_deg}`` (the reading minus the true direction; vanes not named: 0), or None.
         shadow_half_width: [deg] half-width of a cup's mast-wake sector (default 30).
+        site_type: ``"onshore"`` (no convective state while the sun is below the horizon, the
+            heat flux by day at most half the clear-sky irradiance: needs ``latitude``,
+            ``longitude`` and the stamps' ``time_zone``), ``"offshore"`` or None (no bound
+            from the sun) (docs/measurements.md#reading-stability).
+        longitude: [deg, east positive] the site's, for the sun's position.
+        time_zone: the time zone of naive time stamps ("UTC", "Europe/London", "+01:00"):
+            never guessed.
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
     """
@@ -324,6 +353,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             or not np.isfinite(reference_height) or reference_height <= 0):
         raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
                          f"got {reference_height!r}")
+    checked_site_type(site_type, longitude, time_zone, fit_options_and_inputs)
     columns = mast_columns(records, booms)
     if time_column is not None and time_column not in records.columns:
         raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
@@ -363,8 +393,23 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     fit_inputs = dict(fit_options_and_inputs)
     # (a measured turbulence intensity is a pair (height, value), each one number or a column)
     turbulence = fit_inputs.pop("turbulence_intensity", None)
+    measured = None
     if turbulence is None and instruments.speed_std is not None:
-        turbulence = measured_turbulence(instruments, float(reference_height))
+        # the measured TI: the wake's input, and to the fit only its departure from the site's
+        # neutral TI in its sector (docs/measurements.md#reading-stability)
+        measured = measured_turbulence(instruments, float(reference_height))
+        vane = int(np.argmin(np.abs(instruments.vane_heights - float(reference_height))))
+        turbulence, noise, _ = turbulence_departure(measured, instruments, vane, fit_inputs)
+        fit_inputs.setdefault("turbulence_noise", noise)
+    cap = sun_bound(labels, site_type, fit_inputs.get("latitude"), longitude, time_zone)
+    if cap is not None and "max_heat_flux" not in fit_inputs:
+        fit_inputs["max_heat_flux"] = cap
+    richardson = temperature_richardson(records, instruments)
+    if richardson is not None and "bulk_richardson" not in fit_inputs:
+        fit_inputs["bulk_richardson"] = richardson
+    sonic = sonic_inverse_length(records, instruments)
+    if sonic is not None and "inverse_obukhov_length" not in fit_inputs:
+        fit_inputs["inverse_obukhov_length"] = sonic
     # (fixed inputs may be one per record; the fit's options, a noise pair say, are not)
     per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
     candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
@@ -374,6 +419,13 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     if turbulence is not None:
         inputs["turbulence_intensity"] = tuple(
             np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
+    for name in ("max_heat_flux", "bulk_richardson", "inverse_obukhov_length"):
+        if name in inputs:
+            value = inputs[name]
+            inputs[name] = (np.asarray(value)[candidates] if name == "max_heat_flux"
+                            and np.ndim(value) == 1 else value if name == "max_heat_flux"
+                            else tuple(np.asarray(v)[candidates] if np.ndim(v) == 1
+                                       and len(v) == len(records) else v for v in value))
     abl = EkmanABL.fit_profile(
         **fit_data(instruments, candidates),
         on_misfit="raise" if on_misfit == "raise" else "flag",
@@ -415,7 +467,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         reference_height=z_ref,
         wind_speeds=fit.speed(np.array([z_ref]))[:, 0],
         wind_directions=fit.direction(np.array([z_ref]))[:, 0],
-        turbulence_intensities=np.asarray(abl.turbulence_intensity(z_ref), float).reshape(-1),
+        turbulence_intensities=ambient_turbulence(abl, z_ref, measured, candidates[kept]),
         atmosphere=fit.atmosphere(stability_input),
         dropped=list(table["time"]),
         excluded=table,
