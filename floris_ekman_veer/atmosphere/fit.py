@@ -82,10 +82,7 @@ from floris_ekman_veer.atmosphere.fit_result import ProfileFit, stability_class
 from floris_ekman_veer.atmosphere.least_squares import covariance
 from floris_ekman_veer.atmosphere.misfit import CALM_SPEED, hidden_top, misfit_error
 from floris_ekman_veer.atmosphere.multistart import fit_mixed_layer, multistart, restart_misfits
-from floris_ekman_veer.atmosphere.stability_data import (
-    DEFAULT_STABILITY_PRIOR,
-    checked_stability_terms,
-)
+from floris_ekman_veer.atmosphere.stability_data import checked_stability_terms
 
 #: True inside the two fits of one ``stability="either"`` fit (which warns once, on its own).
 _ONE_OF_TWO_SIGNS = contextvars.ContextVar("one_of_two_signs", default=False)
@@ -98,7 +95,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
                 turbulence_noise=DEFAULT_TURBULENCE_NOISE,
                 direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
-                direction_heights=None, stability_prior=DEFAULT_STABILITY_PRIOR,
+                direction_heights=None, stability_prior=None,
                 inverse_obukhov_length=None, max_heat_flux=None, bulk_richardson=None,
                 **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
@@ -157,7 +154,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
             it: each record's iteration is its own).
         stability_prior: [1/m] the standard deviation of a weak normal prior on 1/L, mean 0
-            (default 0.02: |L| = 50 m at one standard deviation; None: none): a record whose
+            (None, the default here: none, the data alone; ``fit_site``'s default is
+            `DEFAULT_STABILITY_PRIOR`, 0.02: |L| = 50 m at one standard deviation): a record whose
             data do not pin L keeps a state near neutral with the prior's uncertainty rather
             than one run to a bound (docs/measurements.md#reading-stability). It is no datum:
             it counts in no degree of freedom and in no refusal.

@@ -22,6 +22,7 @@ from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.stability_data import DEFAULT_STABILITY_PRIOR
 from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
                                             read_instruments)
 from floris_ekman_veer.studies.site_records import (
@@ -401,6 +402,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         vane = int(np.argmin(np.abs(instruments.vane_heights - float(reference_height))))
         turbulence, noise, _ = turbulence_departure(measured, instruments, vane, fit_inputs)
         fit_inputs.setdefault("turbulence_noise", noise)
+    fit_inputs.setdefault("stability_prior", DEFAULT_STABILITY_PRIOR)
     cap = sun_bound(labels, site_type, fit_inputs.get("latitude"), longitude, time_zone)
     if cap is not None and "max_heat_flux" not in fit_inputs:
         fit_inputs["max_heat_flux"] = cap
