@@ -229,7 +229,7 @@ def test_bad_data_are_refused():
 
 
 # A drawn near-northerly profile with little veer has every direction within 0 to 2 pi, as
-# radians would: the DirectionUnitsWarning it gets is tested in tests/studies/test_fit_robustness.py.
+# radians would: the DirectionUnitsWarning it gets is tested in tests/studies/site/test_fit_robustness.py.
 @pytest.mark.filterwarnings("ignore::floris_ekman_veer.DirectionUnitsWarning")
 @given(
     speed=st.floats(4.0, 16.0),

@@ -1,5 +1,5 @@
-"""What a mast tells of each record's stability beyond its wind profile, as ``fit_site`` gives it to
-the fit (docs/measurements.md#reading-stability): the sun's bound on an onshore site's heat flux
+"""Stage 4's stability inputs (pipeline.py): what a mast tells of each record's stability beyond
+its wind profile, as ``fit_site`` gives it to the fit (docs/measurements.md#reading-stability): the sun's bound on an onshore site's heat flux
 (from the time stamps, the site's latitude and longitude and the stamps' time zone), the
 temperatures' bulk Richardson number, a sonic anemometer's Obukhov length or heat flux, and the
 measured turbulence as its departure from the site's own neutral turbulence in its sector."""
@@ -14,6 +14,7 @@ import pandas as pd
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.atmosphere.richardson import measured_richardson
+from floris_ekman_veer.atmosphere.stability_data import DEFAULT_STABILITY_PRIOR
 from floris_ekman_veer.atmosphere.sunlight import SITE_TYPES, max_heat_flux, utc_times
 
 TEMPERATURE_COLUMN = re.compile(r"^temperature_(\d+(?:\.\d+)?)m$")
@@ -174,3 +175,41 @@ def _relative_spread(ratio):
         return 0.2
     median = np.median(ratio)
     return float(1.4826 * np.median(np.abs(ratio - median)) / median)
+
+
+#: The fit's options this module gives, per record where they are arrays.
+STABILITY_OPTIONS = ("max_heat_flux", "bulk_richardson", "inverse_obukhov_length")
+
+
+def stability_options(fit_inputs, labels, instruments, records, site_type, longitude,
+                      time_zone):
+    """The fit's stability options of the site (those given in ``fit_inputs`` kept): the weak
+    prior on 1/L, the sun's bound (onshore), the temperatures' bulk Richardson number and a
+    sonic's 1/L, one value per record."""
+    options = {"stability_prior": fit_inputs.get("stability_prior", DEFAULT_STABILITY_PRIOR)}
+    cap = sun_bound(labels, site_type, fit_inputs.get("latitude"), longitude, time_zone)
+    if cap is not None:
+        options["max_heat_flux"] = cap
+    if records is not None:
+        richardson = temperature_richardson(records, instruments)
+        if richardson is not None:
+            options["bulk_richardson"] = richardson
+        sonic = sonic_inverse_length(records, instruments)
+        if sonic is not None:
+            options["inverse_obukhov_length"] = sonic
+    return {k: v for k, v in options.items() if k not in fit_inputs or k == "stability_prior"}
+
+
+def stability_options_of(inputs, rows, n):
+    """:data:`STABILITY_OPTIONS` in ``inputs`` for the records ``rows`` of ``n``."""
+    chosen = {}
+    for name in STABILITY_OPTIONS:
+        if name not in inputs:
+            continue
+        value = inputs[name]
+        if name == "max_heat_flux":
+            chosen[name] = np.asarray(value)[rows] if np.ndim(value) == 1 else value
+        else:
+            chosen[name] = tuple(np.asarray(v)[rows] if np.ndim(v) == 1 and len(v) == n else v
+                                 for v in value)
+    return chosen

@@ -11,8 +11,9 @@ import pytest
 
 import floris_ekman_veer
 from floris_ekman_veer import fit_site
-from floris_ekman_veer.studies import mast
-from floris_ekman_veer.studies.site_records import neutral_turning as _neutral_turning
+from floris_ekman_veer.studies.site.columns import mast_columns
+from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
+from floris_ekman_veer.studies.site.readings import read_instruments
 from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS, VANE_OFFSETS,
                                      mast_year, shadow_deficit)
 
@@ -26,8 +27,10 @@ def year():
 
 @pytest.fixture(scope="module")
 def instruments(year):
-    return mast.read_instruments(year, mast.mast_columns(year, BOOMS), 80.0,
-                                 _neutral_turning(SITE), booms=BOOMS)
+    """The site fit's stages 1-3 (studies/site/pipeline.py), called one by one."""
+    columns = mast_columns(year, BOOMS)
+    readings = read_instruments(year, columns, booms=BOOMS)
+    return estimate_vane_offsets(readings, year, columns, 80.0, SITE, booms=BOOMS)
 
 
 @pytest.fixture(scope="module")
@@ -74,9 +77,9 @@ def test_cups_out_of_the_mast_wake_are_chosen_and_both_averaged_where_clear():
                           "speed_80m": [8.0, 8.0, 8.0, 8.0],
                           "direction_40m": [135.0, 315.0, 45.0, 45.0],
                           "direction_80m": [135.0, 315.0, 45.0, 45.0]})
-    columns = mast.mast_columns(frame, {"a": 135.0, "b": 315.0})
-    got = mast.read_instruments(frame, columns, 80.0, _neutral_turning(SITE),
-                                booms={"a": 135.0, "b": 315.0}, direction_offsets=None)
+    columns = mast_columns(frame, {"a": 135.0, "b": 315.0})
+    got = read_instruments(frame, columns, booms={"a": 135.0, "b": 315.0},
+                           direction_offsets=None)
     # From 135 deg the cup on boom b (315) is behind the mast: a is used; from 315, b is used
     # (a reads 17 % low behind the mast); from 45 neither is in the wake: the mean; a pair
     # 2.5 m/s apart there disagrees and is named.

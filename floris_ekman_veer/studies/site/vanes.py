@@ -1,8 +1,8 @@
-"""A met mast's vanes (docs/measurements.md#a-real-mast): stuck vanes (icing) removed and named,
-and the vane offsets, what a vane reads minus the true direction relative to the vane nearest the
-reference height, given or estimated from the strong-wind records (near-neutral) as the median
-turning from the reference vane minus the model's own neutral turning
-(docs/measurements.md#vane-offsets)."""
+"""A met mast's vanes (docs/measurements.md#a-real-mast), for stages 2 and 3 of the site fit
+(readings.py, offsets.py): stuck vanes (icing) removed and named, and the vane offsets, what a
+vane reads minus the true direction relative to the vane nearest the reference height, given or
+estimated from the strong-wind records (near-neutral) as the median turning from the reference
+vane minus the model's own neutral turning (docs/measurements.md#vane-offsets)."""
 
 from __future__ import annotations
 
