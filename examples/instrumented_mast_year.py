@@ -63,7 +63,7 @@ import pandas as pd
 from scipy import stats
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.richardson import model_richardson_number
+from floris_ekman_veer.atmosphere.richardson import model_richardson_number, psi_m
 from floris_ekman_veer.atmosphere.sunlight import solar_elevation_and_clear_sky
 
 SEED = 2026
@@ -160,15 +160,17 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     length[convective] = -np.exp(rng.uniform(np.log(10.0), np.log(150.0), convective.sum()))
     speed = np.where(stable & (length < 60.0), np.maximum(speed, 4.0), speed)
     # Inside the atmosphere's physical domain (docs/atmosphere.md#physical-domain): |L| grows
-    # with the wind where the heat flux it implies (u* of the neutral log law) would exceed
+    # with the wind where the heat flux it implies (u* of the surface layer) would exceed
     # MAX_HEAT_FLUX; a strong wind's stratification is weak. The class is then that of L.
     roughness = sector_roughness(direction)
-    u_star = 0.41 * speed / np.log(REFERENCE_HEIGHT / roughness)
-    heat_flux = -1.2 * 1005.0 * 290.0 * u_star**3 / (0.41 * 9.81 * length)
     most = np.minimum(MAX_HEAT_FLUX[1], SUN_HEAT_FLUX_FRACTION * np.maximum(clear_sky, 1.0))
-    factor = np.clip(heat_flux / most, 1.0, None) * np.clip(
-        heat_flux / MAX_HEAT_FLUX[0], 1.0, None)
-    length = np.where(np.isfinite(length), length * factor, length)
+    for _ in range(4):  # (u* of the Businger-Dyer surface layer of L: a few fixed-point steps)
+        u_star = 0.41 * speed / (np.log(REFERENCE_HEIGHT / roughness)
+                                 - psi_m(REFERENCE_HEIGHT / length))
+        heat_flux = -1.2 * 1005.0 * 290.0 * u_star**3 / (0.41 * 9.81 * length)
+        factor = np.clip(heat_flux / most, 1.0, None) * np.clip(
+            heat_flux / MAX_HEAT_FLUX[0], 1.0, None)
+        length = np.where(np.isfinite(length), length * factor, length)
     kind = np.where(np.abs(length) > 500.0, "neutral", kind).astype(object)
 
     abl = EkmanABL.from_reference_wind(speed, REFERENCE_HEIGHT, obukhov_length=length,

@@ -97,7 +97,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
                 direction_heights=None, stability_prior=None,
                 inverse_obukhov_length=None, max_heat_flux=None, bulk_richardson=None,
-                **fixed_inputs):
+                min_degrees_of_freedom=1, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -166,6 +166,10 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             (z_U1, z_U2))``: value and noise a number or one per record (NaN: none), the
             heights of its two temperatures and two speeds; one datum more, the model's the
             Businger-Dyer one of its 1/L (`atmosphere.richardson`).
+        min_degrees_of_freedom: a record with fewer data minus unknowns is refused, "too
+            few data" (default 1: data no more than the unknowns are met exactly by some
+            state of either sign and tell nothing of it); 0 where an exact inversion is
+            meant (``atmosphere_from_shear_and_veer``: a hub speed and a veer for u* and L).
         max_heat_flux: [W/m^2] the largest sensible heat flux per record (a number or one per
             record; inf: the physical domain's own bound; 0: no convective state, an onshore
             night): ``fit_site`` gives the sun's (docs/measurements.md#reading-stability). A
@@ -198,7 +202,8 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             direction_model_error=direction_model_error,
             fit_mixed_layer_height=fit_mixed_layer_height, stability_prior=stability_prior,
             inverse_obukhov_length=inverse_obukhov_length, max_heat_flux=max_heat_flux,
-            bulk_richardson=bulk_richardson, **fixed_inputs)
+            bulk_richardson=bulk_richardson, min_degrees_of_freedom=min_degrees_of_freedom,
+            **fixed_inputs)
     data = checked_fit_data(
         abl_class, heights, speeds, directions, labels=labels, speed_noise=speed_noise,
         direction_noise=direction_noise, refusal_probability=refusal_probability,
@@ -282,7 +287,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     # A record with no more data than unknowns is met exactly by some state of either sign:
     # its data tell nothing of it (misfit_reason names it "too few data").
     degrees_of_freedom = observations - n_unknowns - zi_fitted
-    fits &= degrees_of_freedom >= 1
+    fits &= degrees_of_freedom >= min_degrees_of_freedom
     # A calm record is refused whatever its fit: below the cups' and vanes' starting speeds
     # the readings are no profile (misfit_reason names it "calm").
     fits &= ~(np.nanmax(np.where(np.isfinite(speeds), speeds, -np.inf), axis=1) < CALM_SPEED)

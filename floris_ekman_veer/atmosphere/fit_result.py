@@ -294,7 +294,8 @@ class ProfileFit:
         """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
         for a record that fits, its kind is whatever its data look like)."""
         if (self.degrees_of_freedom is not None
-                and np.reshape(self.degrees_of_freedom, -1)[i] < 1):
+                and np.reshape(self.degrees_of_freedom, -1)[i] < 1
+                and not np.reshape(self.fits, -1)[i]):
             heights = np.reshape(self.heights, (-1, np.shape(self.heights)[-1]))[i]
             speeds = np.reshape(self.speeds, (-1, np.shape(self.speeds)[-1]))[i]
             return "too few data", (
