@@ -15,8 +15,8 @@ import pandas as pd
 from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.plugin.inflow import set_atmosphere
-from floris_ekman_veer.studies.energy import energy_by_period, record_energy
+from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
+from floris_ekman_veer.studies.energy.energy import energy_by_period, record_energy
 from floris_ekman_veer.studies.site.readings import Instruments
 from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS, RecordFit
 

@@ -17,7 +17,7 @@ import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.site.columns import MastColumns
 from floris_ekman_veer.studies.site.readings import (
     SHADOW_HALF_WIDTH,

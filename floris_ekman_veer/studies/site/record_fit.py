@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.site.columns import MastColumns
 from floris_ekman_veer.studies.site.readings import (Instruments, fit_data, fit_heights,
                                                      measured_turbulence)

@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.atmosphere.richardson import measured_richardson
-from floris_ekman_veer.atmosphere.stability_data import DEFAULT_STABILITY_PRIOR
+from floris_ekman_veer.atmosphere.fit.stability_data import DEFAULT_STABILITY_PRIOR
 from floris_ekman_veer.atmosphere.sunlight import SITE_TYPES, max_heat_flux, utc_times
 
 TEMPERATURE_COLUMN = re.compile(r"^temperature_(\d+(?:\.\d+)?)m$")
