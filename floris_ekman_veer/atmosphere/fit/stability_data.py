@@ -100,15 +100,8 @@ def checked_stability_terms(stability_prior, inverse_obukhov_length, max_heat_fl
             raise ValueError("fit_profile: inverse_obukhov_length must be (value [1/m], noise "
                              f"[1/m]), each a number or one per record ({n}); got "
                              f"{inverse_obukhov_length!r}") from None
-        arrays = []
-        for name, v in (("inverse_obukhov_length value", value),
-                        ("inverse_obukhov_length noise", sigma)):
-            array = real_array(name, v)
-            if array.ndim > 1 or (array.ndim == 1 and array.size != n):
-                raise ValueError(f"fit_profile: {name} must be a number or one per record "
-                                 f"({n}); got shape {array.shape}")
-            arrays.append(np.broadcast_to(array, (n,)).astype(float))
-        values, noise = arrays
+        values = _per_record("inverse_obukhov_length value", value, n)
+        noise = _per_record("inverse_obukhov_length noise", sigma, n)
         require_at(~np.isinf(values), "inverse_obukhov_length value", "finite (NaN: none)",
                    values)
         require_at(np.isnan(values) | (noise > 0), "inverse_obukhov_length noise",
@@ -116,11 +109,7 @@ def checked_stability_terms(stability_prior, inverse_obukhov_length, max_heat_fl
         noise = np.where(np.isfinite(values), noise, np.inf)
     cap = np.full(n, np.inf)
     if max_heat_flux is not None:
-        array = real_array("max_heat_flux", max_heat_flux)
-        if array.ndim > 1 or (array.ndim == 1 and array.size != n):
-            raise ValueError(f"fit_profile: max_heat_flux must be a number or one per record "
-                             f"({n}); got shape {array.shape}")
-        cap = np.broadcast_to(array, (n,)).astype(float)
+        cap = _per_record("max_heat_flux", max_heat_flux, n)
         require_at(cap >= 0, "max_heat_flux", ">= 0 W/m^2 (inf: no bound)", cap)
     return StabilityTerms(prior, values, noise, cap, *checked_richardson(bulk_richardson, n))
 
