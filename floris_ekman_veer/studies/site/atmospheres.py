@@ -9,16 +9,21 @@ the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere` carries them to FL
 
 from __future__ import annotations
 
+import warnings
+
 import attrs
 import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
-from floris_ekman_veer.studies.energy.energy import energy_by_period, record_energy
+from floris_ekman_veer.studies.energy.energy import energy_by_month, record_energy
+from floris_ekman_veer.studies.site.baseline import NeutralBaseline
 from floris_ekman_veer.studies.site.readings import Instruments
 from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS, RecordFit
+from floris_ekman_veer.studies.site.wra_file import MastMetadata
 
 #: The fitted records' classes, by their Obukhov length (ProfileFit.stability_class).
 STABILITY_CLASSES = ("convective", "neutral", "stable")
@@ -43,6 +48,10 @@ class SiteSummary:
             its standard error and whether the pair disagrees.
         flags: the instruments' values removed, per kind and column: the count, the first time
             stamp and one reason.
+        baseline: the neutral baseline per sector (roughness length with its uncertainty factor,
+            neutral TI with its standard error, the model's neutral TI; baseline.py).
+        tops_below_reference: fitted records whose layer is so shallow that their I_u at the
+            reference height is 0 (its top below 1 / 1.62 of it; warned by :func:`fit_site`).
     """
 
     exclusions: pd.DataFrame
@@ -55,6 +64,8 @@ class SiteSummary:
     offsets: pd.DataFrame | None
     cup_pairs: pd.DataFrame | None
     flags: pd.DataFrame
+    tops_below_reference: int = 0
+    baseline: pd.DataFrame | None = None
 
     def plot_class_by_hour(self, ax=None):
         """Stacked bars of the fitted classes' fractions per hour of day; returns the Axes."""
@@ -86,8 +97,14 @@ class SiteSummary:
         if self.offsets is not None and len(self.offsets):
             parts.append("vane offsets applied [deg] (reading minus true, relative to the "
                          "reference vane):\n" + self.offsets.to_string(float_format="{:.2f}".format))
+        if self.baseline is not None:
+            parts.append("neutral baseline per sector (strong-wind records):\n"
+                         + self.baseline.to_string(float_format="{:.4g}".format))
         if self.cup_pairs is not None and len(self.cup_pairs):
             parts.append("cup pairs:\n" + self.cup_pairs.to_string(float_format="{:.4f}".format))
+        if self.tops_below_reference:
+            parts.append(f"{self.tops_below_reference} fitted records have their boundary layer "
+                         "top so far below the reference height that their I_u there is 0")
         if len(self.flags):
             parts.append("values removed:\n" + self.flags.drop(columns="example").to_string())
         if self.class_by_hour is not None:
@@ -128,12 +145,26 @@ class SiteAtmosphere:
     #: Per fitted record its row in the records, and the count of records given.
     rows: np.ndarray | None = None
     n_records: int | None = None
-    #: What the mast's instruments gave (stages 2-3, readings.py and offsets.py): the vane offsets applied, the cup
-    #: pairs' agreement, and the values removed (``row``, ``time``, ``column``, ``kind``,
-    #: ``reason``).
+    #: What the mast's instruments gave (stages 2-3, readings.py and offsets.py): the vane
+    #: offsets applied, the cup pairs' agreement, and the values removed (``row``, ``time``,
+    #: ``column``, ``kind``, ``reason``).
     offsets: pd.DataFrame | None = None
     cup_pairs: pd.DataFrame | None = None
     flags: pd.DataFrame | None = None
+    #: The site's neutral baseline (baseline.py): the roughness rose and neutral turbulence.
+    baseline: NeutralBaseline | None = None
+    #: The mast's metadata file as read (wra_file.py: location, logger's UTC offset, columns).
+    metadata: MastMetadata | None = None
+
+    @property
+    def neutral_roughness_lengths(self) -> np.ndarray | None:
+        """Per fitted record its sector's neutral (effective) roughness length [m]."""
+        return None if self.baseline is None else self.baseline.roughness_lengths[self.rows]
+
+    @property
+    def neutral_turbulence_intensities(self) -> np.ndarray | None:
+        """Per fitted record its sector's measured neutral turbulence intensity (NaN: none)."""
+        return None if self.baseline is None else self.baseline.turbulence_intensities[self.rows]
 
     @property
     def stability_classes(self) -> np.ndarray:
@@ -143,7 +174,10 @@ class SiteAtmosphere:
     def timestamps(self) -> pd.DatetimeIndex | None:
         """The fitted records' labels as times (None where they do not read as times)."""
         try:
-            return pd.DatetimeIndex(pd.to_datetime(pd.Series(self.labels), errors="raise"))
+            with warnings.catch_warnings():
+                # (pandas' notice that it parses each label alone: names that are no times)
+                warnings.simplefilter("ignore", UserWarning)
+                return pd.DatetimeIndex(pd.to_datetime(pd.Series(self.labels), errors="raise"))
         except (ValueError, TypeError):
             return None
 
@@ -180,6 +214,8 @@ class SiteAtmosphere:
             kept_fraction_not_calm=len(self.labels) / max(total - calm, 1),
             classes=pd.Series(classes).value_counts().reindex(list(STABILITY_CLASSES)),
             class_by_hour=by_hour, offsets=self.offsets, cup_pairs=self.cup_pairs,
+            tops_below_reference=int(np.count_nonzero(self.turbulence_intensities <= 0.0)),
+            baseline=None if self.baseline is None else self.baseline.sectors,
             flags=flags.groupby(["kind", "column"]).agg(
                 records=("row", "size"), first=("time", "first"), example=("reason", "first")))
 
@@ -233,8 +269,9 @@ class SiteAtmosphere:
         ``client=`` a ``dask.distributed.Client`` runs the chunks on its cluster, bitwise the
         serial numbers, docs/coupling.md#annual-energy), as a site report gives it: ``table``
         by fitted stability class (convective, neutral, stable) and the year, ``by_month``
-        the energy per month of the records' time stamps (None when the records' names are no
-        time stamps).
+        a typical year's energy per calendar month, January to December, averaged over the
+        years present, with each month's data coverage (None when the records' names are no
+        time stamps; ``energy_by_month``).
 
         The records run as chunks of one vectorised FLORIS model each, with the per-record
         atmosphere block (as :meth:`apply`), never a model per class."""
@@ -243,8 +280,7 @@ class SiteAtmosphere:
                                classes=list(self.stability_classes), **options)
         times = self.timestamps()
         if times is not None:
-            energy = attrs.evolve(energy, by_month=energy_by_period(energy,
-                                                                    times.strftime("%Y-%m")))
+            energy = attrs.evolve(energy, by_month=energy_by_month(energy, times))
         return energy
 
 
@@ -263,7 +299,7 @@ def ambient_turbulence(abl, reference_height, measured, rows):
 
 
 def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: list,
-                    reference_height: float, *,
+                    reference_height: float, baseline: NeutralBaseline | None = None, *,
                     stability_input: str = "stability_parameter") -> SiteAtmosphere:
     """The :class:`SiteAtmosphere` of stage 4's fit: FLORIS's inputs per record kept at
     ``reference_height`` (module docstring), what was left out and why, and what the
@@ -279,6 +315,8 @@ def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: lis
     abl = record_fit.abl
     fit = abl.profile_fit
     z_ref = float(reference_height)
+    turbulence = np.asarray(abl.turbulence_intensity(z_ref), float).reshape(-1)
+    warn_tops_below(abl, list(fit.labels), z_ref, turbulence)
     return SiteAtmosphere(
         labels=list(fit.labels),
         abl=abl,
@@ -295,4 +333,26 @@ def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: lis
         offsets=instruments.offsets,
         cup_pairs=instruments.cup_pairs,
         flags=flags,
+        baseline=baseline,
     )
+
+
+def warn_tops_below(abl: EkmanABL, labels: list, reference_height: float, turbulence) -> None:
+    """A ShallowBoundaryLayerWarning naming the records whose fitted layer is so shallow
+    (light-wind stable nights) that the model's turbulence ends below the reference height:
+    I_u is continued above the layer top h to where its variance vanishes, 1.62 h, and is 0
+    above (docs/atmosphere.md#shallow-boundary-layer), and so is their turbulence intensity at
+    the reference height."""
+    top = np.asarray(abl.boundary_layer_height, float).reshape(-1)
+    none = np.flatnonzero(np.asarray(turbulence) <= 0.0)
+    if none.size == 0:
+        return
+    shown = ", ".join(f"{labels[k]} (top {top[k]:.0f} m)" for k in none[:3])
+    package_warnings.warn(
+        f"fit_site: {none.size} of {top.size} fitted records have their boundary layer top so "
+        f"far below the reference height {reference_height:g} m ({shown}"
+        f"{', ...' if none.size > 3 else ''}) that their turbulence intensity there is 0 (the "
+        "model's I_u ends at 1.62 times the top): light-wind stable layers, in which a wake at "
+        "that height meets no ambient turbulence. Give records from a mast reaching the rotor's "
+        "top, or leave such hours out (SiteAtmosphere.summary() counts them)",
+        package_warnings.ShallowBoundaryLayerWarning)

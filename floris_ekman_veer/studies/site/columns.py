@@ -67,16 +67,27 @@ def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
                              f"(from the mast to the cup, clockwise from north); got "
                              f"{orientation!r}")
     cups, stds, vanes, unknown = {}, {}, {}, []
+
+    def put(table, where, column):
+        # Two names of one instrument (speed_90m and speed_90.0m): which one is the reading
+        # is unknown, and keeping either would drop the other silently.
+        if where in table:
+            height = where[0] if isinstance(where, tuple) else where
+            raise ValueError(f"records: columns {table[where]!r} and {column!r} name the same "
+                             f"instrument (height {height:g} m): keep one of them (or name the "
+                             "booms, speed_<h>m_<boom>)")
+        table[where] = column
+
     for column in map(str, records.columns):
         if (m := SPEED_COLUMN.match(column)):
             where = (float(m[1]), m[2])
             if m[3] is None:
-                cups[where] = column
+                put(cups, where, column)
             elif m[3] == "std":
-                stds[where] = column
+                put(stds, where, column)
         elif (m := DIRECTION_COLUMN.match(column)):
             if m[2] is None:
-                vanes[float(m[1])] = column
+                put(vanes, float(m[1]), column)
         elif column.startswith(("speed_", "direction_")):
             unknown.append(column)
     if unknown:

@@ -7,11 +7,13 @@ Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with
 deviations and vanes at their own heights (columns.py), and optionally a ``time`` column naming
 the records. :func:`fit_site` runs, each stage a module a user can call and inspect:
 
-1. the instruments the columns hold (:func:`.columns.mast_columns`);
+1. the instruments the columns hold (:func:`.columns.mast_columns`), named by the mast's IEA
+   Wind Task 43 metadata file where one is given (:func:`.wra_file.read_wra_file`);
 2. the cleaned readings: bad and stuck readings removed and named, redundant cups out of the
    mast's wake (:func:`.readings.read_instruments`);
-3. the vane offsets from the strong-wind, near-neutral records
-   (:func:`.offsets.estimate_vane_offsets`);
+3. the site's neutral baseline (its roughness rose and neutral turbulence,
+   :func:`.baseline.neutral_baseline`) and the vane offsets, both from the strong-wind,
+   near-neutral records (:func:`.offsets.estimate_vane_offsets`);
 4. the per-record fit: records no fit should see named, every other one fitted
    (:func:`.record_fit.fit_records`);
 5. the atmospheres: FLORIS's inputs per record (:func:`.atmospheres.site_atmosphere`).
@@ -19,15 +21,18 @@ the records. :func:`fit_site` runs, each stage a module a user can call and insp
 
 from __future__ import annotations
 
+import attrs
 import numpy as np
 import pandas as pd
 
 from floris_ekman_veer.studies.site.atmospheres import SiteAtmosphere, site_atmosphere
+from floris_ekman_veer.studies.site.baseline import checked_roughness, neutral_baseline
 from floris_ekman_veer.studies.site.columns import mast_columns
 from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
 from floris_ekman_veer.studies.site.readings import SHADOW_HALF_WIDTH, read_instruments
 from floris_ekman_veer.studies.site.record_fit import fit_records
 from floris_ekman_veer.studies.site.stability import checked_site_type
+from floris_ekman_veer.studies.site.wra_file import read_wra_file
 
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")
@@ -40,8 +45,9 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
              stability_input: str = "stability_parameter", on_misfit: str = "raise",
              time_column: str | None = None, booms: dict | None = None,
              direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
-             site_type: str | None = None, longitude: float | None = None,
-             time_zone: str | None = None, **fit_options_and_inputs) -> SiteAtmosphere:
+             roughness_length="estimate", metadata=None, site_type: str | None = None,
+             longitude: float | None = None, time_zone: str | None = None,
+             **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
     The mast's instruments are read first (columns.py, readings.py, offsets.py;
@@ -76,6 +82,15 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             nearest ``reference_height``, from the strong-wind records), ``{vane height:
             offset_deg}`` (the reading minus the true direction; vanes not named: 0), or None.
         shadow_half_width: [deg] half-width of a cup's mast-wake sector (default 30).
+        roughness_length: ``"estimate"`` (default: the site's own effective roughness per
+            30-deg sector from its strong-wind, near-neutral records, baseline.py and
+            docs/measurements.md#the-sites-neutral-baseline), a number [m], one per record, or
+            ``{sector centre deg: z0 m}`` (each record takes the sector nearest its direction).
+        metadata: the path of the mast's IEA Wind Task 43 WRA data model file (JSON; wra_file.py,
+            docs/measurements.md#the-masts-own-metadata): its logger columns are read as the
+            records' columns, its booms as ``booms`` and its location as ``latitude``; given
+            ``booms`` or ``latitude`` that contradict it, or a column it names that the records
+            lack, are refused naming both.
         site_type: ``"onshore"`` (no convective state while the sun is below the horizon, the
             heat flux by day at most half the clear-sky irradiance: needs ``latitude``,
             ``longitude`` and the stamps' ``time_zone``), ``"offshore"`` or None (no bound
@@ -98,8 +113,22 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             or not np.isfinite(reference_height) or reference_height <= 0):
         raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
                          f"got {reference_height!r}")
+    # 1. the instruments (from the mast's metadata file where given)
+    mast = None
+    if metadata is not None:
+        mast = read_wra_file(metadata)
+        records = mast.named_records(records)
+        if booms is not None and mast.booms and dict(booms) != mast.booms:
+            raise ValueError(f"fit_site: booms={booms} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose booms are {mast.booms}; give one of them")
+        booms = booms if booms is not None else (mast.booms or None)
+        given = fit_options_and_inputs.get("latitude", mast.latitude)
+        if np.ndim(given) or not np.isclose(given, mast.latitude, atol=1e-6):
+            raise ValueError(f"fit_site: latitude={given!r} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose location is at {mast.latitude:g} deg; "
+                             "give one of them")
+        fit_options_and_inputs = {**fit_options_and_inputs, "latitude": mast.latitude}
     checked_site_type(site_type, longitude, time_zone, fit_options_and_inputs)
-    # 1. the instruments
     columns = mast_columns(records, booms)
     if time_column is not None and time_column not in records.columns:
         raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
@@ -110,11 +139,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
               else [str(i) for i in records.index])
     if len(records) == 0:
         raise ValueError("fit_site: records is empty")
-    z0 = np.max(np.asarray(fit_options_and_inputs.get("roughness_length", 0.0), float))
-    if not reference_height > 10.0 * z0:
-        raise ValueError(f"fit_site: reference_height must be > 10 roughness lengths "
-                         f"(roughness_length {z0:g} m: above the roughness sublayer, where the "
-                         f"fitted profile is a wind a turbine meets); got {reference_height!r} m")
+    checked_roughness(roughness_length, float(reference_height))
     top = max(columns.cup_heights.max(), columns.vane_heights.max(initial=0.0))
     if reference_height > MAX_EXTRAPOLATION * top:
         raise ValueError(f"fit_site: reference_height must be at most {MAX_EXTRAPOLATION:g} "
@@ -125,16 +150,22 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     instruments = read_instruments(records, columns, booms=booms,
                                    direction_offsets=direction_offsets,
                                    shadow_half_width=shadow_half_width, labels=labels)
-    # 3. the vane offsets
+    # 3. the neutral baseline and the vane offsets (whose reference turning is the model's
+    # neutral one at the site's roughness)
+    baseline = neutral_baseline(instruments, z_ref, fit_options_and_inputs, roughness_length,
+                                cups_per_height=[len(columns.cups[h]) for h in columns.cup_heights])
+    fit_inputs = {**fit_options_and_inputs, "roughness_length": (
+        roughness_length if np.ndim(roughness_length) == 0 and not isinstance(
+            roughness_length, (str, dict)) else baseline.roughness_lengths)}
     if isinstance(direction_offsets, str):
-        instruments = estimate_vane_offsets(instruments, records, columns, z_ref,
-                                            fit_options_and_inputs, booms=booms,
-                                            shadow_half_width=shadow_half_width)
+        instruments = estimate_vane_offsets(instruments, records, columns, z_ref, fit_inputs,
+                                            booms=booms, shadow_half_width=shadow_half_width)
     # 4. the per-record fit
-    record_fit = fit_records(instruments, columns, labels, z_ref, fit_options_and_inputs,
+    record_fit = fit_records(instruments, columns, labels, z_ref, fit_inputs,
                              stability_input=stability_input, on_misfit=on_misfit,
                              records=records, site_type=site_type, longitude=longitude,
                              time_zone=time_zone)
     # 5. the atmospheres
-    return site_atmosphere(record_fit, instruments, labels, z_ref,
+    site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
                            stability_input=stability_input)
+    return site if mast is None else attrs.evolve(site, metadata=mast)

@@ -12,7 +12,8 @@ What :func:`read_instruments` makes of them:
   disagrees beyond the cups' uncertainty (clear cups) or beyond the wake's measured ratio (a cup
   in the wake) in a record is removed at that height and named ("cups disagree"); a pair whose
   median ratio over the year departs from 1 by more than :data:`PAIR_TOLERANCE` is named in
-  ``cup_pairs``;
+  ``cup_pairs``; a cup reading 0 (or stalled at its starting threshold) beside a working
+  partner is dead, not a calm: its reading removed and named ("dead cup"), the partner used;
 * stuck vanes (icing): a vane repeating its reading for :data:`~.vanes.STUCK_RECORDS` records
   or more while another vane turns is removed there and named ("stuck vane");
 * given vane offsets (``direction_offsets={38: -4.1}``) subtracted from the readings; estimated
@@ -57,8 +58,22 @@ MAX_SHADOW_DEFICIT = 0.4
 #: Median ratio of a pair beyond 1 +- this: the pair disagrees (two class-1 calibrations, 1 %
 #: each, at two standard deviations of their ratio).
 PAIR_TOLERANCE = 0.03
+#: A speed column reading this many times the cups above it (or, for the top cups over
+#: :data:`UNIT_MIN_RECORDS` records or more, the cups below) in median is in km/h (3.6 times
+#: m/s): no wind falls with height by that much, and a year's shear never reaches it.
+KMH_RATIO = (2.8, 4.6)
+UNIT_MIN_RECORDS = 24
+#: No site's median wind reaches this [m/s] over :data:`UNIT_SITE_RECORDS` records: a speed
+#: column above it is in km/h (every column, so that no ratio shows it).
+MAX_MEDIAN_SPEED = 25.0
+UNIT_SITE_RECORDS = 720
+#: A cup reading this much or less [m/s] (0, or its starting threshold: IEC 61400-12-1 class-1
+#: cups start at 0.3-0.5 m/s) beside a partner reading :data:`DEAD_CUP_PARTNER` or more at its
+#: height is dead or stalled, not in a calm.
+DEAD_CUP_SPEED = 0.5
+DEAD_CUP_PARTNER = 2.0
 #: What is named per value removed.
-FLAG_KINDS = ("infinite reading", "cups disagree", "stuck vane")
+FLAG_KINDS = ("infinite reading", "dead cup", "cups disagree", "stuck vane")
 
 
 
@@ -71,7 +86,9 @@ class Instruments:
             its standard deviation [m/s] (NaN: none usable);
         vane_heights, directions: the vanes' directions with their offsets removed [deg];
         offsets: per vane height (index) ``offset_deg`` (reading minus true direction, relative
-            to the reference vane), ``uncertainty_deg`` (standard error), ``records`` and
+            to the reference vane), ``uncertainty_deg`` (standard error), ``systematic_deg``
+            (the reference turning's: the model's neutral turning against the surface
+            layer's), ``records`` and
             ``source`` ("reference", "estimated", "given", or "not estimated");
         cup_pairs: per cup height with two cups or more: the cups, their median ratio over the
             records where none is in the mast's wake, its standard error, the records, and
@@ -132,6 +149,7 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, *, booms=None,
             or not 0 <= shadow_half_width < 90):
         raise ValueError(f"fit_site: shadow_half_width must be a number in [0, 90) deg; got "
                          f"{shadow_half_width!r}")
+    check_speed_units(records, columns)
     flags = _Flags()
     vane_heights = columns.vane_heights
     directions = None
@@ -148,6 +166,37 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, *, booms=None,
                        speed_std=speed_std if columns.has_std else None,
                        vane_heights=vane_heights, directions=directions, offsets=offsets,
                        cup_pairs=pairs, flags=flags.table())
+
+
+def check_speed_units(records: pd.DataFrame, columns: MastColumns) -> None:
+    """ValueError naming a speed column that reads in km/h, not m/s (:data:`KMH_RATIO`,
+    :data:`MAX_MEDIAN_SPEED`): its speeds would fall with height, or be a storm all year."""
+    heights = [h for h in columns.cup_heights for _ in columns.cups[h]]
+    names = [c for h in columns.cup_heights for _, c, _ in columns.cups[h]]
+    values = _numbers(records, names)
+    values = np.where(np.isfinite(values) & (values > 0), values, np.nan)
+    counts = np.sum(np.isfinite(values), axis=0)
+    medians = np.array([np.median(v[np.isfinite(v)]) if n else np.nan
+                        for v, n in zip(values.T, counts)])
+    heights = np.asarray(heights)
+    for k, name in enumerate(names):
+        if not counts[k]:
+            continue
+        above = (heights > heights[k]) & np.isfinite(medians)
+        below = (heights < heights[k]) & np.isfinite(medians)
+        if above.any():
+            ratio = medians[k] / np.median(medians[above])
+        elif below.any() and counts[k] >= UNIT_MIN_RECORDS:
+            ratio = medians[k] / np.median(medians[below])
+        else:
+            ratio = np.nan
+        if KMH_RATIO[0] <= ratio <= KMH_RATIO[1] or (
+                counts[k] >= UNIT_SITE_RECORDS and medians[k] > MAX_MEDIAN_SPEED):
+            shown = (f"{ratio:.2f} times the cups {'above' if above.any() else 'below'} it"
+                     if np.isfinite(ratio) else f"a median of {medians[k]:.1f}")
+            raise ValueError(
+                f"records: speed column {name!r} reads {shown} (median {medians[k]:.2f}): it is "
+                "likely in km/h (3.6 times m/s); give the speeds in m/s (divide by 3.6)")
 
 
 def read_cups_again(instruments: Instruments, records: pd.DataFrame, columns: MastColumns, *,
@@ -218,6 +267,7 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
         if len(group) == 1:
             speeds[:, i], variance[:, i] = values[:, 0], stds[:, 0] ** 2
             continue
+        values, stds = _remove_dead(values, stds, names, height, flags)
         wind = direction_near(directions, vane_heights, height, n)
         orientation = np.array([booms[b] for b, _, _ in group])
         # Each cup's angle from its wake's centre: the wind from its boom's orientation + 180.
@@ -266,6 +316,22 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
     pairs = pd.DataFrame(pairs, columns=["height", "cups", "median_ratio", "uncertainty",
                                          "records", "disagree", "wake_deficit"])
     return speeds, np.sqrt(variance), pairs
+
+
+def _remove_dead(values, stds, names, height, flags):
+    """A cup reading :data:`DEAD_CUP_SPEED` or less (0, or stalled at its starting threshold)
+    beside a partner reading :data:`DEAD_CUP_PARTNER` or more is dead, not a calm: its reading
+    (and standard deviation) removed and named ("dead cup"), the partner used in its place
+    (as where it is missing: out of the mast's wake)."""
+    with np.errstate(invalid="ignore"):
+        partner = np.fmax.reduce(np.where(np.isfinite(values), values, -np.inf), axis=1)
+        dead = (values <= DEAD_CUP_SPEED) & (partner[:, None] >= DEAD_CUP_PARTNER)
+    for k in np.flatnonzero(dead.any(axis=0)):
+        flags.add(np.flatnonzero(dead[:, k]), names[k], "dead cup",
+                  lambda r, k=k: f"the cup reads {values[r, k]:g} m/s beside "
+                  f"{', '.join(f'{c} {values[r, j]:g}' for j, c in enumerate(names) if j != k)}"
+                  f" m/s at {height:g} m (a dead or stalled cup, not a calm): the partner is used")
+    return np.where(dead, np.nan, values), np.where(dead, np.nan, stds)
 
 
 def _wake_ratio(angle, wake, clear_mean, half_width):

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, fit_site
-from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
+from floris_ekman_veer.studies.site.shear_and_veer import atmosphere_from_shear_and_veer
 
 SITE = dict(latitude=52.0, roughness_length=0.05)
 Z = np.arange(30.0, 151.0, 20.0)
@@ -198,8 +198,9 @@ def test_unclear_inputs_get_messages_naming_them():
                                          r"m/s fits no atmosphere"):
         atmosphere_from_shear_and_veer(9.0, 90.0, 126.0, 0.2, 10.0, **SITE)
     records = pd.DataFrame({f"speed_{z:.0f}m": [s[j]] for j, z in enumerate(Z)})
-    with pytest.raises(ValueError, match=r"fit_site: reference_height must be > 10 roughness "
-                                         r"lengths.*got 0.01 m"):
+    with pytest.raises(ValueError, match=r"fit_site: roughness_length must be a number in "
+                                         r"\(0, 0.001\) m \(below a tenth of the reference "
+                                         r"height 0.01 m\); got 0.05"):
         fit_site(records, 0.01, **SITE)
 
 

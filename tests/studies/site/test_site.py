@@ -180,7 +180,7 @@ def test_shipped_synthetic_mast_is_labelled_and_fitted():
 def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
     """One of rotor veer and shear with the hub speed determines u* and L: the veer is met
     exactly and the shear follows (docs/measurements.md#simpler-site-inputs)."""
-    from floris_ekman_veer.studies.site import atmosphere_from_shear_and_veer
+    from floris_ekman_veer.studies.site.shear_and_veer import atmosphere_from_shear_and_veer
 
     bottom, top = 27.0, 153.0
     for veer in (2.0, 10.0, 20.0):
