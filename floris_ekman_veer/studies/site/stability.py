@@ -148,8 +148,10 @@ def turbulence_departure(turbulence, instruments, direction_index, fixed):
                                            roughness_length=z0[strong], **others)
         neutral_model[strong] = np.asarray(abl.turbulence_intensity(height), float)
     ratio = measured / neutral_model
+    # (NaN directions: sector -1, no sector's)
+    heading = np.mod(np.nan_to_num(direction), 360.0)
     sector = np.where(np.isfinite(direction),
-                      np.round(np.mod(direction, 360.0) / TURBULENCE_SECTOR).astype(int)
+                      np.round(heading / TURBULENCE_SECTOR).astype(int)
                       % int(360.0 / TURBULENCE_SECTOR), -1)
     overall = np.nanmedian(ratio[strong]) if np.any(strong) else 1.0
     spread_all = _relative_spread(ratio[strong]) if np.any(strong) else 0.2
