@@ -65,11 +65,13 @@ def records(n, seed=1):
     return np.repeat(CLASSES, n), hub, speeds, directions
 
 
-def confusion(n=200):
-    """{true class: ({fitted class: count}, refused, max |hub speed error|)}."""
+def confusion(n=200, **options):
+    """{true class: ({fitted class: count}, refused, max |hub speed error|)} (``options``: the
+    fit's, e.g. ``stability_prior``)."""
     truth, hub, speeds, directions = records(n)
     fit = EkmanABL.fit_profile(HEIGHTS, speeds, directions, on_misfit="flag", stability="either",
-                               speed_noise=0.1, direction_noise=0.5, **SITE).profile_fit
+                               speed_noise=0.1, direction_noise=0.5, **SITE,
+                               **options).profile_fit
     error = np.abs(fit.speed(np.array([90.0]))[:, 0] / hub - 1.0)
     return {
         c: ({k: int(np.sum(fit.stability_class[truth == c] == k)) for k in CLASSES},

@@ -6,8 +6,13 @@ The mast is the usual one of a wind-resource campaign (IEC 61400-12-1 Annex G; t
 Task 43 data model's measurement points): cup anemometers on two booms at 40, 60 and 80 m, one
 boom pointing to 135 deg and one to 315 deg (:data:`BOOMS`), each cup logging its mean speed
 and its standard deviation (``speed_<h>m_<boom>`` and ``speed_<h>m_<boom>_std``), and wind vanes
-a few metres lower, at 38, 58 and 78 m (``direction_<h>m``). The site: 53.3 N, grass (z0 =
-0.05 m). Hourly by default; ``freq="10min", periods=105120`` gives two years of 10-minute means.
+a few metres lower, at 38, 58 and 78 m (``direction_<h>m``), and temperatures at 10 and 78 m
+(``temperature_<h>m`` [deg C]). The site: onshore, 53.3 N 1.8 W, its time stamps in UTC
+(:data:`SITE`, :data:`LONGITUDE`, :data:`TIME_ZONE`), the roughness length varying by
+direction sector (:data:`SECTOR_ROUGHNESS`, 12 sectors of 30 deg: ``true_roughness_length``),
+and the turbulence of the terrain :data:`TERRAIN_TURBULENCE` = 1.2 times the model's (hills and
+hedges upwind: the measured TI 20 % above the model's neutral I_u). Hourly by default;
+``freq="10min", periods=105120`` gives two years of 10-minute means.
 
 The atmosphere of each record is the package's own EkmanABL (``from_reference_wind`` at 80 m),
 in one of three classes (``true_class``) with their Obukhov length (``true_obukhov_length``),
@@ -15,12 +20,13 @@ inside the atmosphere's physical domain: where the drawn L would imply a heat fl
 :data:`MAX_HEAT_FLUX` (with u* of the neutral log law) |L| is enlarged to meet it, and a record
 whose |L| then exceeds 500 m is neutral (the fit's class convention):
 
-* ``stable``: nights (sunset to sunrise, longer in winter) with an 80 m wind below 11 m/s,
-  L = 20 to 200 m (log-uniform; at least 4 m/s where L < 60 m: a night's light wind is stable,
-  not collapsing);
-* ``convective``: the middle of sunny days (10:00 to 16:00 local; a day is sunny with
+* ``stable``: nights (the sun below the horizon, pvlib's solar position) with an 80 m wind
+  below 11 m/s, L = 20 to 200 m (log-uniform; at least 4 m/s where L < 60 m: a night's light
+  wind is stable, not collapsing);
+* ``convective``: sunny days with the sun at least 10 deg high (a day is sunny with
   probability 0.75 in summer and 0.2 in winter) with an 80 m wind below 11 m/s, L = -10 to
-  -150 m (log-uniform);
+  -150 m (log-uniform), the heat flux at most :data:`SUN_HEAT_FLUX_FRACTION` of the clear-sky
+  irradiance (a winter day's convection is weak);
 * ``neutral``: every other record (cloudy days, transitions, and every wind from 11 m/s up,
   mechanically mixed), L infinite or |L| = 3 to 20 km, either sign.
 
@@ -35,8 +41,12 @@ The instruments, each effect seeded and recorded (module constants):
   orientation + 180 deg) reads low by up to 25 % (a Gaussian deficit 12 deg wide, IEC
   61400-12-1 Annex G's lattice-mast wake) and its standard deviation is raised;
 * spikes: :data:`SPIKE_FRACTION` of the cup readings jump up by 3 to 10 m/s (logger noise);
-* standard deviations: the model's I_u at the cup's height times its speed, with a 10 %
-  sampling error (log-normal);
+* standard deviations: the model's I_u at the cup's height times its speed, times the
+  terrain's :data:`TERRAIN_TURBULENCE`, with a 10 % sampling error (log-normal);
+* temperatures: at :data:`TEMPERATURE_HEIGHTS`, on a seasonal and daily cycle, their
+  potential temperature difference that whose bulk Richardson number with the record's own
+  40-80 m speed difference is the Businger-Dyer one of its L (Paulson 1970's psi_h and psi_m,
+  the fit's forms), each sensor with a 0.05 K error, rounded to 0.01 K;
 * vanes: offsets :data:`VANE_OFFSETS` (the reading minus the true direction; the 78 m vane is
   aligned), 1 deg random error, rounded to 0.1 deg;
 * icing: :data:`N_ICING` winter nights on which one vane sticks at its last reading for 6 to
@@ -53,9 +63,23 @@ import pandas as pd
 from scipy import stats
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.atmosphere.richardson import model_richardson_number, psi_m
+from floris_ekman_veer.atmosphere.sunlight import solar_elevation_and_clear_sky
 
 SEED = 2026
-SITE = dict(latitude=53.3, roughness_length=0.05)
+SITE = dict(latitude=53.3)
+LONGITUDE = -1.8
+#: The time zone of the time stamps.
+TIME_ZONE = "UTC"
+#: Roughness length [m] per 30 deg sector, sectors centred on 0, 30, ..., 330 deg.
+SECTOR_ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.2, 0.1, 0.05, 0.03, 0.02, 0.02, 0.03, 0.05)
+#: The measured turbulence over the model's I_u (terrain upwind).
+TERRAIN_TURBULENCE = 1.2
+#: Heights [m] of the two temperature sensors, their error [K].
+TEMPERATURE_HEIGHTS = (10.0, 78.0)
+TEMPERATURE_ERROR = 0.05
+#: A convective record's heat flux is at most this share of the clear-sky irradiance.
+SUN_HEAT_FLUX_FRACTION = 0.3
 REFERENCE_HEIGHT = 80.0
 CUP_HEIGHTS = (40.0, 60.0, 80.0)
 VANE_HEIGHTS = (38.0, 58.0, 78.0)
@@ -95,6 +119,12 @@ def shadow_deficit(wind_direction, boom_orientation):
     return SHADOW_DEFICIT * np.exp(-0.5 * (off / SHADOW_WIDTH) ** 2)
 
 
+def sector_roughness(direction):
+    """[m] the roughness length of the sector the wind comes from."""
+    sector = np.round(np.mod(np.asarray(direction, float), 360.0) / 30.0).astype(int) % 12
+    return np.asarray(SECTOR_ROUGHNESS)[sector]
+
+
 def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.DataFrame:
     """The records (module docstring): one row per record, the instruments' columns and the
     generator's truth (``true_class``, ``true_obukhov_length``, ``true_calm``,
@@ -113,14 +143,16 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     direction = np.mod(240.0 + np.cumsum(rng.normal(0.0, 6.0 * np.sqrt(step), n)), 360.0)
 
     # Classes: nights stable, sunny middays convective, strong winds and the rest neutral.
-    night = (hour < 6.0 - 2.0 * summer) | (hour >= 19.0 + 2.0 * summer)
+    elevation, clear_sky = solar_elevation_and_clear_sky(time.tz_localize(TIME_ZONE),
+                                                         SITE["latitude"], LONGITUDE)
+    night = elevation <= 0.0
     days = np.unique(doy)
     sunny_day = rng.uniform(size=days.size) < 0.475 + 0.275 * np.cos(2 * np.pi * (days - 172) / 365)
     sunny = sunny_day[np.searchsorted(days, doy)]
     light = speed < NEUTRAL_SPEED
     kind = np.full(n, "neutral", dtype=object)
     kind[night & light] = "stable"
-    kind[sunny & (hour >= 10.0) & (hour < 16.0) & light] = "convective"
+    kind[sunny & (elevation >= 10.0) & light] = "convective"
     length = np.where(rng.uniform(size=n) < 0.5, np.inf,
                       rng.choice([-1.0, 1.0], n) * np.exp(rng.uniform(np.log(3e3), np.log(2e4), n)))
     stable, convective = kind == "stable", kind == "convective"
@@ -128,16 +160,21 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     length[convective] = -np.exp(rng.uniform(np.log(10.0), np.log(150.0), convective.sum()))
     speed = np.where(stable & (length < 60.0), np.maximum(speed, 4.0), speed)
     # Inside the atmosphere's physical domain (docs/atmosphere.md#physical-domain): |L| grows
-    # with the wind where the heat flux it implies (u* of the neutral log law) would exceed
+    # with the wind where the heat flux it implies (u* of the surface layer) would exceed
     # MAX_HEAT_FLUX; a strong wind's stratification is weak. The class is then that of L.
-    u_star = 0.41 * speed / np.log(REFERENCE_HEIGHT / SITE["roughness_length"])
-    heat_flux = -1.2 * 1005.0 * 290.0 * u_star**3 / (0.41 * 9.81 * length)
-    factor = np.clip(heat_flux / MAX_HEAT_FLUX[1], 1.0, None) * np.clip(
-        heat_flux / MAX_HEAT_FLUX[0], 1.0, None)
-    length = np.where(np.isfinite(length), length * factor, length)
+    roughness = sector_roughness(direction)
+    most = np.minimum(MAX_HEAT_FLUX[1], SUN_HEAT_FLUX_FRACTION * np.maximum(clear_sky, 1.0))
+    for _ in range(4):  # (u* of the Businger-Dyer surface layer of L: a few fixed-point steps)
+        u_star = 0.41 * speed / (np.log(REFERENCE_HEIGHT / roughness)
+                                 - psi_m(REFERENCE_HEIGHT / length))
+        heat_flux = -1.2 * 1005.0 * 290.0 * u_star**3 / (0.41 * 9.81 * length)
+        factor = np.clip(heat_flux / most, 1.0, None) * np.clip(
+            heat_flux / MAX_HEAT_FLUX[0], 1.0, None)
+        length = np.where(np.isfinite(length), length * factor, length)
     kind = np.where(np.abs(length) > 500.0, "neutral", kind).astype(object)
 
-    abl = EkmanABL.from_reference_wind(speed, REFERENCE_HEIGHT, obukhov_length=length, **SITE)
+    abl = EkmanABL.from_reference_wind(speed, REFERENCE_HEIGHT, obukhov_length=length,
+                                       roughness_length=roughness, **SITE)
     turning = abl.wind_angle(REFERENCE_HEIGHT)  # meteorological direction = const - wind_angle
 
     columns = {"time": time.strftime("%Y-%m-%d %H:%M")}
@@ -151,7 +188,7 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
                     + rng.normal(0.0, CUP_OFFSET_ERROR, n))
             spikes = rng.uniform(size=n) < SPIKE_FRACTION
             read[spikes] += rng.uniform(3.0, 10.0, spikes.sum())
-            std = (intensity * true * (1.0 + 3.0 * deficit)
+            std = (TERRAIN_TURBULENCE * intensity * true * (1.0 + 3.0 * deficit)
                    * np.exp(rng.normal(0.0, STD_SAMPLING_ERROR, n)))
             columns[f"speed_{h:.0f}m_{name}"] = np.round(np.maximum(read, 0.0), 2)
             columns[f"speed_{h:.0f}m_{name}_std"] = np.round(std, 3)
@@ -169,6 +206,17 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
         stuck[h][start:stop] = True
     for h in VANE_HEIGHTS:
         columns[f"direction_{h:.0f}m"] = np.round(np.mod(vanes[h], 360.0), 1)
+    # Temperatures: the rise of theta between the sensors whose bulk Richardson number with the
+    # record's own 40-80 m speeds is the Businger-Dyer one of its L; T = theta - g z/c_p.
+    low, high = TEMPERATURE_HEIGHTS
+    surface = 9.0 + 6.0 * summer + 3.0 * np.cos(2.0 * np.pi * (hour - 14.0) / 24.0)
+    shear = abl.speed(CUP_HEIGHTS[-1]) - abl.speed(CUP_HEIGHTS[0])
+    richardson = model_richardson_number(1.0 / length, TEMPERATURE_HEIGHTS,
+                                         (CUP_HEIGHTS[0], CUP_HEIGHTS[-1]))
+    rise = richardson * shear**2 * (surface + 273.15) / (9.81 * (high - low))
+    for h, theta in ((low, surface), (high, surface + rise)):
+        columns[f"temperature_{h:.0f}m"] = np.round(
+            theta - 9.81 / 1005.0 * h + rng.normal(0.0, TEMPERATURE_ERROR, n), 2)
     table = pd.DataFrame(columns)
     data = [c for c in table.columns if c != "time"]
     missing = rng.uniform(size=(n, len(data))) < MISSING_FRACTION
@@ -179,6 +227,7 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     for h in VANE_HEIGHTS:
         table[f"true_stuck_{h:.0f}m"] = stuck[h]
     table["true_direction_80m"] = np.mod(direction, 360.0)
+    table["true_roughness_length"] = roughness
     return table
 
 

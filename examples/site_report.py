@@ -24,9 +24,10 @@ import pandas as pd
 
 import floris_ekman_veer
 
-from instrumented_mast_year import BOOMS, VANE_OFFSETS, mast_year
+from instrumented_mast_year import BOOMS, LONGITUDE, SITE as MAST_SITE, TIME_ZONE, VANE_OFFSETS, mast_year
 
-SITE = dict(latitude=53.3, roughness_length=0.05)
+#: The site as its engineer knows it: onshore, its location and its stamps' time zone.
+SITE = dict(MAST_SITE, site_type="onshore", longitude=LONGITUDE, time_zone=TIME_ZONE)
 
 
 def arguments(argv=None) -> argparse.Namespace:

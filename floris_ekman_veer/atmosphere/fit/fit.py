@@ -83,6 +83,7 @@ from floris_ekman_veer.atmosphere.fit.fit_result import ProfileFit, stability_cl
 from floris_ekman_veer.atmosphere.fit.least_squares import covariance
 from floris_ekman_veer.atmosphere.fit.misfit import CALM_SPEED, hidden_top, misfit_error
 from floris_ekman_veer.atmosphere.fit.multistart import fit_mixed_layer, multistart, restart_misfits
+from floris_ekman_veer.atmosphere.fit.stability_data import checked_stability_terms
 
 #: True inside the two fits of one ``stability="either"`` fit (which warns once, on its own).
 _ONE_OF_TWO_SIGNS = contextvars.ContextVar("one_of_two_signs", default=False)
@@ -95,7 +96,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 chunk_size=DEFAULT_CHUNK_SIZE, turbulence_intensity=None,
                 turbulence_noise=DEFAULT_TURBULENCE_NOISE,
                 direction_model_error=DEFAULT_DIRECTION_MODEL_ERROR, fit_mixed_layer_height=True,
-                direction_heights=None, **fixed_inputs):
+                direction_heights=None, stability_prior=None,
+                inverse_obukhov_length=None, max_heat_flux=None, bulk_richardson=None,
+                min_degrees_of_freedom=1, **fixed_inputs):
     """The atmosphere whose profile best fits measured speeds and directions (module docstring);
     ``EkmanABL.fit_profile`` is this with its class.
 
@@ -151,6 +154,27 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             docs/measurements.md#mixed-layer-depth). False: the default everywhere.
         chunk_size: records iterated together (bounds the memory; the fits do not depend on
             it: each record's iteration is its own).
+        stability_prior: [1/m] the standard deviation of a weak normal prior on 1/L, mean 0
+            (None, the default here: none, the data alone; ``fit_site``'s default is
+            `DEFAULT_STABILITY_PRIOR`, 0.02: |L| = 50 m at one standard deviation): a record whose
+            data do not pin L keeps a state near neutral with the prior's uncertainty rather
+            than one run to a bound (docs/measurements.md#reading-stability). It is no datum:
+            it counts in no degree of freedom and in no refusal.
+        inverse_obukhov_length: a measured 1/L (temperatures through a bulk Richardson
+            number, a sonic anemometer): ``(value [1/m], noise [1/m])``, each a number or one
+            per record (NaN value: none); one datum more.
+        bulk_richardson: a measured bulk Richardson number, ``(value, noise, (z_T1, z_T2),
+            (z_U1, z_U2))``: value and noise a number or one per record (NaN: none), the
+            heights of its two temperatures and two speeds; one datum more, the model's the
+            Businger-Dyer one of its 1/L (`atmosphere.richardson`).
+        min_degrees_of_freedom: a record with fewer data minus unknowns is refused, "too
+            few data" (default 1: data no more than the unknowns are met exactly by some
+            state of either sign and tell nothing of it); 0 where an exact inversion is
+            meant (``atmosphere_from_shear_and_veer``: a hub speed and a veer for u* and L).
+        max_heat_flux: [W/m^2] the largest sensible heat flux per record (a number or one per
+            record; inf: the physical domain's own bound; 0: no convective state, an onshore
+            night): ``fit_site`` gives the sun's (docs/measurements.md#reading-stability). A
+            fit held on it is flagged (``ProfileFit.bound`` names it).
         **fixed_inputs: EkmanABL inputs other than the wind and the stability: ``latitude`` or
             ``coriolis_parameter`` (required), ``roughness_length`` (required unless fitted),
             ``brunt_vaisala_frequency`` or ``lapse_rate``, ``reference_potential_temperature``,
@@ -179,7 +203,10 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
             max_iterations=max_iterations, chunk_size=chunk_size,
             turbulence_intensity=turbulence_intensity, turbulence_noise=turbulence_noise,
             direction_model_error=direction_model_error,
-            fit_mixed_layer_height=fit_mixed_layer_height, **fixed_inputs)
+            fit_mixed_layer_height=fit_mixed_layer_height, stability_prior=stability_prior,
+            inverse_obukhov_length=inverse_obukhov_length, max_heat_flux=max_heat_flux,
+            bulk_richardson=bulk_richardson, min_degrees_of_freedom=min_degrees_of_freedom,
+            **fixed_inputs)
     data = checked_fit_data(
         abl_class, heights, speeds, directions, labels=labels, speed_noise=speed_noise,
         direction_noise=direction_noise, refusal_probability=refusal_probability,
@@ -193,12 +220,16 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     fixed, z0_array, turbulence = data.fixed, data.z0, data.turbulence
     valid_speeds, n_unknowns, observations = data.valid_speeds, data.n_unknowns, data.observations
     n, m = speeds.shape
+    terms = checked_stability_terms(stability_prior, inverse_obukhov_length, max_heat_flux, n,
+                                    bulk_richardson)
+    observations = observations + terms.data
 
     sign = -1.0 if stability == "convective" else 1.0
     # z_i an unknown of convective fits where not given (docs/measurements.md#mixed-layer-depth)
     zi_stage = sign < 0 and fit_mixed_layer_height and "mixed_layer_height" not in fixed
     model = ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array, fit_roughness,
-                          speed_noise, float(direction_noise), sign, turbulence)
+                          speed_noise, float(direction_noise), sign, turbulence,
+                          stability_terms=terms)
     from scipy.stats import chi2
 
     dof = np.maximum(observations - n_unknowns, 1)
@@ -215,7 +246,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
                 z0_array if z0_array.ndim == 0 else z0_array[chunk], fit_roughness,
                 speed_noise, float(direction_noise), sign,
                 None if turbulence is None else tuple(a[chunk] for a in turbulence),
-                fit_mixed_layer)
+                fit_mixed_layer, terms.at(chunk))
         part = model if chunk.size == n else part_model()
         result = multistart(part, chunk.size, max_iterations)
         restart_misfits(part, *result, (misfit_tolerance**2 * dof)[chunk], max_iterations)
@@ -232,7 +263,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         # every record's state with its z_i (fitted, or the default's own depth: the same state)
         model = ProfileModel(abl_class, heights, speeds, directions, fixed, z0_array,
                               fit_roughness, speed_noise, float(direction_noise), sign,
-                              turbulence, True)
+                              turbulence, True, terms)
         # one unknown more where z_i is fitted
         dof = np.maximum(observations - n_unknowns - zi_fitted, 1)
         misfit_tolerance = np.sqrt(chi2.isf(refusal_probability, dof) / dof)
@@ -252,8 +283,14 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
     widen = np.ones(r.shape[1])
     if directions is not None:
         widen[m:2 * m] = direction_noise**2 / (direction_noise**2 + direction_model_error**2)
+    # (the prior is no datum: not in the test; its column is the last)
+    widen[-1] = 0.0
     refusal_misfit = np.where(valid, np.sqrt(np.sum(r**2 * widen, axis=1) / dof), np.inf)
     fits = refusal_misfit <= misfit_tolerance
+    # A record with no more data than unknowns is met exactly by some state of either sign:
+    # its data tell nothing of it (misfit_reason names it "too few data").
+    degrees_of_freedom = observations - n_unknowns - zi_fitted
+    fits &= degrees_of_freedom >= min_degrees_of_freedom
     # A calm record is refused whatever its fit: below the cups' and vanes' starting speeds
     # the readings are no profile (misfit_reason names it "calm").
     fits &= ~(np.nanmax(np.where(np.isfinite(speeds), speeds, -np.inf), axis=1) < CALM_SPEED)
@@ -264,11 +301,13 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         # (a veer stopping is a top only beyond the directions' model error too)
         fits &= ~(valid & hidden_top(heights, speeds, directions, depth, model.sigma_record,
                                       float(np.hypot(direction_noise, direction_model_error))))
-    # where a refused fit lies on a bound of the physical domain: the bound that binds
+    # where a fit lies on a bound of the physical domain or the sun's: the bound that binds;
+    # such a fit is no record's state (the data ask for one beyond it)
     bound = np.full(n, "", dtype=object)
-    refused = np.flatnonzero(~fits & valid)
-    if refused.size:
-        bound[refused] = model.bound(x[refused], refused)
+    inside = np.flatnonzero(valid)
+    if inside.size:
+        bound[inside] = model.bound(x[inside], inside)
+    fits &= bound == ""
     if on_misfit == "raise" and not np.all(fits):
         raise misfit_error(np.flatnonzero(~fits), labels, heights, speeds, directions,
                             speed_rms, direction_rms, refusal_misfit, model, misfit_tolerance,
@@ -314,6 +353,7 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         covariance=shape(covariance(model, x, valid,
                                      zi_fitted if model.fit_mixed_layer else None)),
         stability=stability, bound=shape(bound),
+        degrees_of_freedom=shape(degrees_of_freedom),
     )
     abl.profile_fit = fit
     if not _ONE_OF_TWO_SIGNS.get():
@@ -336,6 +376,9 @@ def _fit_either_sign(abl_class, heights, speeds, directions, *, on_misfit, label
         _ONE_OF_TWO_SIGNS.reset(inner)
     stable, convective = fits
     passes_s, passes_c = np.asarray(stable.fits), np.asarray(convective.fits)
+    if options.get("max_heat_flux") is not None:
+        # (no convective state where the sun allows no heat flux: an onshore night)
+        passes_c = passes_c & (np.asarray(options["max_heat_flux"]) > 0)
     # Convective where it misses the data less; among equally good fits (data that do not tell
     # the signs apart, e.g. two speeds for two unknowns, both met to round-off) the stable or
     # neutral one, the paper's classes, whatever the round-off of the two iterations.

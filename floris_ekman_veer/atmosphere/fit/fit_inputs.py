@@ -19,7 +19,9 @@ from floris_ekman_veer.warnings import DirectionUnitsWarning, warn
 FIT_OPTIONS = ("speed_noise", "direction_noise", "fit_roughness", "refusal_probability",
                "on_misfit", "labels", "max_iterations", "stability", "chunk_size",
                "turbulence_intensity", "turbulence_noise", "direction_model_error",
-               "fit_mixed_layer_height", "direction_heights")
+               "fit_mixed_layer_height", "direction_heights", "stability_prior",
+               "inverse_obukhov_length", "max_heat_flux", "bulk_richardson",
+               "min_degrees_of_freedom")
 #: Default noise of a measured turbulence intensity, relative to its value: the order of the
 #: sampling error of a 10-minute variance (docs/measurements.md#measured-turbulence).
 DEFAULT_TURBULENCE_NOISE = 0.1

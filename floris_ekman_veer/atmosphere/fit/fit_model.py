@@ -22,6 +22,7 @@ from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     MIN_BOUNDARY_LAYER_HEIGHT,
 )
 from floris_ekman_veer.atmosphere.physical_domain import PHYSICAL_DOMAIN, physical_domain
+from floris_ekman_veer.atmosphere.fit.stability_data import stability_residuals
 
 #: Scale of the stability unknown: lam = LENGTH_SCALE / L.
 LENGTH_SCALE = 100.0
@@ -37,8 +38,12 @@ class ProfileModel:
     docs/measurements.md#mixed-layer-depth)."""
 
     def __init__(self, abl_class, heights, speeds, directions, fixed, z0, fit_roughness,
-                 speed_noise, direction_noise, sign=1.0, turbulence=None, fit_mixed_layer=False):
+                 speed_noise, direction_noise, sign=1.0, turbulence=None, fit_mixed_layer=False,
+                 stability_terms=None):
         self.cls, self.fixed, self.fit_roughness = abl_class, fixed, fit_roughness
+        # The prior on 1/L, a measured 1/L and the sun's heat-flux bound per record
+        # (`StabilityTerms`, docs/measurements.md#reading-stability), or None.
+        self.stability_terms = stability_terms
         self.fit_mixed_layer = fit_mixed_layer
         # A measured turbulence intensity per record: (heights (n,), values (n,) NaN missing,
         # relative noise), or None (docs/measurements.md#measured-turbulence).
@@ -78,6 +83,11 @@ class ProfileModel:
         # (unbound: `DefaultDepth` evaluates through it too)
         return ProfileModel._evaluate(self, x, index)[:5]
 
+    def inverse_length(self, x, index):
+        """[1/m] the signed 1/L of unknowns x of records ``index``."""
+        sign = self.sign if np.ndim(self.sign) == 0 else self.sign[index]
+        return sign * x[:, 1] / LENGTH_SCALE
+
     def _evaluate(self, x, index):
         """(G, mu, z0, valid, h, where each state lies in the physical domain: a
         `DomainCheck`) for unknowns x of records ``index``."""
@@ -116,7 +126,12 @@ class ProfileModel:
             check = physical_domain(heat_flux, g, angle, mu)
             # (with a margin: the ABL re-solved from G must land inside too)
             valid &= check.inside & (check.margin > _DOMAIN_MARGIN)
-        return g, mu, z0, valid, h, check
+            if self.stability_terms is not None:
+                # the sun's bound (docs/measurements.md#reading-stability): at night (0) only
+                # neutral or stable states
+                valid &= heat_flux <= self.stability_terms.max_heat_flux[index] * (
+                    1.0 - _DOMAIN_MARGIN)
+        return g, mu, z0, valid, h, check, heat_flux
 
     def bound(self, x, index):
         """Per state of unknowns x of records ``index``: the bound of the physical domain that
@@ -124,9 +139,14 @@ class ProfileModel:
         little further from neutral (its 1/L times 1.02) leaves the domain across it."""
         pushed = x.copy()
         pushed[:, 1] *= 1.02
-        check = self._evaluate(pushed, index)[5]
+        _, _, _, _, _, check, heat_flux = self._evaluate(pushed, index)
         names = np.reshape(check.binding, -1)
         text = np.full(names.size, "", dtype=object)
+        if self.stability_terms is not None:
+            cap = self.stability_terms.max_heat_flux[index]
+            sun = (names == "") & (heat_flux > cap) & (x[:, 1] > 0)
+            text[sun] = [f"sensible heat flux the sun allows, {c:.4g} W/m^2 (the clear-sky "
+                         "irradiance's share; 0 at night)" for c in cap[sun]]
         for name in set(names) - {""}:
             low, high, unit = PHYSICAL_DOMAIN[name]
             value = np.reshape(check.values[name], -1)
@@ -179,6 +199,9 @@ class ProfileModel:
             self.sigma_s[index], self.sigma_d, offset=True)
         if self.turbulence is not None:
             r = np.concatenate([r, turbulence_residual(abl, self.turbulence, index)], axis=1)
+        if self.stability_terms is not None:
+            r = np.concatenate([r, stability_residuals(self.stability_terms.at(index),
+                                                       self.inverse_length(x, index))], axis=1)
         return r, valid, offset
 
 

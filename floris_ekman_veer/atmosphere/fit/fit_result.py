@@ -102,6 +102,10 @@ class ProfileFit:
     #: fit is refused ("" elsewhere): the data ask for a state beyond it
     #: (docs/measurements.md#physical-domain).
     bound: np.ndarray | str | None = None
+    #: Per record its data (speeds, direction changes, a measured I_u or 1/L) minus its
+    #: unknowns: a record with none left is "too few data", met exactly by some state and
+    #: refused (docs/measurements.md#reading-stability).
+    degrees_of_freedom: np.ndarray | int | None = None
 
     def turbulence_intensity_interval(self, height, reference_height=None):
         """(low, high): the fitted I_u at ``height`` (`EkmanABL.turbulence_intensity`) minus and
@@ -289,17 +293,29 @@ class ProfileFit:
     def reason(self, i):
         """(kind, text): why record ``i`` fits no atmosphere of the model (:func:`misfit_reason`;
         for a record that fits, its kind is whatever its data look like)."""
+        if (self.degrees_of_freedom is not None
+                and np.reshape(self.degrees_of_freedom, -1)[i] < 1
+                and not np.reshape(self.fits, -1)[i]):
+            heights = np.reshape(self.heights, (-1, np.shape(self.heights)[-1]))[i]
+            speeds = np.reshape(self.speeds, (-1, np.shape(self.speeds)[-1]))[i]
+            return "too few data", (
+                f"{int(np.sum(np.isfinite(speeds)))} speed(s) (at "
+                f"{', '.join(f'{z:g}' for z in heights[np.isfinite(speeds)])} m) and its other "
+                f"data are no more than the fit's unknowns ({len(self.fitted)}): some state "
+                "meets them exactly, of either sign, and they tell nothing of the atmosphere "
+                "(docs/measurements.md#reading-stability)")
         reason = self._data_reason(i)
         bound = "" if self.bound is None else str(np.reshape(self.bound, -1)[i])
-        if bound and reason[0] == "misfit":
+        if bound and reason[0] in ("misfit", "convective", "no top"):
             # (what the data show comes first: calm, falling speeds, backing...)
+            misfit = np.reshape(self.refusal_misfit, -1)[i]
+            tolerance = np.reshape(self.misfit_tolerance, -1)[i]
             return "physical bound", (
                 f"its best fit inside the model's physical domain lies on the bound of the "
-                f"{bound} and misses the data (misfit "
-                f"{np.reshape(self.refusal_misfit, -1)[i]:.3g}, refused above "
-                f"{np.reshape(self.misfit_tolerance, -1)[i]:.3g}): the data ask for a state "
-                "beyond it, one the atmosphere refuses as input "
-                "(docs/measurements.md#physical-domain)")
+                f"{bound} (misfit {misfit:.3g}, "
+                + ("refused" if misfit > tolerance else "accepted") + f" above {tolerance:.3g}"
+                "): the data ask for a state beyond it, one the atmosphere refuses as input "
+                "(docs/measurements.md#physical-domain, docs/measurements.md#reading-stability)")
         return reason
 
     def _data_reason(self, i):

@@ -123,8 +123,9 @@ class SiteAtmosphere:
         abl: the fitted EkmanABL, shape (n_records,); ``abl.profile_fit`` the fit.
         reference_height: FLORIS's ``reference_wind_height`` [m].
         wind_speeds, wind_directions, turbulence_intensities: per record, FLORIS's inputs at
-            the reference height (the fitted profile's speed and meteorological direction, the
-            fitted ABL's I_u).
+            the reference height (the fitted profile's speed and meteorological direction; the
+            measured TI where the cups log their standard deviations, else the fitted ABL's
+            I_u: :func:`ambient_turbulence`).
         atmosphere: the ``ekman_veer.atmosphere`` block, one entry per record.
         dropped: labels of the records left out (``on_misfit="drop"``).
         excluded: the records left out, one row each (index: the row in ``records``): ``time``,
@@ -283,6 +284,20 @@ class SiteAtmosphere:
         return energy
 
 
+def ambient_turbulence(abl, reference_height, measured, rows):
+    """FLORIS's turbulence intensity per fitted record: the measured TI (``measured``: (height,
+    values per record), or None) carried to the reference height by the fitted profile's own
+    I_u shape (I_u(z_ref)/I_u(z_meas); at the same height the measured TI itself); the fitted
+    I_u where none is measured (docs/measurements.md#reading-stability)."""
+    model = np.asarray(abl.turbulence_intensity(reference_height), float).reshape(-1)
+    if measured is None:
+        return model
+    height, values = measured
+    at_height = np.asarray(abl.turbulence_intensity(height), float).reshape(-1)
+    value = np.asarray(values, float)[rows]
+    return np.where(np.isfinite(value), value * model / at_height, model)
+
+
 def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: list,
                     reference_height: float, baseline: NeutralBaseline | None = None, *,
                     stability_input: str = "stability_parameter") -> SiteAtmosphere:
@@ -308,7 +323,8 @@ def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: lis
         reference_height=z_ref,
         wind_speeds=fit.speed(np.array([z_ref]))[:, 0],
         wind_directions=fit.direction(np.array([z_ref]))[:, 0],
-        turbulence_intensities=turbulence,
+        turbulence_intensities=ambient_turbulence(abl, z_ref, record_fit.measured_turbulence,
+                                                  record_fit.rows),
         atmosphere=fit.atmosphere(stability_input),
         dropped=list(table["time"]),
         excluded=table,

@@ -31,6 +31,7 @@ from floris_ekman_veer.studies.site.columns import mast_columns
 from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
 from floris_ekman_veer.studies.site.readings import SHADOW_HALF_WIDTH, read_instruments
 from floris_ekman_veer.studies.site.record_fit import fit_records
+from floris_ekman_veer.studies.site.stability import checked_site_type
 from floris_ekman_veer.studies.site.wra_file import read_wra_file
 
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
@@ -44,7 +45,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
              stability_input: str = "stability_parameter", on_misfit: str = "raise",
              time_column: str | None = None, booms: dict | None = None,
              direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
-             roughness_length="estimate", metadata=None,
+             roughness_length="estimate", metadata=None, site_type: str | None = None,
+             longitude: float | None = None, time_zone: str | None = None,
              **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
@@ -89,6 +91,13 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             records' columns, its booms as ``booms`` and its location as ``latitude``; given
             ``booms`` or ``latitude`` that contradict it, or a column it names that the records
             lack, are refused naming both.
+        site_type: ``"onshore"`` (no convective state while the sun is below the horizon, the
+            heat flux by day at most half the clear-sky irradiance: needs ``latitude``,
+            ``longitude`` and the stamps' ``time_zone``), ``"offshore"`` or None (no bound
+            from the sun) (docs/measurements.md#reading-stability).
+        longitude: [deg, east positive] the site's, for the sun's position.
+        time_zone: the time zone of naive time stamps ("UTC", "Europe/London", "+01:00"):
+            never guessed; stamps that carry their offset need none.
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
     """
@@ -119,6 +128,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                              f"{str(metadata)!r}, whose location is at {mast.latitude:g} deg; "
                              "give one of them")
         fit_options_and_inputs = {**fit_options_and_inputs, "latitude": mast.latitude}
+    checked_site_type(site_type, longitude, time_zone, fit_options_and_inputs)
     columns = mast_columns(records, booms)
     if time_column is not None and time_column not in records.columns:
         raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
@@ -152,7 +162,9 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                                             booms=booms, shadow_half_width=shadow_half_width)
     # 4. the per-record fit
     record_fit = fit_records(instruments, columns, labels, z_ref, fit_inputs,
-                             stability_input=stability_input, on_misfit=on_misfit)
+                             stability_input=stability_input, on_misfit=on_misfit,
+                             records=records, site_type=site_type, longitude=longitude,
+                             time_zone=time_zone)
     # 5. the atmospheres
     site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
                            stability_input=stability_input)

@@ -15,12 +15,14 @@ from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.site.columns import MastColumns
 from floris_ekman_veer.studies.site.readings import (Instruments, fit_data, fit_heights,
                                                      measured_turbulence)
+from floris_ekman_veer.studies.site.stability import (stability_options, stability_options_of,
+                                                      turbulence_departure)
 
 #: Why a record can be left out, in the order ``SiteAtmosphere.summary`` lists them.
 EXCLUSION_KINDS = ("repeated record", "repeated time stamp", "infinite reading",
                    "zero reading", "missing data",
                    "calm", "falling speeds", "convective", "backing", "no top", "misfit",
-                   "physical bound", "two states")
+                   "physical bound", "too few data", "two states")
 
 
 @attrs.frozen(eq=False)
@@ -36,16 +38,24 @@ class RecordFit:
     abl: EkmanABL
     rows: np.ndarray
     excluded: dict
+    #: the cups' measured turbulence intensity (height, one value per record), or None: the
+    #: wake's ambient turbulence (docs/measurements.md#reading-stability)
+    measured_turbulence: tuple | None = None
 
 
 def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
                 reference_height: float, fit_options_and_inputs: dict, *,
                 stability_input: str = "stability_parameter",
-                on_misfit: str = "raise") -> RecordFit:
+                on_misfit: str = "raise", records: pd.DataFrame | None = None,
+                site_type: str | None = None, longitude: float | None = None,
+                time_zone: str | None = None) -> RecordFit:
     """Every record's fit (module docstring). ``on_misfit="raise"``: ValueError naming the
     first record that cannot be fitted and why; ``"drop"``: such records are left out and
     named in ``excluded``. The cups' measured turbulence intensity (nearest the reference
-    height) is the fit's ``turbulence_intensity`` unless one is given."""
+    height) enters the fit as its departure from the site's neutral turbulence in its sector
+    unless a ``turbulence_intensity`` is given; the fit takes the weak prior on 1/L, an onshore
+    site's sun bound, and the temperatures' and a sonic's stability where ``records`` hold
+    them (stability.py, docs/measurements.md#reading-stability)."""
     heights, speeds, directions, speed_columns = fit_heights(instruments, columns)
     excluded = screen_records(speed_columns, labels, heights, speeds, directions,
                               3 if fit_options_and_inputs.get("fit_roughness") else 2)
@@ -58,8 +68,16 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
     fit_inputs = dict(fit_options_and_inputs)
     # (a measured turbulence intensity is a pair (height, value), each one number or a column)
     turbulence = fit_inputs.pop("turbulence_intensity", None)
+    measured = None
     if turbulence is None and instruments.speed_std is not None:
-        turbulence = measured_turbulence(instruments, reference_height)
+        # the measured TI: the wake's input, and to the fit only its departure from the site's
+        # neutral TI in its sector (docs/measurements.md#reading-stability)
+        measured = measured_turbulence(instruments, reference_height)
+        vane = int(np.argmin(np.abs(instruments.vane_heights - reference_height)))
+        turbulence, noise, _ = turbulence_departure(measured, instruments, vane, fit_inputs)
+        fit_inputs.setdefault("turbulence_noise", noise)
+    fit_inputs.update(stability_options(fit_inputs, labels, instruments, records, site_type,
+                                        longitude, time_zone))
     # (fixed inputs may be one per record; the fit's options, a noise pair say, are not)
     per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
     n = instruments.speeds.shape[0]
@@ -70,6 +88,7 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
     if turbulence is not None:
         inputs["turbulence_intensity"] = tuple(
             np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
+    inputs.update(stability_options_of(inputs, candidates, n))
     abl = EkmanABL.fit_profile(
         **fit_data(instruments, candidates),
         on_misfit="raise" if on_misfit == "raise" else "flag",
@@ -97,7 +116,8 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
     if kept.size == 0:
         raise ValueError(f"fit_site: no record fits an atmosphere of the model "
                          f"({reasons_text(excluded)})")
-    return RecordFit(abl=abl, rows=candidates[kept], excluded=excluded)
+    return RecordFit(abl=abl, rows=candidates[kept], excluded=excluded,
+                     measured_turbulence=measured)
 
 
 def screen_records(speed_columns, labels, heights, speeds, directions, unknowns):

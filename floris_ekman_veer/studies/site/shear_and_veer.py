@@ -92,6 +92,8 @@ def atmosphere_from_shear_and_veer(hub_speed, hub_height, rotor_diameter, shear_
     # The veer is met within veer_tolerance as stated: no model error of the directions is
     # added to it (docs/measurements.md#direction-model-error).
     fit_options_and_inputs.setdefault("direction_model_error", 0.0)
+    # (a hub speed and a veer for u* and L: an exact inversion, not a measurement's fit)
+    fit_options_and_inputs.setdefault("min_degrees_of_freedom", 0)
     # The fit flags what it refuses; the refusal is said here, of this function's inputs.
     on_misfit = fit_options_and_inputs.pop("on_misfit", "raise")
     abl = EkmanABL.fit_profile(

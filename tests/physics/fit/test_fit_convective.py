@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from floris_ekman_veer import EkmanABL
+from floris_ekman_veer.atmosphere.fit.stability_data import DEFAULT_STABILITY_PRIOR
 
 from benchmarks.fit_stability_classes import confusion  # the repository is on pytest's pythonpath
 
@@ -41,9 +42,10 @@ def test_noise_free_profiles_of_either_sign_are_recovered_exactly():
 def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
     """A Businger-Dyer surface layer (Paulson 1970's psi_m) with u* = 0.7 m/s and L = -20 m
     implies 1,493 W/m^2, beyond the sensible heat flux the atmosphere accepts (800 W/m^2; the
-    model's own solve refuses such a state): the fit's states stay inside the physical domain,
-    its best one on that bound; with a speed noise that tells the shapes apart the record is
-    refused and the bound named."""
+    model's own solve refuses such a state): the convective fit's states stay inside the
+    physical domain, its best one on that bound, which is flagged (the bound named) and never
+    kept, whatever the noise; the fit of either sign takes the neutral state that passes
+    instead (docs/measurements.md#reading-stability)."""
     u_star, length, z0 = 0.7, -20.0, 0.1
     x = (1.0 - 16.0 * Z / length) ** 0.25
     psi = 2.0 * np.log((1.0 + x) / 2.0) + np.log((1.0 + x * x) / 2.0) - 2.0 * np.arctan(x) + np.pi / 2
@@ -51,9 +53,13 @@ def test_a_convective_profile_beyond_the_heat_flux_bound_is_held_on_it():
     assert u_star**3 / (0.41 * 9.81 / 265.0 * -length) * 1321.0 == pytest.approx(1493.0, abs=2.0)
     directions = np.full(Z.size, 270.0)
     fit = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0, on_misfit="flag",
-                               **SITE).profile_fit
+                               stability="convective", **SITE).profile_fit
     assert fit.stability_class == "convective"
     assert 0.99 * 800.0 < float(fit.abl.sensible_heat_flux) <= 800.0
+    assert not fit.fits and fit.bound == "sensible heat flux 800 W/m^2"
+    either = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0, on_misfit="flag",
+                                  **SITE).profile_fit
+    assert either.fits and either.bound == "" and either.stability_class == "neutral"
     fine = EkmanABL.fit_profile(Z, speeds, directions, roughness_length=z0,
                                 speed_noise=0.001, direction_noise=0.5, on_misfit="flag",
                                 **SITE).profile_fit
@@ -81,14 +87,19 @@ def test_the_stable_only_fit_cannot_follow_a_convective_layer():
 
 def test_noisy_records_are_classed_by_the_misfit():
     """30 records per class, 0.1 m/s and 0.5 deg of noise (benchmarks/fit_stability_classes.py,
-    which gives the table of 200 per class): every stable and neutral record in its class, at
-    least 80 % of the convective ones (heat fluxes 20-700 W/m^2: the rest near-neutral, a weak
-    heat flux in a strong wind being |L| > 500 m), none refused, the hub speed within 2 %."""
-    table = confusion(30)
+    which gives the table of 200 per class), with fit_site's weak prior on 1/L: every stable and
+    neutral record in its class, at least 80 % of the convective ones (heat fluxes 20-700
+    W/m^2: the rest near-neutral, a weak heat flux in a strong wind being |L| > 500 m), none
+    refused, the hub speed within 2 %. From the data alone one convective record's best fit
+    lies on the 800 W/m^2 bound (its directions back by 2.3 deg with the noise) and is refused,
+    never kept (docs/measurements.md#reading-stability)."""
+    table = confusion(30, stability_prior=DEFAULT_STABILITY_PRIOR)
     assert table["stable"][0]["stable"] == 30 and table["neutral"][0]["neutral"] == 30
     assert table["convective"][0]["convective"] >= 24 and table["convective"][0]["stable"] == 0
     for counts, refused, error in table.values():
         assert refused == 0 and error <= 0.02
+    alone = confusion(30)
+    assert [refused for _, refused, _ in alone.values()] == [1, 0, 0]
 
 
 def test_a_convective_fit_gives_back_its_floris_block():

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from floris_ekman_veer import EkmanABL
+from floris_ekman_veer.atmosphere.fit.stability_data import DEFAULT_STABILITY_PRIOR
 
 
 KAPPA = 0.4
@@ -134,15 +135,19 @@ def test_a_mixed_layer_with_a_measured_intensity_has_the_convective_turbulence()
 
 def test_a_measured_intensity_is_recovered_exactly_and_picks_the_sign():
     """The model's own profiles at two heights (speeds only: two data, two unknowns, a stable
-    and a convective state fit each exactly) with the model's I_u at 100 m: the true L of either
-    sign comes back to 1e-6, where without it a convective record is fitted as stable."""
+    and a convective state fit each exactly: "too few data", refused) with the model's I_u at
+    100 m: the true L of either sign comes back to 1e-6, where without it a convective record
+    is fitted as stable."""
     site = {k: v for k, v in SITE.items() if k != "mixed_layer_height"}
     heights = np.array([40.0, 100.0])
     lengths = np.array([-60.0, -200.0, 200.0, 80.0])
     true = EkmanABL.from_reference_wind(8.0, 90.0, obukhov_length=lengths, **site)
     speeds = true.speed(heights[:, None]).T
-    alone = EkmanABL.fit_profile(heights, speeds, stability="either", **site, **NOISE).profile_fit
+    alone = EkmanABL.fit_profile(heights, speeds, stability="either", on_misfit="flag", **site,
+                                 **NOISE).profile_fit
     assert alone.stability_class[1] == "stable"
+    assert not np.any(alone.fits) and np.all(alone.degrees_of_freedom == 0)
+    assert all(alone.reason(i)[0] == "too few data" for i in range(4))
     abl = EkmanABL.fit_profile(heights, speeds, stability="either",
                                turbulence_intensity=(100.0, true.turbulence_intensity(100.0)),
                                **site, **NOISE)
@@ -168,7 +173,8 @@ def test_turbulence_intensity_option_is_checked():
 
 def test_fit_site_takes_a_measured_intensity_per_record():
     """fit_site passes ``turbulence_intensity=(height, column)`` through, one value per record
-    (NaN: none): the records it has pinned to the model's own I_u, the others fitted without."""
+    (NaN: none): the records it has pinned to the model's own I_u; one without (two speeds for
+    two unknowns) is "too few data", left out."""
     import pandas as pd
 
     from floris_ekman_veer import fit_site
@@ -182,10 +188,10 @@ def test_fit_site_takes_a_measured_intensity_per_record():
                             "speed_100m": speeds[:, 1]})
     measured = np.asarray(true.turbulence_intensity(100.0), float)
     measured[2] = np.nan
-    fitted = fit_site(records, 90.0, stability="either",
-                      turbulence_intensity=(100.0, measured), **site).profile_fit
-    np.testing.assert_allclose(fitted.obukhov_length[:2], lengths[:2], rtol=1e-6)
-    assert fitted.stability_class[2] == "stable"  # speeds alone: the ambiguity of the test above
+    site_fit = fit_site(records, 90.0, stability="either", on_misfit="drop", stability_prior=None,
+                        turbulence_intensity=(100.0, measured), **site)
+    np.testing.assert_allclose(site_fit.profile_fit.obukhov_length, lengths[:2], rtol=1e-6)
+    assert list(site_fit.excluded["kind"]) == ["too few data"]
 
 
 def turning_record(turn):
@@ -270,9 +276,11 @@ def test_noisy_neutral_records_turning_five_degrees_are_accepted():
     assert accepted == 84 and classes["stable"] == 0
     assert high <= 0.02 and low <= 0.05
     assert turning_acceptance(5.0, direction_model_error=0.0)[0] < 42
-    # (one backing record's only passing fit was a convective layer beyond the heat flux the
-    # atmosphere accepts as input, 800 W/m^2: inside the physical domain it is refused)
-    assert turning_acceptance(-5.0)[0] >= 83
+    # Backing by 5 deg: from the data alone 21 records' best fits are convective layers on the
+    # heat flux bound (800 W/m^2), never kept (docs/measurements.md#reading-stability); with
+    # fit_site's weak prior on 1/L most of them are fitted inside it.
+    assert 60 <= turning_acceptance(-5.0)[0] <= 66
+    assert turning_acceptance(-5.0, stability_prior=DEFAULT_STABILITY_PRIOR)[0] >= 75
 
 
 def test_a_backing_front_is_refused_within_the_model_error():

@@ -90,7 +90,9 @@ def test_repeated_time_stamps_are_named_not_merged():
     with pytest.raises(ValueError, match=r"record 02 cannot be fitted: time stamp 02 is given to 2 "
                                          r"records \(rows 2, 3\) with different data"):
         fit_site(records, 90.0, **SITE)
-    site = fit_site(records, 90.0, on_misfit="drop", **SITE)
+    # (the data alone: noise-free records come back exactly; fit_site's prior on 1/L moves them
+    # by 1e-3, docs/measurements.md#reading-stability)
+    site = fit_site(records, 90.0, on_misfit="drop", stability_prior=None, **SITE)
     # "02" twice with different data: both out; "04" twice with the same data: counted once.
     assert site.labels == ["00", "01", "04"]
     assert list(site.excluded["kind"]) == ["repeated time stamp"] * 2 + ["repeated record"]
@@ -348,15 +350,16 @@ def test_the_issues_records_that_aborted_a_site_are_fitted_or_named():
                                    stability=stability).profile_fit
         assert np.isfinite(fit.misfit)
         assert -300.0 <= float(fit.abl.sensible_heat_flux) <= 800.0
-    # A well-mixed 16.6 m/s record (once L = -0.084 m, 4.6e7 W/m^2, I_u(90 m) = 7.05): a
-    # convective state on the 800 W/m^2 bound, L = -122 m, I_u(90 m) 0.157.
+    # A well-mixed 16.6 m/s record (once L = -0.084 m, 4.6e7 W/m^2, I_u(90 m) = 7.05): its
+    # convective state lies on the 800 W/m^2 bound, L = -122 m: flagged, the bound named, never
+    # kept (docs/measurements.md#reading-stability).
     mixed = EkmanABL.fit_profile(np.array([30.0, 70.0, 110.0, 150.0]),
                                  [16.2, 16.5, 16.6, 16.6], [270.0, 270.2, 270.1, 270.3],
-                                 latitude=52.0, roughness_length=0.05).profile_fit
-    assert mixed.fits and mixed.stability_class == "convective"
+                                 latitude=52.0, roughness_length=0.05, stability="convective",
+                                 on_misfit="flag").profile_fit
+    assert not mixed.fits and mixed.bound == "sensible heat flux 800 W/m^2"
     assert 799.0 < float(mixed.abl.sensible_heat_flux) <= 800.0
     assert mixed.obukhov_length == pytest.approx(-122.0, abs=1.0)
-    assert float(mixed.abl.turbulence_intensity(90.0)) == pytest.approx(0.157, abs=0.002)
     # An infinite reading is removed (the record keeps its other data) and named by its time
     # stamp (docs/measurements.md#a-real-mast).
     bad = calm.copy()

@@ -14,10 +14,17 @@ from floris_ekman_veer import fit_site
 from floris_ekman_veer.studies.site.columns import mast_columns
 from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
 from floris_ekman_veer.studies.site.readings import read_instruments
-from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS, VANE_OFFSETS,
-                                     mast_year, shadow_deficit)
+from floris_ekman_veer.studies.site.readings import measured_turbulence
+from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, LONGITUDE, N_ICING, TERRAIN_TURBULENCE,
+                                     TIME_ZONE, VANE_HEIGHTS, VANE_OFFSETS, mast_year,
+                                     shadow_deficit)
 
-SITE = dict(latitude=53.3, roughness_length=0.05)
+#: The site as its engineer knows it: onshore at 53.3 N 1.8 W, the stamps in UTC; one roughness
+#: length for all sectors (the generator's are 0.02 to 0.3 m).
+SITE = dict(latitude=53.3, roughness_length=0.05, site_type="onshore", longitude=LONGITUDE,
+            time_zone=TIME_ZONE)
+#: The fit's inputs alone (stages 1-3 take no site type).
+FIT_INPUTS = dict(latitude=53.3, roughness_length=0.05)
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +37,7 @@ def instruments(year):
     """The site fit's stages 1-3 (studies/site/pipeline.py), called one by one."""
     columns = mast_columns(year, BOOMS)
     readings = read_instruments(year, columns, booms=BOOMS)
-    return estimate_vane_offsets(readings, year, columns, 80.0, SITE, booms=BOOMS)
+    return estimate_vane_offsets(readings, year, columns, 80.0, FIT_INPUTS, booms=BOOMS)
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +63,8 @@ def test_the_generator_is_seeded_and_makes_what_it_documents(year):
     hour = pd.to_datetime(year["time"]).dt.hour
     assert (year["true_class"][hour == 13] == "convective").mean() > 0.2
     assert (year["true_class"][hour.isin([0, 1, 2, 3])] == "stable").mean() > 0.6
-    assert year.loc[year["true_class"] == "convective", "true_obukhov_length"].between(-150, -10).all()
+    # (|L| drawn from 10-150 m, enlarged where the heat flux would exceed the sun's share)
+    assert year.loc[year["true_class"] == "convective", "true_obukhov_length"].between(-500, -10).all()
     assert year.loc[year["true_class"] == "stable", "true_obukhov_length"].between(20, 200).all()
     # Icing: N_ICING runs of one vane repeating its reading.
     stuck = pd.concat([year[f"true_stuck_{h:.0f}m"] for h in VANE_HEIGHTS], ignore_index=True)
@@ -129,13 +137,15 @@ def test_cup_pairs_agree_within_their_calibration(instruments):
     assert (np.abs(pairs["median_ratio"] - 1.0) < 0.03).all() and not pairs["disagree"].any()
 
 
-def test_a_pair_that_disagrees_over_the_year_is_named(year):
+def test_a_pair_that_disagrees_over_the_year_is_named(year, instruments):
     drifted = year.head(500).copy()
     drifted["speed_60m_b"] *= 1.06  # a cup calibrated 6 % high
     site = fit_site(drifted, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
     pairs = site.summary().cup_pairs.set_index("height")
     assert pairs.loc[60.0, "disagree"] and not pairs.loc[40.0, "disagree"]
-    assert pairs.loc[60.0, "median_ratio"] == pytest.approx(1.06 * 1.015, abs=0.01)
+    # (the pair's own calibrations: their ratio over the year)
+    own = instruments.cup_pairs.set_index("height").loc[60.0, "median_ratio"]
+    assert pairs.loc[60.0, "median_ratio"] == pytest.approx(1.06 * own, abs=0.01)
 
 
 def test_one_inf_reading_is_named_by_its_time_stamp_and_aborts_nothing(year):
@@ -148,22 +158,31 @@ def test_one_inf_reading_is_named_by_its_time_stamp_and_aborts_nothing(year):
     assert records["time"][3] in site.labels and records["time"][5] in site.labels
 
 
-def test_the_cups_standard_deviations_are_the_fits_turbulence(year):
+def test_the_cups_turbulence_is_the_wakes_input_and_only_its_departure_the_fits(year):
+    """The measured TI (the cups' standard deviation over their speed at 80 m) is FLORIS's
+    turbulence intensity for each record; the fit sees it divided by the site's terrain excess
+    (the generator's 1.2 over the model's I_u): its own I_u at 80 m is the measured TI over
+    about 1.2, not the measured TI read as convection (docs/measurements.md#reading-stability).
+    Without the standard deviations FLORIS gets the fitted I_u."""
     records = year.head(48)
     with_std = fit_site(records, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    columns = mast_columns(records, BOOMS)
+    readings = estimate_vane_offsets(read_instruments(records, columns, booms=BOOMS), records,
+                                     columns, 80.0, FIT_INPUTS, booms=BOOMS)
+    height, measured = measured_turbulence(readings, 80.0)
+    assert height == 80.0
+    measured = measured[with_std.rows]
+    given = np.isfinite(measured)
+    assert given.sum() > 40
+    np.testing.assert_allclose(with_std.turbulence_intensities[given], measured[given],
+                               rtol=1e-12)
+    fitted = np.asarray(with_std.abl.turbulence_intensity(80.0), float)[given]
+    assert np.median(measured[given] / fitted) == pytest.approx(TERRAIN_TURBULENCE, rel=0.05)
     without = fit_site(records.drop(columns=[c for c in records if c.endswith("_std")]), 80.0,
                        on_misfit="drop", booms=BOOMS, **SITE)
-    common = sorted(set(with_std.labels) & set(without.labels))
-    assert len(common) > 40
-    # The measured I_u at 80 m: the fit with it lands nearer it than the fit without.
-    truth = {t: i for t, i in zip(records["time"], (records["speed_80m_a_std"] + records[
-        "speed_80m_b_std"]) / (records["speed_80m_a"] + records["speed_80m_b"]))}
-
-    def error(site):
-        fitted = dict(zip(site.labels, site.abl.turbulence_intensity(80.0)))
-        return np.nanmedian([abs(fitted[t] / truth[t] - 1.0) for t in common])
-
-    assert error(with_std) < 0.8 * error(without)
+    np.testing.assert_allclose(without.turbulence_intensities,
+                               np.asarray(without.abl.turbulence_intensity(80.0), float),
+                               rtol=1e-12)
 
 
 @pytest.mark.parametrize("reference_height, match", [
@@ -198,18 +217,24 @@ def test_bad_columns_and_options_are_named(year):
 
 # ------------------------------------------------------------------- the year, with defaults
 def test_the_year_is_kept_its_offsets_found_and_its_classes_read(year, site):
-    """The acceptance of docs/measurements.md#a-real-mast: with the defaults, at least 95 % of
-    the non-calm records kept, the offsets within 0.5 deg, and the fitted classes the
-    generator's for at least 85 % of the kept records."""
+    """The acceptance of docs/measurements.md#reading-stability: with the defaults, at least
+    95 % of the non-calm records kept, the fitted classes the generator's for at least 90 % of
+    the kept records, at most 5 % of the night's (21-04 h) records convective, none kept on a
+    bound or without a degree of freedom."""
     not_calm = ~year["true_calm"].to_numpy()
     assert np.sum(not_calm[site.rows]) >= 0.95 * np.sum(not_calm)
     truth = year["true_class"].to_numpy()[site.rows]
     assert list(site.labels) == list(year["time"].iloc[site.rows])
     matched = np.mean(truth == site.stability_classes)
-    assert matched >= 0.85
+    assert matched >= 0.9
     # Each class is read, not one swallowing the others.
     for name in ("convective", "neutral", "stable"):
         assert np.mean(site.stability_classes[truth == name] == name) >= 0.8, name
+    hour = pd.to_datetime(pd.Series(site.labels)).dt.hour.to_numpy()
+    night = (hour >= 21) | (hour <= 4)
+    assert np.mean(site.stability_classes[night] == "convective") <= 0.05
+    fit = site.profile_fit
+    assert np.all(fit.bound == "") and np.all(fit.degrees_of_freedom >= 1)
 
 
 def test_the_summary_reads_like_a_site_report(year, site, tmp_path):
