@@ -306,6 +306,19 @@ def test_dask_interface_rejects_other_client_objects():
         ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=8786)
 
 
+def test_unknown_interface_lists_every_interface_with_dask():
+    with pytest.raises(ValueError, match=r"interface='dask2' is not one of 'multiprocessing', "
+                                         r"'pathos', 'concurrent', 'dask' .* or None"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask2")
+
+
+@pytest.mark.parametrize("address", ["x", "tcp://scheduler"])
+def test_dask_client_string_that_is_no_address_names_the_form(address):
+    with pytest.raises(ValueError, match=rf"client='{address}' is not a Dask scheduler address: "
+                                         r"give one such as 'tcp://scheduler:8786'"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=address)
+
+
 class _FakeClient:
     """What _check_workers reads of a Client: run() on every worker, the scheduler address."""
 
