@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import logging
 import os
 import sys
 import warnings
@@ -44,7 +45,7 @@ __all__ = [
     "ShallowBoundaryLayerWarning", "ThrustLimitWarning", "TurbinePlacementWarning",
     "apply_setting", "silence_warnings", "warnings_setting",
     "WorkerRecords", "carrying", "collecting", "discard_from_workers", "discarding",
-    "in_worker_process", "note_thrust_limit", "range_text", "report_from_workers", "run_scope",
+    "in_worker_process", "LOGGER", "note_thrust_limit", "notice", "range_text", "report_from_workers", "run_scope",
     "speeds_text", "study_scope", "user_frame", "values_seen", "warn", "warn_shallow",
 ]
 
@@ -132,6 +133,19 @@ def warn(message: str, category: type, items=()) -> None:
         module=module_globals.get("__name__", "<unknown>"),
         registry=module_globals.setdefault("__warningregistry__", {}),
     )
+
+
+#: FLORIS's logger (its handlers show what the input's ``logging`` block asks for): the
+#: package's notices that ask nothing of the user.
+LOGGER = logging.getLogger("floris.floris_ekman_veer")
+
+
+def notice(message: str, key: str, items=()) -> None:
+    """Log ``message`` at INFO on FLORIS's logger, once per study and ``key`` as :func:`warn`
+    says a warning (again only for ``items`` not noticed yet): for what the user can do nothing
+    about, which a warning would repeat on the canonical path."""
+    if _REPORTED.new(("notice", key), tuple(items) or (message,)):
+        LOGGER.info(message)
 
 
 def values_seen(key: str, values) -> set:

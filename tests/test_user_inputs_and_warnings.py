@@ -39,10 +39,8 @@ def caught():
 
 
 def of(records, category):
-    """The records of ``category``, without the notice that FLORIS's placeholder TI are not the
-    atmosphere's (tests/plugin/test_floris_input_messages.py tests it)."""
-    return [r for r in records if issubclass(r.category, category)
-            and not str(r.message).startswith("flow_field.turbulence_intensities")]
+    """The records of ``category``."""
+    return [r for r in records if issubclass(r.category, category)]
 
 
 def line_of(text: str) -> int:

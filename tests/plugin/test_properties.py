@@ -68,10 +68,6 @@ pytestmark = [
     pytest.mark.filterwarnings(
         "ignore::floris_ekman_veer.plugin.shallow.ShallowBoundaryLayerWarning"
     ),
-    # drawn turbulence intensities, which the ekman_veer model does not read (that notice is
-    # tested in tests/plugin/test_floris_input_messages.py)
-    pytest.mark.filterwarnings(
-        "ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning"),
 ]
 
 
