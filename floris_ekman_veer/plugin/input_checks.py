@@ -11,6 +11,7 @@ its condition or turbine index) and the valid range (docs/coupling.md#input-vali
 
 from __future__ import annotations
 
+import functools
 import sys
 
 import numpy as np
@@ -50,6 +51,35 @@ def uses_package(core, atmosphere) -> bool:
         or uses_wake_models(core)
         or any(_is_disk(t) for t in core.farm.turbine_definitions)
     )
+
+
+@functools.lru_cache(maxsize=None)
+def _library_thrust_table(name: str) -> tuple | None:
+    """The thrust coefficients of FLORIS's library turbine ``name`` (None if it has none)."""
+    from floris.core.farm import default_turbine_library_path
+    from floris.utilities import load_yaml
+
+    path = (default_turbine_library_path / name).with_suffix(".yaml")
+    if not path.is_file():
+        return None
+    return tuple(float(v) for v in load_yaml(path)["power_thrust_table"]["thrust_coefficient"])
+
+
+def stock_thrust_tables(farm) -> bool:
+    """Whether every turbine is a FLORIS library turbine with its library thrust table (the
+    loading near cut-in is FLORIS's, not the user's: the thrust-limit summary is then a notice,
+    floris_ekman_veer.warnings._warn_thrust_limit)."""
+    seen: dict = {}
+    for turbine in farm.turbine_definitions:
+        key = id(turbine)
+        if key not in seen:
+            library = _library_thrust_table(str(turbine.get("turbine_type")))
+            table = turbine.get("power_thrust_table", {}).get("thrust_coefficient")
+            seen[key] = (library is not None and table is not None
+                         and tuple(float(v) for v in table) == library)
+        if not seen[key]:
+            return False
+    return bool(seen)
 
 
 def _is_disk(turbine: dict) -> bool:
