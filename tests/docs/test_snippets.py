@@ -44,3 +44,5 @@ def test_snippet_runs_as_written(code, tmp_path):
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, f"the snippet failed:\n{code}\n--- stderr:\n{run.stderr[-3000:]}"
+    # and silently: no warning of the package nor FLORIS's (docs/user_guide.md#warnings)
+    assert not re.search(r"\w+Warning: ", run.stderr), f"the snippet warned:\n{run.stderr[-3000:]}"
