@@ -335,6 +335,14 @@ def test_readme_quick_start_fits_a_screen_and_links_the_gallery():
         assert "--gallery" in (REPO / script).read_text(), script
 
 
+def test_user_guide_lists_every_example():
+    """docs/user_guide.md#examples names every script of examples/, with what it does."""
+    text = (REPO / "docs" / "user_guide.md").read_text()
+    section = text.split("\n## Examples\n", 1)[1].split("\n## ", 1)[0]
+    listed = set(re.findall(r"^- `examples/(\w+)\.py`", section, flags=re.M))
+    assert listed == {p.stem for p in (REPO / "examples").glob("*.py")}
+
+
 # ------------------------------------------------------------ numbers the pages take from scripts
 #: Numbers of the README and docs/ that a named script prints: (page, the page's text holding
 #: the number, the script and its arguments, a regular expression of the script's output whose
