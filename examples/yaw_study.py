@@ -229,10 +229,10 @@ def run_study(reduced: bool = False, energy: bool = True) -> dict:
 #: How the row figure tells the models apart: colour, a small shift along the spacing axis (so
 #: that equal optima, e.g. two models at the -25 deg bound, stay visible side by side) and a
 #: filled or open marker; the wind speed is the line style and marker shape.
-MODEL_STYLE = {"ekman_veer": dict(color="m", shift=-0.09, mfc="m"),
+MODEL_STYLE = {"ekman_veer": dict(color="m", shift=-0.14, mfc="m"),
                "gch": dict(color="tab:cyan", shift=0.0, mfc="tab:cyan"),
-               "gch_fair_veer": dict(color="tab:gray", shift=0.09, mfc="none")}
-SPEED_STYLE = {8.0: ("-", "o"), 10.0: ("--", "s"), 12.0: (":", "^")}
+               "gch_fair_veer": dict(color="tab:gray", shift=0.14, mfc="none")}
+SPEED_STYLE = {8.0: ("-", "o", -0.04), 10.0: ("--", "s", 0.0), 12.0: (":", "^", 0.04)}
 
 
 def _same_sign_segments(x, y):
@@ -252,10 +252,10 @@ def plot_row(yaw: pd.DataFrame, output: Path, dpi: int = 120) -> Path:
                              squeeze=False)
     for j, label in enumerate(labels):
         for (name, speed), df in yaw[yaw["atmosphere"] == label].groupby(["model", "wind_speed"]):
-            line, marker = SPEED_STYLE.get(speed, ("-", "o"))
+            line, marker, shift = SPEED_STYLE.get(speed, ("-", "o", 0.0))
             model = MODEL_STYLE[name]
             df = df.sort_values("spacing_D")
-            x = df["spacing_D"].to_numpy() + model["shift"]
+            x = df["spacing_D"].to_numpy() + model["shift"] + shift
             marks = dict(marker=marker, color=model["color"], mfc=model["mfc"], ms=5)
             axes[0, j].plot(x, df["gain_percent"], ls=line, **marks)
             yaw_front = df["yaw_T1"].to_numpy()
@@ -270,15 +270,17 @@ def plot_row(yaw: pd.DataFrame, output: Path, dpi: int = 120) -> Path:
     axes[0, 0].set_ylabel("farm power gain [%]")
     axes[1, 0].set_ylabel("optimal yaw of the front turbine [deg]\n(dotted: the search's bounds)")
     # One legend below the panels, colour = model, style = wind speed: off the data.
-    handles = [Line2D([], [], color=m["color"], marker="o", mfc=m["mfc"], label=MODELS[name])
-               for name, m in MODEL_STYLE.items() if name in set(yaw["model"])]
-    handles += [Line2D([], [], color="k", ls=ls, marker=mk, mfc="none", label=f"{speed:g} m/s")
-                for speed, (ls, mk) in SPEED_STYLE.items() if speed in set(yaw["wind_speed"])]
-    fig.tight_layout(rect=(0.0, 0.1, 1.0, 1.0))
-    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=8, frameon=False,
-               title="colour: model (markers side by side where optima coincide); line and "
-                     "marker: wind speed; lines join optima of one sign only",
-               title_fontsize=8)
+    models = [Line2D([], [], color=m["color"], marker="o", mfc=m["mfc"], label=MODELS[name])
+              for name, m in MODEL_STYLE.items() if name in set(yaw["model"])]
+    speeds = [Line2D([], [], color="k", ls=ls, marker=mk, mfc="none", label=f"{speed:g} m/s")
+              for speed, (ls, mk, _) in SPEED_STYLE.items() if speed in set(yaw["wind_speed"])]
+    fig.tight_layout(rect=(0.0, 0.13, 1.0, 1.0))
+    fig.legend(handles=models, loc="lower center", bbox_to_anchor=(0.5, 0.05), ncol=3,
+               fontsize=8, frameon=False, title_fontsize=8,
+               title="colour: model; markers side by side where optima coincide (as at the "
+                     "-25 deg bound); lines join optima of one sign only")
+    fig.legend(handles=speeds, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=3,
+               fontsize=8, frameon=False)
     path = output / "yaw_study_row.png"
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
