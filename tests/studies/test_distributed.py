@@ -71,9 +71,11 @@ SCRIPT = textwrap.dedent(
             from floris_ekman_veer import ThrustLimitWarning
 
             rng = np.random.default_rng(1)
+            from tests.conftest import own_turbine  # the user's turbine: a warning, not a notice
+
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                light = FlorisModel(farm)
+                light = FlorisModel(own_turbine(farm))
                 light.set(wind_directions=rng.uniform(0, 360, 8), wind_speeds=rng.uniform(3, 8, 8),
                           turbulence_intensities=np.full(8, 0.06))
             said = {}
