@@ -22,7 +22,7 @@ from floris.utilities import load_yaml
 import floris_ekman_veer
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.plugin import shallow
+from floris_ekman_veer.plugin.inflow import shallow
 from tests.conftest import STABLE_ATMOSPHERE, own_turbine
 
 REPO = Path(__file__).resolve().parents[1]
@@ -238,7 +238,7 @@ def restore_setting():
 
 
 def test_silence_warnings_here_and_in_the_workers_it_sends_models_to(restore_setting):
-    from floris_ekman_veer.plugin.parallel import WorkerDict
+    from floris_ekman_veer.plugin.floris_tools.parallel import WorkerDict
 
     floris_ekman_veer.silence_warnings()
     with caught() as records:
