@@ -132,7 +132,8 @@ heights = st.one_of(st.just(0.0), finite((1e-6, 400.0)))
 WAKES = {
     "M-1/M-2": dict(velocity_model="ekman_veer", deflection_model="ekman_veer"),
     "M-3": dict(velocity_model="bastankhah2014", deflection_model="ekman_veer"),
-    "gauss": dict(velocity_model="gauss", deflection_model="gauss"),
+    # FLORIS's gauss as FLORIS runs it (its wakes' squares summed)
+    "gauss": dict(velocity_model="gauss", deflection_model="gauss", combination_model="sosfs"),
 }
 
 
