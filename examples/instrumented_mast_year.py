@@ -232,7 +232,16 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
 
 
 if __name__ == "__main__":
-    year = mast_year()
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--periods", type=int, default=8760, help="number of hourly records")
+    parser.add_argument("--csv", help="write the records to this CSV file (the package's "
+                        "inputs/site/instrumented_mast_10_days.csv: --periods 240)")
+    arguments = parser.parse_args()
+    year = mast_year(periods=arguments.periods)
+    if arguments.csv:
+        year.to_csv(arguments.csv, index=False)
     stuck = sum(int(year[f"true_stuck_{h:.0f}m"].sum()) for h in VANE_HEIGHTS)
     print(f"{len(year)} records; classes {year['true_class'].value_counts().to_dict()}; calm "
           f"{int(year['true_calm'].sum())}; stuck vane readings {stuck}")

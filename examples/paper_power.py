@@ -238,7 +238,9 @@ def power_ratio_figure(results: dict, disk: np.ndarray, beta: float, output: Pat
             if r == len(rows) - 1:
                 ax.set_xlabel(r"$y_T/D$")
     axes[0, 0].legend(loc="lower left", fontsize=8)
-    fig.suptitle(rf"P/P0 (Eq. P_ratio) of a disk behind a turbine yawed by $\beta$ = {beta:+g} deg")
+    fig.suptitle(rf"Power of a disk downstream of a turbine yawed by $\beta$ = {beta:+g} deg, "
+                 rf"relative to the same disk alone: $P/P_0 = (U_d/U_h)^3$, at $x_T$ behind it "
+                 rf"and $y_T$ across")
     prefix = "paper" if tuple(cases) == WAKE_CASES else \
         "_".join(name.replace("-", "").lower() for name in cases)
     path = output / f"{prefix}_power_ratio_beta{beta_tag(beta)}.png"

@@ -116,10 +116,11 @@ def plot_profiles(site, output: Path) -> Path:
     ax_s.set_xlabel("wind speed [m/s]")
     ax_d.set_xlabel("wind direction [deg]")
     ax_s.set_ylabel("height [m]")
-    ax_s.legend(fontsize=7, title="synthetic mast (dots), fit (lines)", title_fontsize=7,
-                loc="lower right")
     fig.suptitle("Ekman-surface-layer fit to synthetic mast records (52 N, z0 = 0.05 m)")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.12, 1.0, 1.0))
+    # below the panels: on them it would cover the lowest readings
+    fig.legend(*ax_s.get_legend_handles_labels(), loc="lower center", ncol=3, fontsize=8,
+               title="synthetic mast (dots), fit (lines)", title_fontsize=8, frameon=False)
     path = output / "site_fit_profiles.png"
     fig.savefig(path, dpi=120)
     plt.close(fig)

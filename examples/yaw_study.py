@@ -226,26 +226,61 @@ def run_study(reduced: bool = False, energy: bool = True) -> dict:
 
 
 # ----------------------------------------------------------------------------------- figures
+#: How the row figure tells the models apart: colour, a small shift along the spacing axis (so
+#: that equal optima, e.g. two models at the -25 deg bound, stay visible side by side) and a
+#: filled or open marker; the wind speed is the line style and marker shape.
+MODEL_STYLE = {"ekman_veer": dict(color="m", shift=-0.14, mfc="m"),
+               "gch": dict(color="tab:cyan", shift=0.0, mfc="tab:cyan"),
+               "gch_fair_veer": dict(color="tab:gray", shift=0.14, mfc="none")}
+SPEED_STYLE = {8.0: ("-", "o", -0.04), 10.0: ("--", "s", 0.0), 12.0: (":", "^", 0.04)}
+
+
+def _same_sign_segments(x, y):
+    """Consecutive points joined only where the optimum keeps its sign: a line from -23 to +23
+    deg would suggest optima in between that the study never found."""
+    for k in range(len(x) - 1):
+        if np.sign(y[k]) == np.sign(y[k + 1]) or 0.0 in (y[k], y[k + 1]):
+            yield x[k:k + 2], y[k:k + 2]
+
+
 def plot_row(yaw: pd.DataFrame, output: Path, dpi: int = 120) -> Path:
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
     labels = list(dict.fromkeys(yaw["atmosphere"]))
-    fig, axes = plt.subplots(2, len(labels), figsize=(4.2 * len(labels), 6.5), sharex=True,
+    fig, axes = plt.subplots(2, len(labels), figsize=(4.2 * len(labels), 7.2), sharex=True,
                              squeeze=False)
-    colours = {"ekman_veer": "m", "gch": "tab:cyan", "gch_fair_veer": "tab:gray"}
     for j, label in enumerate(labels):
         for (name, speed), df in yaw[yaw["atmosphere"] == label].groupby(["model", "wind_speed"]):
-            style = {8.0: "-o", 10.0: "--s", 12.0: ":^"}.get(speed, "-")
-            axes[0, j].plot(df["spacing_D"], df["gain_percent"], style, color=colours[name],
-                            label=f"{name}, {speed:g} m/s")
-            axes[1, j].plot(df["spacing_D"], df["yaw_T1"], style, color=colours[name])
+            line, marker, shift = SPEED_STYLE.get(speed, ("-", "o", 0.0))
+            model = MODEL_STYLE[name]
+            df = df.sort_values("spacing_D")
+            x = df["spacing_D"].to_numpy() + model["shift"] + shift
+            marks = dict(marker=marker, color=model["color"], mfc=model["mfc"], ms=5)
+            axes[0, j].plot(x, df["gain_percent"], ls=line, **marks)
+            yaw_front = df["yaw_T1"].to_numpy()
+            axes[1, j].plot(x, yaw_front, ls="none", **marks)
+            for xs, ys in _same_sign_segments(x, yaw_front):
+                axes[1, j].plot(xs, ys, ls=line, color=model["color"])
         axes[0, j].set_title(f"{label}: 3-turbine row, 270 deg")
         axes[1, j].set_xlabel("spacing [D]")
         axes[1, j].axhline(0.0, color="k", lw=0.5)
+        for bound in (-YAW_LIMIT, YAW_LIMIT):
+            axes[1, j].axhline(bound, color="k", lw=0.5, ls=":")
     axes[0, 0].set_ylabel("farm power gain [%]")
-    axes[1, 0].set_ylabel("optimal yaw of the front turbine [deg]")
-    axes[0, 0].legend(fontsize=6)
-    fig.tight_layout()
+    axes[1, 0].set_ylabel("optimal yaw of the front turbine [deg]\n(dotted: the search's bounds)")
+    # One legend below the panels, colour = model, style = wind speed: off the data.
+    models = [Line2D([], [], color=m["color"], marker="o", mfc=m["mfc"], label=MODELS[name])
+              for name, m in MODEL_STYLE.items() if name in set(yaw["model"])]
+    speeds = [Line2D([], [], color="k", ls=ls, marker=mk, mfc="none", label=f"{speed:g} m/s")
+              for speed, (ls, mk, _) in SPEED_STYLE.items() if speed in set(yaw["wind_speed"])]
+    fig.tight_layout(rect=(0.0, 0.13, 1.0, 1.0))
+    fig.legend(handles=models, loc="lower center", bbox_to_anchor=(0.5, 0.05), ncol=3,
+               fontsize=8, frameon=False, title_fontsize=8,
+               title="colour: model; markers side by side where optima coincide (as at the "
+                     "-25 deg bound); lines join optima of one sign only")
+    fig.legend(handles=speeds, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=3,
+               fontsize=8, frameon=False)
     path = output / "yaw_study_row.png"
     fig.savefig(path, dpi=dpi)
     plt.close(fig)

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import logging
 import os
 import sys
 import warnings
@@ -44,7 +45,7 @@ __all__ = [
     "ShallowBoundaryLayerWarning", "ThrustLimitWarning", "TurbinePlacementWarning",
     "apply_setting", "silence_warnings", "warnings_setting",
     "WorkerRecords", "carrying", "collecting", "discard_from_workers", "discarding",
-    "in_worker_process", "note_thrust_limit", "range_text", "report_from_workers", "run_scope",
+    "in_worker_process", "LOGGER", "note_thrust_limit", "notice", "range_text", "report_from_workers", "run_scope",
     "speeds_text", "study_scope", "user_frame", "values_seen", "warn", "warn_shallow",
 ]
 
@@ -134,6 +135,19 @@ def warn(message: str, category: type, items=()) -> None:
     )
 
 
+#: FLORIS's logger (its handlers show what the input's ``logging`` block asks for): the
+#: package's notices that ask nothing of the user.
+LOGGER = logging.getLogger("floris.floris_ekman_veer")
+
+
+def notice(message: str, key: str, items=()) -> None:
+    """Log ``message`` at INFO on FLORIS's logger, once per study and ``key`` as :func:`warn`
+    says a warning (again only for ``items`` not noticed yet): for what the user can do nothing
+    about, which a warning would repeat on the canonical path."""
+    if _REPORTED.new(("notice", key), tuple(items) or (message,)):
+        LOGGER.info(message)
+
+
 def values_seen(key: str, values) -> set:
     """Record ``values`` under ``key`` for this study (forgotten, as :func:`warn`'s items, when a
     recording context starts) and return every value recorded under it so far."""
@@ -196,9 +210,10 @@ _RUN: contextvars.ContextVar = contextvars.ContextVar("floris_ekman_veer_run", d
 
 
 @contextlib.contextmanager
-def run_scope(wind_speeds, reference_height):
+def run_scope(wind_speeds, reference_height, stock=False):
     """Collect the per-wake notes of one FLORIS solve (:func:`note_thrust_limit`) and issue one
-    summary warning at its end. Nested scopes report to the outermost."""
+    summary warning at its end (a notice on FLORIS's logger where every turbine is ``stock``:
+    :func:`_warn_thrust_limit`). Nested scopes report to the outermost."""
     if _RUN.get() is not None:
         yield
         return
@@ -212,11 +227,11 @@ def run_scope(wind_speeds, reference_height):
         return
     records = _COLLECTING.get()
     if records is None:
-        _issue_thrust_limit(notes, wind_speeds, reference_height)
+        _issue_thrust_limit(notes, wind_speeds, reference_height, stock)
         return
     for limit, (_count, conditions) in notes.items():
         flagged, total = _flagged(conditions, wind_speeds)
-        records.append(("thrust", limit, flagged, total, reference_height))
+        records.append(("thrust", limit, flagged, total, reference_height, bool(stock)))
 
 
 def note_thrust_limit(heavy, limit: float) -> None:
@@ -249,12 +264,17 @@ def _flagged(conditions, wind_speeds):
     return [float(v) for v in speeds], int(conditions.size)
 
 
-def _issue_thrust_limit(notes, wind_speeds, reference_height) -> None:
+def _issue_thrust_limit(notes, wind_speeds, reference_height, stock=False) -> None:
     for limit, (_count, conditions) in notes.items():
-        _warn_thrust_limit(limit, *_flagged(conditions, wind_speeds), reference_height)
+        _warn_thrust_limit(limit, *_flagged(conditions, wind_speeds), reference_height,
+                           stock=stock)
 
 
-def _warn_thrust_limit(limit, flagged, total, reference_height, runs=1) -> None:
+def _warn_thrust_limit(limit, flagged, total, reference_height, runs=1, stock=False) -> None:
+    """The thrust-limit summary: a ThrustLimitWarning, or, where every turbine is ``stock`` (a
+    FLORIS library turbine with its own thrust table, e.g. the NREL 5 MW's C_T of 0.97-1.13 at
+    3-4 m/s, met in every wind rose from cut-in), a notice on FLORIS's logger: the user can
+    neither change that table nor should raise the limit beyond momentum theory."""
     where = ""
     if flagged is not None:
         where = (f" in {_conditions_text(len(flagged), total, runs)} (wind speeds "
@@ -262,13 +282,15 @@ def _warn_thrust_limit(limit, flagged, total, reference_height, runs=1) -> None:
     # The loading comes from the turbines' own thrust tables (C_T cos^2(yaw) only falls with
     # yaw), so a stock turbine above the limit near cut-in meets it in every wind rose: said once
     # per study and limit, not again for each new set of wind speeds.
-    warn(
+    message = (
         f"turbine wakes{where} have C_T cos^2(yaw) > {limit:g}, beyond momentum "
         f"theory: evaluated at C_T cos^2(yaw) = {limit:g} "
         "(wake.wake_velocity_parameters.ekman_veer.max_thrust_coefficient; "
-        "docs/conventions.md#thrust-coefficient-and-yaw); said once per study",
-        ThrustLimitWarning, (("max_thrust_coefficient", float(limit)),),
-    )
+        "docs/conventions.md#thrust-coefficient-and-yaw); said once per study")
+    if stock:
+        notice(message, "thrust limit", items=(float(limit),))
+        return
+    warn(message, ThrustLimitWarning, (("max_thrust_coefficient", float(limit)),))
 
 
 # -------------------------------------------------------------------- from worker processes
@@ -398,8 +420,8 @@ def report_from_workers(n_conditions: int | None = None) -> None:
             for k, value in enumerate((record[1], record[2], record[3], record[4], record[7], 1)):
                 entry[k] += value
             continue
-        _, limit, flagged, total, reference_height = record
-        entry = thrust.setdefault(limit, [[], 0, reference_height, True])
+        _, limit, flagged, total, reference_height, stock = record
+        entry = thrust.setdefault((limit, stock), [[], 0, reference_height, True])
         if flagged is None:
             entry[3] = False
         else:
@@ -409,9 +431,10 @@ def report_from_workers(n_conditions: int | None = None) -> None:
                                                     runs) in shallow.items():
         warn_shallow(count, total, speeds, heights, top, hub, hub_above, reference_height,
                      policy_path, runs)
-    for limit, (flagged, total, reference_height, counted) in thrust.items():
+    for (limit, stock), (flagged, total, reference_height, counted) in thrust.items():
         if counted:
-            _warn_thrust_limit(limit, flagged, n_conditions or total, reference_height)
+            _warn_thrust_limit(limit, flagged, n_conditions or total, reference_height,
+                               stock=stock)
         else:
-            _warn_thrust_limit(limit, None, None, reference_height)
+            _warn_thrust_limit(limit, None, None, reference_height, stock=stock)
 

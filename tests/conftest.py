@@ -123,3 +123,20 @@ def assert_as_plain_floris(outputs):
         registry.register()
     for a, b in zip(hooked, plain, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def own_turbine(config: dict, name: str = "my_nrel_5MW") -> dict:
+    """``config`` (an input dict, or a YAML path) with its NREL 5 MW turbines replaced by the
+    user's own copy of FLORIS's definition under ``name``: the same thrust table, but the user's,
+    so that the thrust limit is a ThrustLimitWarning (on FLORIS's library turbine it is a notice
+    on FLORIS's logger: floris_ekman_veer.warnings._warn_thrust_limit)."""
+    from floris.core.farm import default_turbine_library_path
+    from floris.utilities import load_yaml
+
+    config = copy.deepcopy(load_yaml(str(config)) if not isinstance(config, dict) else config)
+    turbine = load_yaml(str(default_turbine_library_path / "nrel_5MW.yaml"))
+    turbine["turbine_type"] = name
+    config["farm"]["turbine_type"] = [
+        turbine if t in ("nrel_5MW",) or (isinstance(t, dict) and t.get("turbine_type") == "nrel_5MW")
+        else t for t in config["farm"]["turbine_type"]]
+    return config

@@ -124,3 +124,27 @@ def test_register_in():
     with pytest.raises(ValueError, match="velocity_model 'x'.*refusing to overwrite"):
         registry.register_in(table, "x", Gaussian2014VelocityDeficit, "velocity_model")
     assert table == {"x": EkmanVeerVelocityDeficit}
+
+
+def test_floris_without_the_import_names_no_model_and_the_inputs_say_why(tmp_path):
+    """FLORIS 4.7 has no plugin entry points: in a fresh interpreter that does not import the
+    package, a shipped input stops at FLORIS's bare KeyError (nothing of the package can run
+    to improve it); so every shipped input says in its first lines to import the package first
+    (docs/user_guide.md#your-floris-input-with-veer)."""
+    import subprocess
+    import sys
+
+    import floris
+
+    # FLORIS reads no installed plugins: none of its modules looks up entry points
+    sources = Path(floris.__file__).parent.rglob("*.py")
+    assert not [p for p in sources if "entry_points" in p.read_text(errors="ignore")]
+    script = ("from floris import FlorisModel\n"
+              f"FlorisModel({str(floris_ekman_veer.example_input('farm_night'))!r})\n")
+    run = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode != 0 and "KeyError: 'ekman_veer'" in run.stderr
+    directory = floris_ekman_veer.example_input("farm_night").parent
+    for path in sorted(directory.rglob("*.yaml")):
+        head = " ".join(path.read_text().splitlines()[:3])
+        assert "import floris_ekman_veer" in head and "no plugin entry points" in head, path

@@ -23,7 +23,7 @@ import floris_ekman_veer
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer import EkmanABL
 from floris_ekman_veer.plugin.inflow import shallow
-from tests.conftest import STABLE_ATMOSPHERE
+from tests.conftest import STABLE_ATMOSPHERE, own_turbine
 
 REPO = Path(__file__).resolve().parents[1]
 FARM = floris_ekman_veer.example_input("farm_sbl6")
@@ -39,10 +39,8 @@ def caught():
 
 
 def of(records, category):
-    """The records of ``category``, without the notice that FLORIS's placeholder TI are not the
-    atmosphere's (tests/plugin/wake_models/test_floris_input_messages.py tests it)."""
-    return [r for r in records if issubclass(r.category, category)
-            and not str(r.message).startswith("flow_field.turbulence_intensities")]
+    """The records of ``category``."""
+    return [r for r in records if issubclass(r.category, category)]
 
 
 def line_of(text: str) -> int:
@@ -185,26 +183,40 @@ def test_optimize_yaw_counts_the_shallow_conditions_once_at_its_start():
     assert str(record.message).startswith("2 of 3 conditions (wind speeds 8 and 9 m/s at 90 m")
 
 
-def test_thrust_limit_warning_once_per_run_naming_the_speeds():
-    fmodel = FlorisModel(FARM)
-    fmodel.set(wind_speeds=[3.0, 3.5, 9.0, 4.0], wind_directions=[270.0] * 4,
-               turbulence_intensities=[0.06] * 4)
+def test_thrust_limit_warning_once_per_run_naming_the_speeds(caplog):
+    """The user's turbine whose thrust table exceeds the limit (a copy of the NREL 5 MW's) gets
+    one ThrustLimitWarning per run naming the speeds; FLORIS's own NREL 5 MW, whose table the
+    user cannot change, one INFO notice on FLORIS's logger and no warning."""
+    conditions = dict(wind_speeds=[3.0, 3.5, 9.0, 4.0], wind_directions=[270.0] * 4,
+                      turbulence_intensities=[0.06] * 4)
+    fmodel = FlorisModel(own_turbine(FARM))
+    fmodel.set(**conditions)
     with caught() as records:
         fmodel.run()  # RUN-LINE
         fmodel.run()
     (record,) = of(records, floris_ekman_veer.ThrustLimitWarning)
     assert (record.filename, record.lineno) == (__file__, line_of("# RUN" "-LINE"))
     # NREL 5 MW's C_T cos^2 = 0.96 is exceeded below about 4 m/s only (its thrust table)
-    assert str(record.message).startswith(
-        "turbine wakes in 3 of 4 conditions (wind speeds 3, 3.5 and 4 m/s at 90 m) have "
-        "C_T cos^2(yaw) > 0.96")
+    summary = ("turbine wakes in 3 of 4 conditions (wind speeds 3, 3.5 and 4 m/s at 90 m) have "
+               "C_T cos^2(yaw) > 0.96")
+    assert str(record.message).startswith(summary)
+    stock = FlorisModel(FARM)
+    stock.set(**conditions)
+    with caught() as records, caplog.at_level("INFO", logger="floris.floris_ekman_veer"):
+        stock.run()
+        stock.run()
+    assert not of(records, floris_ekman_veer.ThrustLimitWarning)
+    notices = [r.getMessage() for r in caplog.records if r.name == "floris.floris_ekman_veer"
+               and r.getMessage().startswith("turbine wakes")]
+    assert len(notices) == 1 and notices[0].startswith(summary)
+    np.testing.assert_array_equal(stock.get_turbine_powers(), fmodel.get_turbine_powers())
 
 
 def test_thrust_limit_warning_once_per_study_over_wind_roses():
     """The stock NREL 5 MW's own table exceeds C_T = 0.96 below about 4 m/s, so every wind rose
-    meets the limit: one warning for the study, not one per wind rose (before: one per new set
-    of speeds)."""
-    fmodel = FlorisModel(FARM)
+    meets the limit: one warning for the study (with the user's copy of it), not one per wind
+    rose (before: one per new set of speeds)."""
+    fmodel = FlorisModel(own_turbine(FARM))
     with caught() as records:
         for speeds in ([3.0, 8.0], [3.5, 10.0], [4.0, 3.2, 12.0]):
             fmodel.set(wind_speeds=speeds, wind_directions=[270.0] * len(speeds),
@@ -322,7 +334,9 @@ def test_sub_cut_in_speeds_no_abl_reaches_give_zero_power(wake):
     """SBL-6 stability has no boundary layer (h >= 10 m) with 0.5-2 m/s at 90 m; the NREL 5 MW
     makes no power below 2.9 m/s: those conditions are at rest, the others are unchanged."""
     config = load_yaml(str(FARM))
-    config["wake"]["model_strings"].update(velocity_model=wake, deflection_model=wake)
+    config["wake"]["model_strings"].update(velocity_model=wake, deflection_model=wake,
+                                           combination_model="fls" if wake == "ekman_veer"
+                                           else "sosfs")
     speeds = [0.0, 0.5, 1.0, 2.0, 9.0]
     with pytest.raises(ValueError, match="no ABL|the model accepts"):
         EkmanABL.from_reference_wind(0.5, 90.0, **SBL6)
@@ -493,7 +507,8 @@ def setting():
 
 def main():
     from distributed import Client, LocalCluster
-    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_sbl6"))
+    from tests.conftest import own_turbine
+    fmodel = FlorisModel(own_turbine(floris_ekman_veer.example_input("farm_sbl6")))
     fmodel.set(wind_directions=[270.0] * 2, wind_speeds=[3.5, 9.0], turbulence_intensities=[0.06] * 2)
     with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0") as cluster, \\
             Client(cluster) as client:

@@ -89,155 +89,15 @@ class DragLawState(NamedTuple):
     along_stress: np.ndarray
 
 
-class EkmanABL(WindProfile):
-    """Coupled Ekman-surface-layer atmospheric boundary layer, solved for given G.
+class EkmanSolver:
+    """The solve of :class:`EkmanABL`: the geostrophic drag law in u* for each condition, and
+    the solver's interface the reference-wind solve and the profile fit use
+    (docs/atmosphere.md#the-solvers-interface): `condition_parameters`, `state_at`,
+    `surface_layer_exists`, `set_state`, `require_depth`, `require_domain`. A base of EkmanABL
+    (its inputs and constants are EkmanABL's), kept apart so that ``help(EkmanABL)`` shows the
+    methods a user calls (``from_reference_wind``, ``fit_profile``, ``velocity``, ``speed``,
+    ...) before these internals."""
 
-    Keyword inputs (all broadcast together; conditions may be arrays):
-
-    - ``geostrophic_wind`` G [m/s], > 0.
-    - Coriolis: ``coriolis_parameter`` f_c [1/s] (signed: negative in the southern
-      hemisphere) or ``latitude`` [deg, negative = south]; |latitude| >= 1 degree, i.e.
-      |f_c| >= 2 Omega sin(1 deg): the model has no solution at the equator.
-    - ``roughness_length`` z0 [m], > 0.
-    - Stability, at most one of, of either sign (negative mu or L, positive heat flux or
-      heating rate: a convective layer, docs/atmosphere.md#convective-boundary-layer):
-      ``stability_parameter`` mu = u*/(kappa f_c L); ``cooling_rate`` C_r [K/h] with
-      Q0 = C_r h when cooling (paper Section 2.5), Q0 = C_r z_i/(1 + A_e) when heating;
-      ``surface_heat_flux`` Q0 [K m/s]; ``sensible_heat_flux`` H [W/m^2] = rho c_p Q0;
-      ``obukhov_length`` L [m] (+-inf = neutral). Default: neutral (mu = 0).
-    - ``mixed_layer_height`` z_i [m], the depth of a convective layer (used where mu < 0;
-      default the neutral height of Eq. h_hat_model at the same u*).
-    - Free atmosphere, at most one of ``brunt_vaisala_frequency`` N [1/s] >= 0 or
-      ``lapse_rate`` dTheta/dz [K/m] >= 0 (N = sqrt(g/Theta0 gamma)); default the paper's
-      N_inf = 6.1e-3 1/s. Enters through the Zilitinkevich number mu_N = N/|f_c|.
-    - ``reference_potential_temperature`` Theta0 [K], default the paper's 265 K.
-    - Model constants: ``von_karman`` 0.41, ``c_g`` 1.43, ``stress_decay`` (Gamma) 0.83,
-      ``c_tn`` 0.5, ``c_cn`` 1.6, ``c_ns`` 0.78, ``matching_fraction`` 0.2, and, beyond the
-      paper, ``businger_dyer_gamma`` 16 (Dyer 1974; 19.3 for Hogstrom 1988).
-
-    Solved attributes: ``friction_velocity`` [m/s], ``boundary_layer_height`` [m],
-    ``cross_isobaric_angle`` [deg, signed, surface-stress frame], ``stability_parameter``
-    (mu, also when derived from C_r, Q0 or L), ``zilitinkevich_number`` mu_N,
-    ``geostrophic_components`` (U_g, V_g), ``coriolis_parameter`` (signed), and the
-    dimensionless ``h_hat`` = h f_c/u* with the GDL coefficients ``gdl_a``, ``gdl_b`` (A, B);
-    ``coriolis_magnitude`` |f_c| and ``hemisphere`` (+1 north, -1 south), the given stability
-    input's name ``stability_input`` and value ``stability_value``.
-
-    The solver's interface (docs/atmosphere.md#the-solvers-interface), which the reference-wind
-    solve and the profile fit use: `condition_parameters`, `state_at`, `surface_layer_exists`,
-    `set_state`, `solved_at`, `require_depth`, `require_domain`.
-    """
-
-    #: The entrainment ratio A_e of the heating-rate closure (`ENTRAINMENT_RATIO`).
-    entrainment_ratio = ENTRAINMENT_RATIO
-
-
-    def __init__(
-        self,
-        *,
-        geostrophic_wind,
-        coriolis_parameter=None,
-        latitude=None,
-        roughness_length,
-        stability_parameter=None,
-        cooling_rate=None,
-        surface_heat_flux=None,
-        obukhov_length=None,
-        sensible_heat_flux=None,
-        mixed_layer_height=None,
-        brunt_vaisala_frequency=None,
-        lapse_rate=None,
-        reference_potential_temperature=PAPER_POTENTIAL_TEMPERATURE,
-        von_karman=0.41,
-        c_g=1.43,
-        stress_decay=0.83,
-        c_tn=0.5,
-        c_cn=1.6,
-        c_ns=0.78,
-        matching_fraction=0.2,
-        businger_dyer_gamma=BUSINGER_DYER_GAMMA,
-    ):
-        constants = checked_model_constants(
-            von_karman=von_karman, c_g=c_g, stress_decay=stress_decay, c_tn=c_tn, c_cn=c_cn,
-            c_ns=c_ns, matching_fraction=matching_fraction)
-        self.von_karman, self.c_g, self.stress_decay = (
-            constants["von_karman"], constants["c_g"], constants["stress_decay"])
-        self.c_tn, self.c_cn, self.c_ns = constants["c_tn"], constants["c_cn"], constants["c_ns"]
-        self.matching_fraction = constants["matching_fraction"]
-        self.businger_dyer_gamma = float(checked(
-            "businger_dyer_gamma", businger_dyer_gamma, lambda v: (v > 0) & (np.ndim(v) == 0)
-        ))
-        self.coriolis_parameter = checked_coriolis_parameter(coriolis_parameter, latitude)
-        self.coriolis_magnitude = np.abs(self.coriolis_parameter)
-        self.hemisphere = np.sign(self.coriolis_parameter)
-        self.roughness_length = checked("roughness_length", roughness_length, lambda z0: z0 > 0)
-        self.reference_potential_temperature = checked(
-            "reference_potential_temperature", reference_potential_temperature,
-            lambda t: (t >= POTENTIAL_TEMPERATURE_RANGE[0]) & (t <= POTENTIAL_TEMPERATURE_RANGE[1]),
-        )
-        self.brunt_vaisala_frequency = free_atmosphere_frequency(
-            brunt_vaisala_frequency, lapse_rate, self.reference_potential_temperature)
-        self.zilitinkevich_number = self.brunt_vaisala_frequency / self.coriolis_magnitude
-        self.stability_input, self.stability_value = checked_stability_input(
-            dict(stability_parameter=stability_parameter, cooling_rate=cooling_rate,
-                 surface_heat_flux=surface_heat_flux, obukhov_length=obukhov_length,
-                 sensible_heat_flux=sensible_heat_flux),
-            self.reference_potential_temperature)
-        self.mixed_layer_height = None if mixed_layer_height is None else checked(
-            "mixed_layer_height", mixed_layer_height,
-            lambda z: (z >= MIN_BOUNDARY_LAYER_HEIGHT) & (z <= MAX_MIXED_LAYER_HEIGHT),
-        )
-        given = {
-            "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
-            "roughness_length": self.roughness_length,
-            "reference_potential_temperature": self.reference_potential_temperature,
-            "lapse_rate" if lapse_rate is not None else "brunt_vaisala_frequency":
-                self.brunt_vaisala_frequency,
-            self.stability_input: self.stability_value,
-        }
-        if self.mixed_layer_height is not None:
-            given["mixed_layer_height"] = self.mixed_layer_height
-        if geostrophic_wind is _INPUTS_ONLY:
-            require_broadcastable(given)
-            return
-        self.geostrophic_wind = checked("geostrophic_wind", geostrophic_wind, lambda g: g > 0)
-        require_broadcastable({"geostrophic_wind": self.geostrophic_wind, **given})
-        self._solve()
-
-    @classmethod
-    def check_inputs(cls, **inputs):
-        """Validate EkmanABL keyword inputs without the geostrophic wind (types, ranges and
-        exclusive choices, as the constructor does) and return the unsolved instance; raises
-        ValueError naming the input, its valid range (`VALID_RANGES`) and, for arrays, the
-        index of the offending entries."""
-        if "geostrophic_wind" in inputs:
-            raise ValueError("check_inputs takes the inputs without geostrophic_wind")
-        return cls(geostrophic_wind=_INPUTS_ONLY, **inputs)
-
-    @classmethod
-    def solved_at(cls, log_u_star, geostrophic_wind, **inputs):
-        """The ABL of ``inputs`` and ``geostrophic_wind`` whose solve's root ln u* is already
-        known: the state of Eq. (GDL) is explicit in u* for a given stability (the reference-wind
-        solve's parametrisation, docs/atmosphere.md#reference-wind-solve), so a caller that
-        found G from u* (the profile fit, docs/measurements.md#fit-time) sets the solution
-        without solving for u* again. The caller vouches that the state is a model state (a
-        physical GDL branch, a surface layer above z0, h at least the shallowest accepted)."""
-        abl = cls.check_inputs(**inputs)
-        abl.geostrophic_wind = np.asarray(geostrophic_wind, dtype=float)
-        params, shape = abl.condition_parameters(abl.geostrophic_wind, np.shape(log_u_star))
-        abl.set_state(np.broadcast_to(np.asarray(log_u_star, dtype=float), shape), params)
-        return abl
-
-    @staticmethod
-    def valid_range(name):
-        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`);
-        ValueError naming the inputs for a name that is none of them."""
-        if not isinstance(name, str) or name not in VALID_RANGES:
-            raise ValueError(f"valid_range: name must be one of EkmanABL's inputs "
-                             f"{sorted(VALID_RANGES)}; got {name!r}")
-        return VALID_RANGES[name]
-
-    # ----------------------------------------------------------------------------- solver
     def _neutral_h_hat(self, p):
         """h_hat of Eq. (h_hat_model) at mu = 0."""
         return boundary_layer_height_hat(0.0, p["mu_n"], self.c_tn, self.c_cn, self.c_ns)
@@ -368,13 +228,6 @@ class EkmanABL(WindProfile):
             mask, reason, lead="the inputs leave the physical domain",
         ))
 
-    def physical_domain(self) -> DomainCheck:
-        """Where the solved states lie in the `PHYSICAL_DOMAIN` (`physical_domain`): the implied
-        sensible heat flux, geostrophic wind and, where convective, cross-isobaric angle, per
-        condition, without raising (docs/atmosphere.md#physical-domain)."""
-        return physical_domain(self.sensible_heat_flux, self.geostrophic_wind,
-                               self.cross_isobaric_angle, self.stability_parameter)
-
     def require_domain(self, error):
         """Raise ``error(mask of the offending conditions, reason)`` at the first condition
         outside the physical domain, the reason naming the implied quantity, its value and range."""
@@ -427,6 +280,178 @@ class EkmanABL(WindProfile):
         self.convective_variance = convective_variance(
             self.boundary_layer_height, self.obukhov_length
         )[()]
+
+
+class EkmanABL(WindProfile, EkmanSolver):
+    """Coupled Ekman-surface-layer atmospheric boundary layer, solved for given G.
+
+    Keyword inputs (all broadcast together; conditions may be arrays):
+
+    - ``geostrophic_wind`` G [m/s], > 0.
+    - Coriolis: ``coriolis_parameter`` f_c [1/s] (signed: negative in the southern
+      hemisphere) or ``latitude`` [deg, negative = south]; |latitude| >= 1 degree, i.e.
+      |f_c| >= 2 Omega sin(1 deg): the model has no solution at the equator.
+    - ``roughness_length`` z0 [m], > 0.
+    - Stability, at most one of, of either sign (negative mu or L, positive heat flux or
+      heating rate: a convective layer, docs/atmosphere.md#convective-boundary-layer):
+      ``stability_parameter`` mu = u*/(kappa f_c L); ``cooling_rate`` C_r [K/h] with
+      Q0 = C_r h when cooling (paper Section 2.5), Q0 = C_r z_i/(1 + A_e) when heating;
+      ``surface_heat_flux`` Q0 [K m/s]; ``sensible_heat_flux`` H [W/m^2] = rho c_p Q0;
+      ``obukhov_length`` L [m] (+-inf = neutral). Default: neutral (mu = 0).
+    - ``mixed_layer_height`` z_i [m], the depth of a convective layer (used where mu < 0;
+      default the neutral height of Eq. h_hat_model at the same u*).
+    - Free atmosphere, at most one of ``brunt_vaisala_frequency`` N [1/s] >= 0 or
+      ``lapse_rate`` dTheta/dz [K/m] >= 0 (N = sqrt(g/Theta0 gamma)); default the paper's
+      N_inf = 6.1e-3 1/s. Enters through the Zilitinkevich number mu_N = N/|f_c|.
+    - ``reference_potential_temperature`` Theta0 [K], default the paper's 265 K.
+    - Model constants: ``von_karman`` 0.41, ``c_g`` 1.43, ``stress_decay`` (Gamma) 0.83,
+      ``c_tn`` 0.5, ``c_cn`` 1.6, ``c_ns`` 0.78, ``matching_fraction`` 0.2, and, beyond the
+      paper, ``businger_dyer_gamma`` 16 (Dyer 1974; 19.3 for Hogstrom 1988).
+
+    Solved attributes: ``friction_velocity`` [m/s], ``boundary_layer_height`` [m],
+    ``cross_isobaric_angle`` [deg, signed, surface-stress frame], ``stability_parameter``
+    (mu, also when derived from C_r, Q0 or L), ``zilitinkevich_number`` mu_N,
+    ``geostrophic_components`` (U_g, V_g), ``coriolis_parameter`` (signed), and the
+    dimensionless ``h_hat`` = h f_c/u* with the GDL coefficients ``gdl_a``, ``gdl_b`` (A, B);
+    ``coriolis_magnitude`` |f_c| and ``hemisphere`` (+1 north, -1 south), the given stability
+    input's name ``stability_input`` and value ``stability_value``.
+
+    The solver's interface (docs/atmosphere.md#the-solvers-interface), which the reference-wind
+    solve and the profile fit use: `solved_at` and, from the base :class:`EkmanSolver`,
+    `condition_parameters`, `state_at`, `surface_layer_exists`, `set_state`, `require_depth`,
+    `require_domain`.
+
+    Example (a stable night, L = 100 m, with 8 m/s at a 90 m hub; ``from_reference_wind``
+    solves the G that gives it):
+
+        >>> from floris_ekman_veer import EkmanABL
+        >>> abl = EkmanABL.from_reference_wind(8.0, 90.0, latitude=52.0, roughness_length=0.1,
+        ...                                    obukhov_length=100.0)
+        >>> round(float(abl.boundary_layer_height), 1)          # h [m]
+        220.5
+        >>> abl.speed([30.0, 90.0, 150.0]).round(2)             # |U(z)| [m/s]
+        array([4.98, 8.  , 9.49])
+        >>> round(float(abl.wind_direction_change(27.0, 153.0)), 1)  # veer across a rotor [deg]
+        20.4
+        >>> round(float(abl.turbulence_intensity(90.0)), 4)     # I_u at the hub
+        0.0459
+    """
+
+    #: The entrainment ratio A_e of the heating-rate closure (`ENTRAINMENT_RATIO`).
+    entrainment_ratio = ENTRAINMENT_RATIO
+
+
+    def __init__(
+        self,
+        *,
+        geostrophic_wind,
+        coriolis_parameter=None,
+        latitude=None,
+        roughness_length,
+        stability_parameter=None,
+        cooling_rate=None,
+        surface_heat_flux=None,
+        obukhov_length=None,
+        sensible_heat_flux=None,
+        mixed_layer_height=None,
+        brunt_vaisala_frequency=None,
+        lapse_rate=None,
+        reference_potential_temperature=PAPER_POTENTIAL_TEMPERATURE,
+        von_karman=0.41,
+        c_g=1.43,
+        stress_decay=0.83,
+        c_tn=0.5,
+        c_cn=1.6,
+        c_ns=0.78,
+        matching_fraction=0.2,
+        businger_dyer_gamma=BUSINGER_DYER_GAMMA,
+    ):
+        constants = checked_model_constants(
+            von_karman=von_karman, c_g=c_g, stress_decay=stress_decay, c_tn=c_tn, c_cn=c_cn,
+            c_ns=c_ns, matching_fraction=matching_fraction)
+        self.von_karman, self.c_g, self.stress_decay = (
+            constants["von_karman"], constants["c_g"], constants["stress_decay"])
+        self.c_tn, self.c_cn, self.c_ns = constants["c_tn"], constants["c_cn"], constants["c_ns"]
+        self.matching_fraction = constants["matching_fraction"]
+        self.businger_dyer_gamma = float(checked(
+            "businger_dyer_gamma", businger_dyer_gamma, lambda v: (v > 0) & (np.ndim(v) == 0)
+        ))
+        self.coriolis_parameter = checked_coriolis_parameter(coriolis_parameter, latitude)
+        self.coriolis_magnitude = np.abs(self.coriolis_parameter)
+        self.hemisphere = np.sign(self.coriolis_parameter)
+        self.roughness_length = checked("roughness_length", roughness_length, lambda z0: z0 > 0)
+        self.reference_potential_temperature = checked(
+            "reference_potential_temperature", reference_potential_temperature,
+            lambda t: (t >= POTENTIAL_TEMPERATURE_RANGE[0]) & (t <= POTENTIAL_TEMPERATURE_RANGE[1]),
+        )
+        self.brunt_vaisala_frequency = free_atmosphere_frequency(
+            brunt_vaisala_frequency, lapse_rate, self.reference_potential_temperature)
+        self.zilitinkevich_number = self.brunt_vaisala_frequency / self.coriolis_magnitude
+        self.stability_input, self.stability_value = checked_stability_input(
+            dict(stability_parameter=stability_parameter, cooling_rate=cooling_rate,
+                 surface_heat_flux=surface_heat_flux, obukhov_length=obukhov_length,
+                 sensible_heat_flux=sensible_heat_flux),
+            self.reference_potential_temperature)
+        self.mixed_layer_height = None if mixed_layer_height is None else checked(
+            "mixed_layer_height", mixed_layer_height,
+            lambda z: (z >= MIN_BOUNDARY_LAYER_HEIGHT) & (z <= MAX_MIXED_LAYER_HEIGHT),
+        )
+        given = {
+            "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
+            "roughness_length": self.roughness_length,
+            "reference_potential_temperature": self.reference_potential_temperature,
+            "lapse_rate" if lapse_rate is not None else "brunt_vaisala_frequency":
+                self.brunt_vaisala_frequency,
+            self.stability_input: self.stability_value,
+        }
+        if self.mixed_layer_height is not None:
+            given["mixed_layer_height"] = self.mixed_layer_height
+        if geostrophic_wind is _INPUTS_ONLY:
+            require_broadcastable(given)
+            return
+        self.geostrophic_wind = checked("geostrophic_wind", geostrophic_wind, lambda g: g > 0)
+        require_broadcastable({"geostrophic_wind": self.geostrophic_wind, **given})
+        self._solve()
+
+    @classmethod
+    def check_inputs(cls, **inputs):
+        """Validate EkmanABL keyword inputs without the geostrophic wind (types, ranges and
+        exclusive choices, as the constructor does) and return the unsolved instance; raises
+        ValueError naming the input, its valid range (`VALID_RANGES`) and, for arrays, the
+        index of the offending entries."""
+        if "geostrophic_wind" in inputs:
+            raise ValueError("check_inputs takes the inputs without geostrophic_wind")
+        return cls(geostrophic_wind=_INPUTS_ONLY, **inputs)
+
+    @classmethod
+    def solved_at(cls, log_u_star, geostrophic_wind, **inputs):
+        """The ABL of ``inputs`` and ``geostrophic_wind`` whose solve's root ln u* is already
+        known: the state of Eq. (GDL) is explicit in u* for a given stability (the reference-wind
+        solve's parametrisation, docs/atmosphere.md#reference-wind-solve), so a caller that
+        found G from u* (the profile fit, docs/measurements.md#fit-time) sets the solution
+        without solving for u* again. The caller vouches that the state is a model state (a
+        physical GDL branch, a surface layer above z0, h at least the shallowest accepted)."""
+        abl = cls.check_inputs(**inputs)
+        abl.geostrophic_wind = np.asarray(geostrophic_wind, dtype=float)
+        params, shape = abl.condition_parameters(abl.geostrophic_wind, np.shape(log_u_star))
+        abl.set_state(np.broadcast_to(np.asarray(log_u_star, dtype=float), shape), params)
+        return abl
+
+    @staticmethod
+    def valid_range(name):
+        """The valid range of input ``name`` as the error messages state it (`VALID_RANGES`);
+        ValueError naming the inputs for a name that is none of them."""
+        if not isinstance(name, str) or name not in VALID_RANGES:
+            raise ValueError(f"valid_range: name must be one of EkmanABL's inputs "
+                             f"{sorted(VALID_RANGES)}; got {name!r}")
+        return VALID_RANGES[name]
+
+    def physical_domain(self) -> DomainCheck:
+        """Where the solved states lie in the `PHYSICAL_DOMAIN` (`physical_domain`): the implied
+        sensible heat flux, geostrophic wind and, where convective, cross-isobaric angle, per
+        condition, without raising (docs/atmosphere.md#physical-domain)."""
+        return physical_domain(self.sensible_heat_flux, self.geostrophic_wind,
+                               self.cross_isobaric_angle, self.stability_parameter)
 
     # ----------------------------------------------------------------------------- drivers
     @classmethod

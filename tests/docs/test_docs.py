@@ -335,6 +335,14 @@ def test_readme_quick_start_fits_a_screen_and_links_the_gallery():
         assert "--gallery" in (REPO / script).read_text(), script
 
 
+def test_user_guide_lists_every_example():
+    """docs/user_guide.md#examples names every script of examples/, with what it does."""
+    text = (REPO / "docs" / "user_guide.md").read_text()
+    section = text.split("\n## Examples\n", 1)[1].split("\n## ", 1)[0]
+    listed = set(re.findall(r"^- `examples/(\w+)\.py`", section, flags=re.M))
+    assert listed == {p.stem for p in (REPO / "examples").glob("*.py")}
+
+
 # ------------------------------------------------------------ numbers the pages take from scripts
 #: Numbers of the README and docs/ that a named script prints: (page, the page's text holding
 #: the number, the script and its arguments, a regular expression of the script's output whose
@@ -403,12 +411,57 @@ SCRIPT_NUMBERS += [
      r"At L = -1e5 m against the CNBL.*?u\* \+([\d.]+) %, h \+[\d.]+ %, U \+([\d.]+) %, "
      r"V \+([\d.]+) %, k_w \+([\d.]+) %"),
 ]
+#: The README's own results (docs/performance.md's timings: test_readme_timings_say_how_measured).
+SCRIPT_NUMBERS += [
+    ("README.md", r"\| 8 m/s \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \| \| 9 m/s \| ([\d.]+) \| ([\d.]+) \| "
+                  r"([\d.]+) \| \| 11 m/s \| ([\d.]+) \| ([\d.]+) \| ([\d.]+) \|",
+     ("examples/farm_main.py",),
+     r"U\(90 m\) = 8 m/s.*?farm \[MW\]\s+([\d.]+)\s+([\d.]+)\s+([\d.]+).*?U\(90 m\) = 9 m/s.*?"
+     r"farm \[MW\]\s+([\d.]+)\s+([\d.]+)\s+([\d.]+).*?U\(90 m\) = 11 m/s.*?farm \[MW\]\s+"
+     r"([\d.]+)\s+([\d.]+)\s+([\d.]+)"),
+    ("README.md", r"M-1 misses the power ratios P_i/P_1 of rows 2-10 by ([\d.]+) RMSE, FLORIS's GCH "
+                  r"by ([\d.]+) and the published EllipSys3D RANS by ([\d.]+), while FLORIS's "
+                  r"`empirical_gauss` comes closer \(([\d.]+)\)",
+     ("examples/validate.py",),
+     # the matched atmosphere, direction-averaged: the third cell of each model's row
+     r"## Hornsrev1, P_i/P_1 over the waked positions[^\n]*\n"
+     + "".join(rf"(?=.*?\n\| {model} \|(?:[^|]+\|){{2}} ([\d.]+))"
+               for model in ("M-1", "GCH", r"EllipSys3D RANS \(published\)", "empirical_gauss"))),
+    ("README.md", r"M-1 misses by ([\d.]+), GCH by ([\d.]+), the RANS by ([\d.]+), and FLORIS's cc "
+                  r"and TurbOPark come closer \(([\d.]+), ([\d.]+)\)",
+     ("examples/validate.py",),
+     r"## Lillgrund, P_i/P_1 over the waked positions[^\n]*\n"
+     + "".join(rf"(?=.*?\n\| {model} \|(?:[^|]+\|){{2}} ([\d.]+))"
+               for model in ("M-1", "GCH", r"EllipSys3D RANS \(published\)", "cc", "TurbOPark"))),
+]
 #: docs/atmosphere.md's drag-law table, row by row: L's label, then the nine numbers.
 SCRIPT_NUMBERS += [
     ("docs/atmosphere.md", rf"\| {label} \|" + r" (-?[\d.]+) \|" * 9, ("examples/day_and_night.py",),
      rf"Drag-law coefficients.*?\n\s+{label}" + r"\s+(-?[\d.]+)" * 9)
     for label in ("-1e5", "-1e4", "-1000", "-300", "-100", "-30")
 ]
+
+
+#: The README's measured times and speed ratios (they move with the machine, so no test can
+#: re-measure them): each names the command that measured it, the load it ran at and the
+#: threads (docs/performance.md has the tables; the README's test-command sentence is the
+#: lead's and is checked by .ci/run).
+README_TIMINGS = [
+    (r"a steered year of 8,760 records on a 3 x 3 farm takes ([\d.]+) minutes",
+     "python -m benchmarks.bench_year"),
+    (r"M-1 runs at ([\d.]+) x FLORIS gauss's wall time", "python -m benchmarks.bench_peers"),
+]
+
+
+@pytest.mark.parametrize("claim, command", README_TIMINGS)
+def test_readme_timings_say_how_measured(claim, command):
+    text = re.sub(r"\s+", " ", (REPO / "README.md").read_text())
+    match = re.search(claim, text)
+    assert match, f"README.md no longer holds {claim!r}: update README_TIMINGS"
+    paragraph = text[match.start():match.start() + 700]
+    assert command in paragraph
+    assert re.search(r"load average [\d.]+(-[\d.]+)? on the 2 cores", paragraph)
+    assert "thread" in paragraph
 
 
 def page_numbers(page: str, pattern: str) -> list[str]:

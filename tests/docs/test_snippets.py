@@ -44,3 +44,19 @@ def test_snippet_runs_as_written(code, tmp_path):
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, f"the snippet failed:\n{code}\n--- stderr:\n{run.stderr[-3000:]}"
+    # and silently: no warning of the package nor FLORIS's (docs/user_guide.md#warnings)
+    assert not re.search(r"\w+Warning: ", run.stderr), f"the snippet warned:\n{run.stderr[-3000:]}"
+
+
+@pytest.mark.parametrize("example", ["quick_start.py", "day_and_night.py"])
+def test_canonical_examples_run_silently(example, tmp_path):
+    """The first examples a user runs say nothing on stderr: no warning the user cannot act on
+    (FLORIS's TI and a library turbine's thrust table are logged, not warned:
+    docs/user_guide.md#warnings). (yaw_study.py, a long study, is run by
+    tests/docs/test_yaw_study_example.py.)"""
+    env = {**os.environ, "MPLBACKEND": "Agg",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))}
+    run = subprocess.run([sys.executable, str(REPO / "examples" / example)], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stderr == ""

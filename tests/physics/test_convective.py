@@ -426,7 +426,8 @@ def test_gauss_and_ekman_veer_run_on_the_shipped_convective_day():
     fmodel.set(wind_speeds=[6.0, 9.0], wind_directions=[270.0, 270.0],
                turbulence_intensities=[0.06, 0.06])
     config = fmodel.core.as_dict()
-    config["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss")
+    config["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss",
+                                           combination_model="sosfs")  # FLORIS's own
     gauss = FlorisModel(config)
     for model in (fmodel, gauss):
         with warnings.catch_warnings():

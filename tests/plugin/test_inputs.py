@@ -70,7 +70,9 @@ def test_paper_case_inputs(case, cooling_rate):
 
 def test_farm_input_runs_each_model_by_name():
     """The farm input carries the blocks that make ekman_veer, bastankhah2014 (M-3), gauss, cc,
-    jensen and turbopark selectable by changing model names only, all on the Ekman inflow."""
+    jensen and turbopark selectable by changing model names (and, for gauss and cc, the
+    combination to FLORIS's own sosfs: docs/user_guide.md#floriss-own-models-on-the-same-inflow),
+    all on the Ekman inflow."""
     config = load_yaml(INPUTS / "farm_sbl6.yaml")
     assert config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"][
         "stability_parameter"] == 148.49  # the paper's SBL-6 (Table 1)
@@ -79,7 +81,9 @@ def test_farm_input_runs_each_model_by_name():
         ("ekman_veer", "ekman_veer"), ("bastankhah2014", "ekman_veer"), ("gauss", "gauss"),
         ("cc", "gauss"), ("jensen", "gauss"), ("turbopark", "gauss"),
     ):
-        config["wake"]["model_strings"].update(velocity_model=velocity, deflection_model=deflection)
+        config["wake"]["model_strings"].update(
+            velocity_model=velocity, deflection_model=deflection,
+            combination_model="sosfs" if velocity in ("gauss", "cc") else "fls")
         # M-3 proper: no veer (at zero yaw, bastankhah2014 with the veer offset is M-1 exactly)
         m3 = velocity == "bastankhah2014"
         config["wake"]["wake_deflection_parameters"]["ekman_veer"].update(

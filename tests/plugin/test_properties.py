@@ -68,10 +68,6 @@ pytestmark = [
     pytest.mark.filterwarnings(
         "ignore::floris_ekman_veer.plugin.inflow.shallow.ShallowBoundaryLayerWarning"
     ),
-    # drawn turbulence intensities, which the ekman_veer model does not read (that notice is
-    # tested in tests/plugin/wake_models/test_floris_input_messages.py)
-    pytest.mark.filterwarnings(
-        "ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning"),
 ]
 
 
@@ -136,7 +132,8 @@ heights = st.one_of(st.just(0.0), finite((1e-6, 400.0)))
 WAKES = {
     "M-1/M-2": dict(velocity_model="ekman_veer", deflection_model="ekman_veer"),
     "M-3": dict(velocity_model="bastankhah2014", deflection_model="ekman_veer"),
-    "gauss": dict(velocity_model="gauss", deflection_model="gauss"),
+    # FLORIS's gauss as FLORIS runs it (its wakes' squares summed)
+    "gauss": dict(velocity_model="gauss", deflection_model="gauss", combination_model="sosfs"),
 }
 
 

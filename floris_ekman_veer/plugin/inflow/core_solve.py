@@ -48,8 +48,9 @@ def with_core_atmosphere(method):
                                     (WAKE_MODELS, self.wake)):
                 stack.callback(variable.reset, variable.set(value))
             # The package's per-wake warnings are said once, summarised, at the end of a solve.
-            stack.enter_context(package_warnings.run_scope(self.flow_field.wind_speeds,
-                                                           self.flow_field.reference_wind_height))
+            stack.enter_context(package_warnings.run_scope(
+                self.flow_field.wind_speeds, self.flow_field.reference_wind_height,
+                stock=input_checks.stock_thrust_tables(self.farm)))
             rest = stack.enter_context(_at_rest(self, atmosphere))
             if method.__name__ != "steady_state_atmospheric_condition":
                 # (run() initialises the domain first: said there, once)

@@ -11,6 +11,7 @@ its condition or turbine index) and the valid range (docs/coupling.md#input-vali
 
 from __future__ import annotations
 
+import functools
 import sys
 
 import numpy as np
@@ -52,6 +53,35 @@ def uses_package(core, atmosphere) -> bool:
     )
 
 
+@functools.lru_cache(maxsize=None)
+def _library_thrust_table(name: str) -> tuple | None:
+    """The thrust coefficients of FLORIS's library turbine ``name`` (None if it has none)."""
+    from floris.core.farm import default_turbine_library_path
+    from floris.utilities import load_yaml
+
+    path = (default_turbine_library_path / name).with_suffix(".yaml")
+    if not path.is_file():
+        return None
+    return tuple(float(v) for v in load_yaml(path)["power_thrust_table"]["thrust_coefficient"])
+
+
+def stock_thrust_tables(farm) -> bool:
+    """Whether every turbine is a FLORIS library turbine with its library thrust table (the
+    loading near cut-in is FLORIS's, not the user's: the thrust-limit summary is then a notice,
+    floris_ekman_veer.warnings._warn_thrust_limit)."""
+    seen: dict = {}
+    for turbine in farm.turbine_definitions:
+        key = id(turbine)
+        if key not in seen:
+            library = _library_thrust_table(str(turbine.get("turbine_type")))
+            table = turbine.get("power_thrust_table", {}).get("thrust_coefficient")
+            seen[key] = (library is not None and table is not None
+                         and tuple(float(v) for v in table) == library)
+        if not seen[key]:
+            return False
+    return bool(seen)
+
+
 def _is_disk(turbine: dict) -> bool:
     return turbine.get("operation_model") == OPERATION_MODEL_NAME
 
@@ -74,6 +104,7 @@ def check_core(core, atmosphere=None) -> None:
     _check_turbines(core.farm)
     warn_ignored_flow_inputs(core, atmosphere)
     warn_deficit_superposition(core)
+    warn_builtin_combination(core, atmosphere)
 
 
 def warn_ignored_flow_inputs(core, atmosphere) -> None:
@@ -112,7 +143,9 @@ OWN_TURBULENCE_MATCH = 5e-4 + 1e-12
 def notice_unused_turbulence(core, abl, atmosphere) -> None:
     """``flow_field.turbulence_intensities``, which FLORIS requires, is not the ekman_veer wake
     model's ambient turbulence (it takes I_u at hub height from the solved atmosphere ``abl``):
-    said once per study and atmosphere, as the unused ``wind_shear`` is, whatever TI are given
+    logged (INFO, FLORIS's logger: FLORIS requires TI, so every run would otherwise warn of what
+    the user cannot change; :func:`floris_ekman_veer.warnings.notice`) once per study and
+    atmosphere, whatever TI are given
     (one constant value too: a gauss run beside it reads that value, so a comparison on "the same
     inflow" would differ in its turbulence unknowingly), unless they are the atmosphere's own I_u
     at a hub height, as the package's comparisons give them (studies/comparison.py)."""
@@ -138,7 +171,7 @@ def notice_unused_turbulence(core, abl, atmosphere) -> None:
                   f"{core.wake.velocity_model.wake_expansion})"
                   if getattr(core.wake.velocity_model, "wake_expansion", "ambient") != "ambient"
                   else "")
-    package_warnings.warn(
+    package_warnings.notice(
         "flow_field.turbulence_intensities "
         f"({package_warnings.range_text(seen, '').strip()}) are not used as the ambient "
         f"turbulence by the {VELOCITY_MODEL_NAME} wake model: it takes I_u at hub height from "
@@ -147,7 +180,7 @@ def notice_unused_turbulence(core, abl, atmosphere) -> None:
         "them as the ambient turbulence: for a "
         "comparison on the same inflow give them the atmosphere's I_u "
         "(docs/user_guide.md#floris-inputs-the-atmosphere-replaces)",
-        package_warnings.ModelSettingsWarning, items=(("turbulence_intensities",),))
+        "turbulence_intensities", items=("once",))
 
 
 def warn_deficit_superposition(core) -> None:
@@ -169,6 +202,36 @@ def warn_deficit_superposition(core) -> None:
             "fls, or deficit_velocity: free_stream to scale them with the free stream "
             "(docs/coupling.md#wakes-deep-in-an-array)",
             package_warnings.ModelSettingsWarning, items=(("combination_model", combination),))
+
+
+#: FLORIS 4.7's own combination for its velocity models that read a sum of squares (its example
+#: inputs gauss.yaml, gch.yaml, cc.yaml, emgauss.yaml; the package's comparisons run them so,
+#: studies/comparison.py's BUILTIN_WAKES).
+BUILTIN_COMBINATION = {"gauss": "sosfs", "cc": "sosfs", "empirical_gauss": "sosfs"}
+
+
+def warn_builtin_combination(core, atmosphere) -> None:
+    """FLORIS's gauss, cc or empirical_gauss on the atmosphere with ``combination_model: fls``,
+    the combination this package's inputs carry for ``ekman_veer`` (what an input edited by
+    changing only the model names keeps): one
+    :class:`~floris_ekman_veer.warnings.ModelSettingsWarning` per model and study naming the
+    setting, since FLORIS runs these models with ``sosfs`` (on farm_night at 11 m/s gauss + fls
+    gives 8 % less farm power than gauss + sosfs;
+    docs/user_guide.md#floriss-own-models-on-the-same-inflow). Silent without an atmosphere
+    (plain FLORIS inputs are FLORIS's) and with FLORIS's own combination."""
+    if atmosphere is None:
+        return
+    velocity = str(core.wake.model_strings.get("velocity_model", "")).lower()
+    combination = str(core.wake.model_strings.get("combination_model", "")).lower()
+    own = BUILTIN_COMBINATION.get(velocity)
+    if own is not None and combination == "fls":
+        package_warnings.warn(
+            f"wake.model_strings.combination_model = 'fls' with FLORIS's velocity_model "
+            f"{velocity!r}: FLORIS runs {velocity} with combination_model: {own} (its example "
+            f"inputs; floris_ekman_veer.studies.comparison.builtin_model), and summing its wakes "
+            f"instead deepens them (farm_night at 11 m/s: 8 % less farm power); set "
+            f"combination_model: {own} (docs/user_guide.md#floriss-own-models-on-the-same-inflow)",
+            package_warnings.ModelSettingsWarning, items=(("combination_model", velocity),))
 
 
 def _check_layout(farm) -> None:

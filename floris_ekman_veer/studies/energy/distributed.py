@@ -40,6 +40,8 @@ from floris_ekman_veer.plugin.floris_tools.parallel import prepare_worker
 from floris_ekman_veer.studies.energy.condition_chunks import run_chunk
 
 DASK = "dask"
+#: The interfaces ParFlorisModel runs: FLORIS 4.7's own (None: serial) and the Dask one.
+INTERFACES = ("multiprocessing", "pathos", "concurrent", None, DASK)
 
 
 def _import_distributed():
@@ -106,7 +108,16 @@ def _resolve_client(client):
     if isinstance(client, distributed.Client):
         return client
     if isinstance(client, str):
-        return _connect(distributed, client)
+        try:
+            return _connect(distributed, client)
+        except (ValueError, TypeError) as error:
+            # distributed's own answer ("missing port number in address 'x'") names neither
+            # the parameter nor what an address looks like
+            raise ValueError(
+                f"ParFlorisModel client={client!r} is not a Dask scheduler address: give one "
+                "such as 'tcp://scheduler:8786' (scheme://host:port), or a "
+                f"dask.distributed.Client ({error})"
+            ) from None
     if client is None:
         try:
             return distributed.default_client()
@@ -154,6 +165,13 @@ class ParFlorisModel(_FlorisParFlorisModel):
                     value < 1 and value != -1):
                 raise ValueError(f"ParFlorisModel {name} must be a positive integer or -1 (the "
                                  f"default); got {value!r}")
+        if interface not in INTERFACES:
+            # FLORIS's own list would omit "dask"
+            raise ValueError(
+                f"ParFlorisModel interface={interface!r} is not one of 'multiprocessing', "
+                "'pathos', 'concurrent', 'dask' (pip install 'floris-ekman-veer[dask]') or None "
+                "(serial)"
+            )
         if interface != DASK:
             if client is not None:
                 raise ValueError(

@@ -23,6 +23,7 @@ from floris_ekman_veer import ParFlorisModel, registry
 from floris_ekman_veer.plugin.floris_tools import parallel
 from floris_ekman_veer.plugin.inflow import inflow
 from floris_ekman_veer.warnings import ThrustLimitWarning
+from tests.conftest import own_turbine
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +33,8 @@ def light_wind_farm():
     wd, ws, yaw = rng.uniform(0, 360, n), rng.uniform(3, 8, n), rng.uniform(-30, 30, (n, 9))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fmodel = FlorisModel(fev.example_input("farm_sbl6"))
+        # the user's copy of the NREL 5 MW: its thrust limit is a warning (FLORIS's own, a notice)
+        fmodel = FlorisModel(own_turbine(fev.example_input("farm_sbl6")))
         fmodel.set(wind_directions=wd, wind_speeds=ws, turbulence_intensities=np.full(n, 0.06),
                    yaw_angles=yaw)
     return fmodel
@@ -67,11 +69,12 @@ SPAWN_SCRIPT = textwrap.dedent(
     from floris import FlorisModel
     import floris_ekman_veer as fev
     from floris_ekman_veer import ParFlorisModel, ThrustLimitWarning
+    from tests.conftest import own_turbine
     n = 8
     rng = np.random.default_rng(1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        serial = FlorisModel(fev.example_input("farm_sbl6"))
+        serial = FlorisModel(own_turbine(fev.example_input("farm_sbl6")))
         serial.set(wind_directions=rng.uniform(0, 360, n), wind_speeds=rng.uniform(3, 8, n),
                    turbulence_intensities=np.full(n, 0.06))
     par = ParFlorisModel(serial, interface="multiprocessing", max_workers=2)

@@ -32,13 +32,6 @@ REPO = Path(__file__).resolve().parents[3]
 FARM = REPO / "inputs" / "farm_sbl6.yaml"
 
 
-# The paper's case inputs keep FLORIS's turbulence_intensities, which the ekman_veer model does not
-# read (it takes I_u from the atmosphere): the ModelSettingsWarning saying so is tested in
-# tests/plugin/wake_models/test_floris_input_messages.py, not here.
-pytestmark = pytest.mark.filterwarnings(
-    "ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning")
-
-
 def atmosphere(name):
     return load_yaml(REPO / "inputs" / f"{name}.yaml")["wake"]["wake_velocity_parameters"][
         "ekman_veer"]["atmosphere"]

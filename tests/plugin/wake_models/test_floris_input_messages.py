@@ -4,6 +4,8 @@ the atmosphere replaces say so once, a model-name typo names the registered mode
 closest one, a result table prints whole, and the README's quick start is inside the validated
 envelope without a warning."""
 
+import contextlib
+import logging
 import re
 import subprocess
 import sys
@@ -24,10 +26,13 @@ REPO = Path(__file__).resolve().parents[3]
 ATMOSPHERE = {"latitude": 52.0, "roughness_length": 0.1, "cooling_rate": -0.25}
 
 
-def defaults(velocity="ekman_veer", deflection="ekman_veer", **flow_field):
+def defaults(velocity="ekman_veer", deflection="ekman_veer", combination=None, **flow_field):
+    """FLORIS's default input with the atmosphere, GCH's switches off and the combination the
+    velocity model is run with (fls for ekman_veer, FLORIS's sosfs for gauss) unless given."""
     config = FlorisModel.get_defaults()
+    combination = combination or ("fls" if velocity == "ekman_veer" else "sosfs")
     config["wake"]["model_strings"].update(velocity_model=velocity, deflection_model=deflection,
-                                           combination_model="fls")
+                                           combination_model=combination)
     config["wake"]["wake_velocity_parameters"]["ekman_veer"] = {"atmosphere": ATMOSPHERE}
     config["wake"].update(enable_secondary_steering=False, enable_yaw_added_recovery=False,
                           enable_transverse_velocities=False)
@@ -36,25 +41,52 @@ def defaults(velocity="ekman_veer", deflection="ekman_veer", **flow_field):
 
 
 #: The ekman_veer wake model's notice that FLORIS's turbulence intensities are not its ambient
-#: turbulence (test_floris_turbulence_intensities_are_said_unused_by_ekman_veer).
+#: turbulence (test_floris_turbulence_intensities_are_said_unused_by_ekman_veer): logged at INFO
+#: on FLORIS's logger, not warned.
 TURBULENCE_NOTICE = "flow_field.turbulence_intensities"
 
 
+class _Notices(logging.Handler):
+    def __init__(self):
+        super().__init__(logging.INFO)
+        self.messages = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
+@contextlib.contextmanager
+def logged_notices():
+    """The messages the package logs on FLORIS's logger meanwhile."""
+    handler = _Notices()
+    logger = logging.getLogger("floris.floris_ekman_veer")
+    logger.addHandler(handler)
+    try:
+        yield handler.messages
+    finally:
+        logger.removeHandler(handler)
+
+
 def settings_warnings(config, repeat=2, intensities=(0.06, 0.06), turbulence_notice=False):
-    with warnings.catch_warnings(record=True) as caught:
+    """The ModelSettingsWarnings of ``repeat`` builds and runs (one study); with
+    ``turbulence_notice`` the logged turbulence notices instead."""
+    with warnings.catch_warnings(record=True) as caught, logged_notices() as notices:
         warnings.simplefilter("always")
         for _ in range(repeat):
             fmodel = FlorisModel(config)
             fmodel.set(wind_speeds=[8.0, 9.0], wind_directions=[270.0] * 2,
                        turbulence_intensities=list(intensities))
             fmodel.run()
-    return [str(w.message) for w in caught if issubclass(w.category, ModelSettingsWarning)
-            and (turbulence_notice or not str(w.message).startswith(TURBULENCE_NOTICE))]
+    if turbulence_notice:
+        assert not [w for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
+        return [m for m in notices if m.startswith(TURBULENCE_NOTICE)]
+    return [str(w.message) for w in caught if issubclass(w.category, ModelSettingsWarning)]
 
 
 def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
     """ekman_veer takes I_u from the atmosphere: FLORIS's TI changes none of its powers (0.02,
-    0.06, 0.15), and one ModelSettingsWarning per study says so at the run, one constant TI
+    0.06, 0.15), and one INFO notice on FLORIS's logger per study says so at the run (no
+    warning: FLORIS requires TI, the user cannot leave them out), one constant TI
     included, with the values given and the atmosphere's own I_u; TI that are the atmosphere's
     I_u to three decimals are silent, and so are gauss on the same inflow and a shipped input's
     build."""
@@ -81,12 +113,12 @@ def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
                              turbulence_notice=True) == []
     assert settings_warnings(defaults("gauss", "gauss", wind_shear=0.0, wind_veer=0.0),
                              turbulence_notice=True) == []
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True), logged_notices() as notices:
         warnings.simplefilter("always")
         FlorisModel(floris_ekman_veer.example_input("farm_night"))  # placeholder TI 0.06
-    assert not [w for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
+    assert not [m for m in notices if m.startswith(TURBULENCE_NOTICE)]
     powers = []
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True) as caught, logged_notices() as logged:
         warnings.simplefilter("always")
         for ti in (0.02, 0.06, 0.15):  # one study: said once, at the first run
             fmodel = FlorisModel(defaults(wind_shear=0.0, wind_veer=0.0))
@@ -94,7 +126,8 @@ def test_floris_turbulence_intensities_are_said_unused_by_ekman_veer():
                        wind_directions=[270.0], turbulence_intensities=[ti])
             fmodel.run()
             powers.append(fmodel.get_turbine_powers())
-    notices = [str(w.message) for w in caught if str(w.message).startswith(TURBULENCE_NOTICE)]
+    assert not [w for w in caught if issubclass(w.category, ModelSettingsWarning)]
+    notices = [m for m in logged if m.startswith(TURBULENCE_NOTICE)]
     assert len(notices) == 1 and notices[0].startswith(
         "flow_field.turbulence_intensities (0.02) are not used")
     np.testing.assert_array_equal(powers[0], powers[1])
@@ -130,6 +163,54 @@ def test_zero_shear_and_veer_and_gauss_reading_its_veer_are_silent():
     with warnings.catch_warnings():
         warnings.simplefilter("error", ModelSettingsWarning)
         FlorisModel(plain)
+
+
+def _farm_night_with(model_strings, gch=False):
+    config = FlorisModel(floris_ekman_veer.example_input("farm_night")).core.as_dict()
+    config["wake"]["model_strings"].update(model_strings)
+    config["wake"].update(enable_secondary_steering=gch, enable_yaw_added_recovery=gch,
+                          enable_transverse_velocities=gch)
+    return config
+
+
+def test_floris_models_named_into_a_shipped_input_are_told_their_own_combination():
+    """The user guide's switch to FLORIS's models on the same inflow: changing only the model
+    names of a shipped input keeps its ``combination_model: fls``, which deepens gauss's wakes
+    (8 % less farm power on farm_night at 11 m/s, 270 deg): one ModelSettingsWarning per model
+    and study names the setting and FLORIS's own (sosfs); the documented switch (names and
+    sosfs) and studies.comparison.builtin_model run the same model, silently."""
+    from floris_ekman_veer.studies.comparison import builtin_model
+
+    conditions = dict(wind_speeds=[11.0], wind_directions=[270.0], turbulence_intensities=[0.06])
+    powers = {}
+    for combination in ("fls", "sosfs"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fmodel = FlorisModel(_farm_night_with(dict(
+                velocity_model="gauss", deflection_model="gauss", combination_model=combination)))
+            FlorisModel(fmodel.core.as_dict())  # the same study: said once
+            fmodel.set(**conditions)
+            fmodel.run()
+        found = [str(w.message) for w in caught if issubclass(w.category, ModelSettingsWarning)]
+        powers[combination] = fmodel.get_farm_power()[0]
+        if combination == "fls":
+            assert len(found) == 1 and found[0].startswith(
+                "wake.model_strings.combination_model = 'fls' with FLORIS's velocity_model "
+                "'gauss': FLORIS runs gauss with combination_model: sosfs")
+        else:
+            assert found == []
+    assert 1.0 - powers["fls"] / powers["sosfs"] == pytest.approx(0.08, abs=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelSettingsWarning)
+        reference = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+        same = builtin_model(reference, "gauss")
+        same.set(**conditions)
+        same.run()
+    assert same.get_farm_power()[0] == powers["sosfs"]
+    # FLORIS's own combination for jensen and turbopark is fls: silent.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ModelSettingsWarning)
+        FlorisModel(_farm_night_with(dict(velocity_model="jensen", deflection_model="gauss")))
 
 
 @pytest.mark.parametrize("kind, typo, match", [

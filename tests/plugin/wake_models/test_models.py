@@ -41,6 +41,7 @@ from floris_ekman_veer.plugin.wake_models.models import (
     Gaussian2014VelocityDeficit,
 )
 from floris_ekman_veer.wake.deficit import potential_core_length
+from tests.conftest import own_turbine
 
 DEBUG = False
 
@@ -215,6 +216,8 @@ def test_switching_model_names_keeps_the_ekman_inflow():
     def run(velocity, deflection, yaw=0.0):
         cfg = config("farm_sbl6")
         cfg["wake"]["model_strings"].update(velocity_model=velocity, deflection_model=deflection)
+        if velocity == "gauss":  # FLORIS's gauss as FLORIS runs it (its wakes' squares summed)
+            cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
         cfg["wake"]["wake_velocity_parameters"].setdefault(velocity, {})  # FLORIS needs a block
         fmodel = FlorisModel(cfg)
         fmodel.set(yaw_angles=np.full((1, 9), yaw))
@@ -578,7 +581,9 @@ def test_positive_yaw_moves_the_wake_to_minus_y_like_floris_gauss():
     centres = {}
     for model in ("ekman_veer", "gauss"):
         cfg = config("cnbl")
-        cfg["wake"]["model_strings"].update(velocity_model=model, deflection_model=model)
+        cfg["wake"]["model_strings"].update(velocity_model=model, deflection_model=model,
+                                            combination_model=defaults["model_strings"][
+                                                "combination_model"] if model == "gauss" else "fls")
         cfg["wake"]["wake_velocity_parameters"]["gauss"] = defaults["wake_velocity_parameters"]["gauss"]
         cfg["wake"]["wake_deflection_parameters"]["gauss"] = (
             defaults["wake_deflection_parameters"]["gauss"])
@@ -739,10 +744,12 @@ def test_unknown_atmosphere_key_fails_at_build():
 
 
 def test_thrust_coefficient_beyond_momentum_theory():
-    """NREL 5 MW at 3 m/s: FLORIS hands C_T = 0.9999 (its clip of the table's value); the wake is
+    """NREL 5 MW at 3 m/s (the user's copy: a warning, not FLORIS's own turbine's notice):
+    FLORIS hands C_T = 0.9999 (its clip of the table's value); the wake is
     evaluated at max_thrust_coefficient = 0.96 with a RuntimeWarning, i.e. it is BP14 at
     C_T = 0.96 (veer off, zero yaw), and everything is finite."""
-    cfg = config("farm_sbl6", veer=False, wind_speeds=[3.0], reference_wind_height=HUB_5MW)
+    cfg = own_turbine(config("farm_sbl6", veer=False, wind_speeds=[3.0],
+                             reference_wind_height=HUB_5MW))
     cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
         config("cnbl")["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"])
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0], [0.0]
@@ -774,7 +781,8 @@ def test_heavily_loaded_yawed_rotor_limits_the_normal_loading():
         ("ekman_veer", 20.0, False), ("bastankhah2014", 20.0, False),
         ("ekman_veer", 0.0, True), ("bastankhah2014", 0.0, True),
     ):
-        cfg = config("farm_sbl6", wind_speeds=[3.0], reference_wind_height=HUB_5MW)
+        # (the user's copy of the NREL 5 MW: the limit is a warning, not FLORIS's own's notice)
+        cfg = own_turbine(config("farm_sbl6", wind_speeds=[3.0], reference_wind_height=HUB_5MW))
         cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
             config("cnbl")["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"])
         cfg["wake"]["model_strings"]["velocity_model"] = velocity_model

@@ -71,9 +71,11 @@ SCRIPT = textwrap.dedent(
             from floris_ekman_veer import ThrustLimitWarning
 
             rng = np.random.default_rng(1)
+            from tests.conftest import own_turbine  # the user's turbine: a warning, not a notice
+
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                light = FlorisModel(farm)
+                light = FlorisModel(own_turbine(farm))
                 light.set(wind_directions=rng.uniform(0, 360, 8), wind_speeds=rng.uniform(3, 8, 8),
                           turbulence_intensities=np.full(8, 0.06))
             said = {}
@@ -304,6 +306,19 @@ def test_dask_interface_without_a_client():
 def test_dask_interface_rejects_other_client_objects():
     with pytest.raises(ValueError, match="got int"):
         ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=8786)
+
+
+def test_unknown_interface_lists_every_interface_with_dask():
+    with pytest.raises(ValueError, match=r"interface='dask2' is not one of 'multiprocessing', "
+                                         r"'pathos', 'concurrent', 'dask' .* or None"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask2")
+
+
+@pytest.mark.parametrize("address", ["x", "tcp://scheduler"])
+def test_dask_client_string_that_is_no_address_names_the_form(address):
+    with pytest.raises(ValueError, match=rf"client='{address}' is not a Dask scheduler address: "
+                                         r"give one such as 'tcp://scheduler:8786'"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=address)
 
 
 class _FakeClient:

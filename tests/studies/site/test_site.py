@@ -85,9 +85,6 @@ def test_floris_run_gives_back_the_fitted_profiles():
 
 
 @ROW_MODEL_SETTINGS
-# The records' turbulence intensities, which ekman_veer does not read (a notice tested in
-# tests/plugin/wake_models/test_floris_input_messages.py), go to the GCH comparison.
-@pytest.mark.filterwarnings("ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning")
 def test_annual_energy_and_optimize_yaw_run_per_record():
     records, _ = records_of([8.0, 8.0, 9.0], [np.inf, 150.0, 150.0], [270.0, 270.0, 272.0],
                             noise=1.0, seed=5)
