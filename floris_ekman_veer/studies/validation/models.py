@@ -116,12 +116,16 @@ def _sample_step(sample_step) -> float:
                   lambda step: np.isfinite(step) and 0.0 < step <= 10.0)
 
 
+#: Fields of a wake model that are not model settings: the inflow, the shallow-ABL policy.
+_NOT_SETTINGS = ("atmosphere", "shallow_boundary_layer")
+
+
 def _shown(component) -> list[str]:
     # Every choice (string or boolean) of a wake component, and each number that is not its
     # class default: what distinguishes one set-up of the model from another.
     items = []
     for item in attrs.fields(type(component)):
-        if not item.init or item.name == "atmosphere":
+        if not item.init or item.name in _NOT_SETTINGS:
             continue
         value = getattr(component, item.name)
         if isinstance(value, (str, bool, np.bool_)):
@@ -145,8 +149,8 @@ def model_label(name: str, fmodel) -> str:
     every number set away from its default. Two runs with one label ran one model
     (docs/validation.md#model-labels)."""
     wake = fmodel.core.wake
-    items = [f"{kind.removesuffix('_model')}={value}"
-             for kind, value in wake.model_strings.items()]
+    items = [f"{kind}={wake.model_strings[f'{kind}_model']}"
+             for kind in ("velocity", "deflection", "turbulence", "combination")]
     items += [short for switch, short in _SWITCHES.items() if getattr(wake, switch)]
     items += [item for component in (wake.velocity_model, wake.deflection_model,
                                      wake.turbulence_model) for item in _shown(component)]
