@@ -98,6 +98,10 @@ def test_farm_efficiency_averages_each_turbine_over_the_direction_uncertainty():
     without = models.farm_efficiency(farm(efficiency=efficiency(standard_error=None)), ["M-1"],
                                      sample_step=2.0)
     assert np.isnan(validation.efficiency_errors(without)["standard_error"]).all()
+    # A table built elsewhere (a peer model's) without kind or standard error is scored too.
+    other = validation.efficiency_errors(raw.drop(columns=["kind", "standard_error"]))
+    assert other[["rmse", "bias"]].to_numpy().tolist() == errors[errors["kind"] == "raw"][
+        ["rmse", "bias"]].to_numpy().tolist()
 
 
 def test_total_turbulence_converts_with_the_neutral_surface_layer_ratio():
@@ -115,7 +119,8 @@ def test_total_turbulence_converts_with_the_neutral_surface_layer_ratio():
 
 def test_labels_carry_the_settings_and_make_good_keys():
     """M-1 and its FLORIS-style coupling share a name stem but not a label; each label names
-    the resolved wake_expansion and combination; a user's changed constant shows; no label
+    the resolved wake_expansion and combination and the package's constants; a user's changed
+    constant shows; no label
     has a comma or a space; the row table carries the label of every model."""
     case = farm()
     labels = {}
@@ -130,7 +135,9 @@ def test_labels_carry_the_settings_and_make_good_keys():
     assert "combination=sosfs" in labels["M-1, FLORIS-style"]
     assert labels["M-1, FLORIS-style"].startswith("M-1_FLORIS-style[")
     assert "transverse_velocities" in labels["GCH"] and "velocity=gauss" in labels["GCH"]
-    assert "k_w_floor=0.03" in labels["mine"] and "k_w_floor" not in labels["M-1"]
+    assert "deflection.veer=True" in labels["M-1"]
+    assert "k_w_floor=0.03" in labels["mine"] and "k_w_floor=0.021" in labels["M-1"]
+    assert "alpha=" not in labels["GCH"]  # FLORIS's numbers at FLORIS's defaults
     assert len(set(labels.values())) == 4
     assert not any(c in label for label in labels.values() for c in ", ")
     ratios = models.row_ratios(case, ["M-1", mine], sample_step=2.0, offsets=(0.0,))
@@ -252,10 +259,11 @@ def test_the_valid_calls_build():
     assert farm(turbine=nrel, layout=(LAYOUT[0] * 2, LAYOUT[1])).rotor_diameter == 125.88
 
 
-def _bad_number(low=None, high=None):
-    """Numbers outside [low, high], NaN, infinities, strings, booleans and None."""
+def _bad_number(low=None, high=None, optional=False):
+    """Numbers outside [low, high], NaN, infinities, strings, booleans and (unless the field is
+    ``optional``, None meaning "not given") None."""
     options = [st.just(NAN), st.just(math.inf), st.just(-math.inf), st.text(max_size=3),
-               st.booleans(), st.none()]
+               st.booleans()] + ([] if optional else [st.none()])
     # (-0.0 equals a bound 0.0: it is inside the range, hence the filters)
     if low is not None:
         options.append(st.floats(max_value=low, exclude_max=True, allow_nan=False,
@@ -306,7 +314,7 @@ WALK = [
         lambda x: lambda: farm(layout=(x, [0.0, 0.0, 0.0])))),
     ("direction_offsets", st.one_of(st.just(()), _spoil([-1.0, 0.0, 1.0], _bad_number(-30, 30))).map(
         lambda o: lambda: farm(direction_offsets=o))),
-    ("roughness_length", _bad_number(low=1e-6, high=5.0).map(
+    ("roughness_length", _bad_number(low=1e-6, high=5.0, optional=True).map(
         lambda z: lambda: farm(roughness_length=z))),
     ("sample_step", _bad_number(low=0.0, high=10.0).map(
         lambda s: lambda: models.row_ratios(farm(), ["M-1"], sample_step=s))),

@@ -99,12 +99,17 @@ def reference_row_errors(ratios: pd.DataFrame, by=("case", "kind")) -> pd.DataFr
     return row_errors(first.assign(ratio=first["rans"]), by=by)
 
 
-def efficiency_errors(efficiency: pd.DataFrame, by=("case", "reading", "model", "kind")) -> pd.DataFrame:
+def efficiency_errors(efficiency: pd.DataFrame, by=None) -> pd.DataFrame:
     """RMSE, bias and the reference's standard error (RMS over the same points; NaN where the
     reference gives none) of the farm efficiency (``models.farm_efficiency``) against its
-    reference at the reference's directions, per group ``by``."""
+    reference at the reference's directions, per group ``by`` (default: case, reading, model
+    and kind, those of them the table has, so that a table built elsewhere without "kind" or
+    "standard_error" columns is scored as well)."""
+    if by is None:
+        by = [c for c in ("case", "reading", "model", "kind") if c in efficiency]
+    spread = "standard_error" if "standard_error" in efficiency else None
     return (efficiency.groupby(list(by), sort=False)
-            .apply(_errors, "efficiency", "reference", "standard_error", include_groups=False)
+            .apply(_errors, "efficiency", "reference", spread, include_groups=False)
             .reset_index())
 
 

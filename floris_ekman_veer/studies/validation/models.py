@@ -121,8 +121,10 @@ _NOT_SETTINGS = ("atmosphere", "shallow_boundary_layer")
 
 
 def _shown(component) -> list[str]:
-    # Every choice (string or boolean) of a wake component, and each number that is not its
-    # class default: what distinguishes one set-up of the model from another.
+    # Every choice (string or boolean) of a wake component, and its numbers: all of them for
+    # the package's own models (whose defaults a release may change), those set away from
+    # FLORIS's defaults for FLORIS's (FLORIS's version is pinned).
+    own = type(component).__module__.startswith("floris_ekman_veer.")
     items = []
     for item in attrs.fields(type(component)):
         if not item.init or item.name in _NOT_SETTINGS:
@@ -130,7 +132,7 @@ def _shown(component) -> list[str]:
         value = getattr(component, item.name)
         if isinstance(value, (str, bool, np.bool_)):
             items.append(f"{item.name}={value}")
-        elif isinstance(value, (int, float)) and value != item.default:
+        elif isinstance(value, (int, float)) and (own or value != item.default):
             items.append(f"{item.name}={value:g}")
     return items
 
@@ -144,16 +146,17 @@ _SWITCHES = {"enable_secondary_steering": "secondary_steering",
 def model_label(name: str, fmodel) -> str:
     """A label that carries the settings a built model runs with, and makes a good key (no
     commas, no spaces): the name, then in brackets FLORIS's model strings, the GCH switches
-    that are on, every choice of the velocity and deflection models (the package's
-    ``wake_expansion``, ``deficit_velocity``, ``veer`` ...) with their defaults resolved, and
-    every number set away from its default. Two runs with one label ran one model
-    (docs/validation.md#model-labels)."""
+    that are on, every choice of the velocity, deflection and turbulence models (the
+    package's ``wake_expansion``, ``deficit_velocity``, ``veer`` ...) with their defaults
+    resolved, every number of the package's models and each number of FLORIS's set away from
+    its default. Two runs with one label ran one model (docs/validation.md#model-labels)."""
     wake = fmodel.core.wake
     items = [f"{kind}={wake.model_strings[f'{kind}_model']}"
              for kind in ("velocity", "deflection", "turbulence", "combination")]
     items += [short for switch, short in _SWITCHES.items() if getattr(wake, switch)]
-    items += [item for component in (wake.velocity_model, wake.deflection_model,
-                                     wake.turbulence_model) for item in _shown(component)]
+    items += _shown(wake.velocity_model)
+    items += [f"{kind}.{item}" for kind in ("deflection", "turbulence")
+              for item in _shown(getattr(wake, f"{kind}_model"))]
     return f"{re.sub(r'[^A-Za-z0-9.-]+', '_', name)}[{';'.join(items)}]"
 
 
