@@ -177,6 +177,25 @@ def test_offshore_is_required_and_sets_the_site_roughness():
     assert validation.FarmCase(**arguments, offshore=False, roughness_length=0.1).site_roughness == 0.1
 
 
+def test_a_farm_given_its_own_atmosphere_runs_the_given_reading():
+    """A case with an atmosphere block and no turbulence runs the "given" reading: its models
+    see the block's I_u(z_h) (lower in the stable block than in the neutral one of the same
+    roughness), the waked turbines lose power; the "matched" reading is refused naming the
+    missing turbulence."""
+    block = {"latitude": 54.0, "roughness_length": 0.01}
+    stable = farm(turbulence=None, atmosphere={**block, "cooling_rate": -0.25})
+    neutral = farm(turbulence=None, atmosphere=block)
+    seen = [models.build_model(case, "given", "M-1").core.flow_field.turbulence_intensities[0]
+            for case in (stable, neutral)]
+    assert seen[0] == pytest.approx(atmospheres.hub_turbulence(stable, stable.atmosphere), rel=1e-12)
+    assert seen[0] < seen[1]
+    table = models.row_ratios(stable, ["M-1"], readings=("given",), offsets=(0.0,), sample_step=2.0)
+    ratios = table[table["kind"] == "raw"]["ratio"].to_numpy()
+    assert ratios[0] == 1.0 and np.all((ratios[1:] > 0.3) & (ratios[1:] < 0.9))
+    with pytest.raises(ValueError, match="turbulence"):
+        models.row_ratios(stable, ["M-1"], offsets=(0.0,))
+
+
 # --------------------------------------------------------------------------- bad input
 NAN = float("nan")
 #: Issue 40's list of bad calls, each with the field its message must name.

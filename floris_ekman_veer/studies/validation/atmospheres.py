@@ -119,5 +119,8 @@ def atmosphere(case, reading: str) -> dict:
         return dict(case.atmosphere)
     if reading not in ATMOSPHERES:
         raise ValueError(f"reading must be one of {ATMOSPHERES + (GIVEN,)}, got {reading!r}")
+    if reading == "matched" and case.streamwise_turbulence is None:
+        raise ValueError(f"{case.name}: reading 'matched' needs the case's turbulence (the "
+                         f"measured I_u); this case gives an atmosphere block: use reading {GIVEN!r}")
     z0 = case.site_roughness if reading == "site" else matched_roughness(case)
     return {"latitude": float(case.latitude), "roughness_length": float(z0)}
