@@ -14,6 +14,9 @@ The names a user's farm needs are importable from here (docs/validation.md#your-
 ``FarmCase``, ``RowReference``, ``EfficiencyReference``, ``DirectionUncertainty``,
 ``turbine_from_table``, ``streamwise_turbulence``, ``row_ratios``, ``farm_efficiency``,
 ``row_errors``, ``efficiency_errors``, ``model_label`` and ``WAKE_MODELS``.
+
+May import: the base, the physics, the plugin, FLORIS and the other studies; never the registry
+or the package's top (docs/architecture.md).
 """
 
 from floris_ekman_veer.studies.validation.atmospheres import streamwise_turbulence

@@ -18,7 +18,7 @@ import numpy as np
 from attrs import define, field
 
 from floris_ekman_veer._validation import boolean
-from floris_ekman_veer.atmosphere.input_ranges import MIN_ABS_LATITUDE
+from floris_ekman_veer.atmosphere.inputs.input_ranges import MIN_ABS_LATITUDE
 from floris_ekman_veer.studies.validation.atmospheres import (
     ROUGHNESS_RANGE,
     hub_turbulence,
