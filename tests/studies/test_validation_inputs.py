@@ -17,8 +17,15 @@ from floris import FlorisModel
 from hypothesis import given
 from hypothesis import strategies as st
 
-from floris_ekman_veer.studies import validation
-from floris_ekman_veer.studies.validation import atmospheres, cases, models
+from floris_ekman_veer.studies.validation import (
+    atmospheres,
+    cases,
+    farm_case,
+    metrics,
+    models,
+    references,
+    turbines,
+)
 
 SPEED = [4.0, 8.0, 12.0, 25.0]
 POWER = [60.0, 700.0, 2000.0, 2000.0]
@@ -29,22 +36,22 @@ SCADA = np.array([[1, 1.0, 0.02], [2, 0.62, 0.03], [3, 0.58, 0.03]])
 def turbine(**changes):
     arguments = dict(name="T", rotor_diameter=80.0, hub_height=70.0, wind_speed=SPEED,
                      power=POWER, thrust_coefficient=THRUST)
-    return validation.turbine_from_table(**{**arguments, **changes})
+    return turbines.turbine_from_table(**{**arguments, **changes})
 
 
 def row(**changes):
     arguments = dict(label="row A", wind_direction=270.0, turbines=[0, 1, 2], measured=SCADA)
-    return validation.RowReference(**{**arguments, **changes})
+    return references.RowReference(**{**arguments, **changes})
 
 
 def efficiency(**changes):
     arguments = dict(directions=[260.0, 270.0, 280.0], efficiency=[0.9, 0.7, 0.9],
                      source="SCADA", standard_error=[0.01, 0.02, 0.01])
-    return validation.EfficiencyReference(**{**arguments, **changes})
+    return references.EfficiencyReference(**{**arguments, **changes})
 
 
 def uncertainty(**changes):
-    return validation.DirectionUncertainty(**{"constant": 3.0, **changes})
+    return references.DirectionUncertainty(**{"constant": 3.0, **changes})
 
 
 LAYOUT = (np.array([0.0, 400.0, 800.0]), np.zeros(3))  # a row along 270 deg, 5 D apart
@@ -54,7 +61,7 @@ def farm(**changes):
     arguments = dict(name="my farm", layout=LAYOUT, turbine=turbine(), wind_speed=8.0,
                      latitude=54.0, turbulence=0.06, direction_uncertainty=uncertainty(),
                      rows=(row(),), efficiency=efficiency(), offshore=True)
-    return validation.FarmCase(**{**arguments, **changes})
+    return farm_case.FarmCase(**{**arguments, **changes})
 
 
 # ----------------------------------------------------------------------- what a user gets
@@ -89,7 +96,7 @@ def test_farm_efficiency_averages_each_turbine_over_the_direction_uncertainty():
     assert averaged["efficiency"].iloc[1] > raw["efficiency"].iloc[1]  # the aligned minimum
     np.testing.assert_array_equal(raw["standard_error"], [0.01, 0.02, 0.01])
 
-    errors = validation.efficiency_errors(table)
+    errors = metrics.efficiency_errors(table)
     (row_,) = errors[errors["kind"] == "averaged"].itertuples()
     error = averaged["efficiency"].to_numpy() - [0.9, 0.7, 0.9]
     assert (row_.n, row_.rmse, row_.bias) == pytest.approx((3, np.sqrt(np.mean(error**2)),
@@ -97,9 +104,9 @@ def test_farm_efficiency_averages_each_turbine_over_the_direction_uncertainty():
     assert row_.standard_error == pytest.approx(np.sqrt((0.01**2 + 0.02**2 + 0.01**2) / 3))
     without = models.farm_efficiency(farm(efficiency=efficiency(standard_error=None)), ["M-1"],
                                      sample_step=2.0)
-    assert np.isnan(validation.efficiency_errors(without)["standard_error"]).all()
+    assert np.isnan(metrics.efficiency_errors(without)["standard_error"]).all()
     # A table built elsewhere (a peer model's) without kind or standard error is scored too.
-    other = validation.efficiency_errors(raw.drop(columns=["kind", "standard_error"]))
+    other = metrics.efficiency_errors(raw.drop(columns=["kind", "standard_error"]))
     assert other[["rmse", "bias"]].to_numpy().tolist() == errors[errors["kind"] == "raw"][
         ["rmse", "bias"]].to_numpy().tolist()
 
@@ -109,12 +116,12 @@ def test_total_turbulence_converts_with_the_neutral_surface_layer_ratio():
     streamwise_turbulence divides by it; the single wakes read their total TI so."""
     ratio = math.sqrt((2.39**2 + 1.92**2 + 1.25**2) / 3.0) / 2.39
     assert round(ratio, 2) == atmospheres.TOTAL_OVER_STREAMWISE == 0.8
-    assert validation.streamwise_turbulence(0.048) == pytest.approx(0.06, rel=1e-15)
+    assert atmospheres.streamwise_turbulence(0.048) == pytest.approx(0.06, rel=1e-15)
     nibe = cases.SINGLE_WAKE_CASES["Nibe"]
     assert nibe.streamwise_turbulence == pytest.approx(0.08 / 0.8, rel=1e-15)
     for bad in (0.0, -0.1, 0.8, float("nan"), "0.1"):
         with pytest.raises(ValueError, match="total_turbulence"):
-            validation.streamwise_turbulence(bad)
+            atmospheres.streamwise_turbulence(bad)
 
 
 def test_labels_carry_the_settings_and_make_good_keys():
@@ -147,7 +154,7 @@ def test_labels_carry_the_settings_and_make_good_keys():
 def test_power_and_thrust_on_separate_speed_grids():
     """C_T on its own grid: the turbine runs where both curves are given, on the union of the
     grids there, each curve interpolated linearly; one grid gives the table as before."""
-    t = validation.turbine_from_table("T", 80.0, 70.0, [3.0, 6.0, 12.0, 25.0],
+    t = turbines.turbine_from_table("T", 80.0, 70.0, [3.0, 6.0, 12.0, 25.0],
                                       [0.0, 300.0, 2000.0, 2000.0], [0.9, 0.75, 0.1],
                                       thrust_wind_speed=[4.0, 9.0, 20.0])
     table = t["power_thrust_table"]
@@ -157,11 +164,11 @@ def test_power_and_thrust_on_separate_speed_grids():
         [0.9, 0.9 - 0.15 * 2 / 5, 0.75, 0.75 - 0.65 * 3 / 11, 0.1])
     assert turbine()["power_thrust_table"]["wind_speed"] == [0.0, 3.9, *SPEED, 25.1, 50.0]
     with pytest.raises(ValueError, match="overlap"):
-        validation.turbine_from_table("T", 80.0, 70.0, [3.0, 6.0], [10.0, 300.0], [0.8, 0.7],
+        turbines.turbine_from_table("T", 80.0, 70.0, [3.0, 6.0], [10.0, 300.0], [0.8, 0.7],
                                       thrust_wind_speed=[6.0, 9.0])
     with pytest.raises(ValueError, match="thrust_coefficient must have one value per "
                                          "thrust_wind_speed"):
-        validation.turbine_from_table("T", 80.0, 70.0, SPEED, POWER, THRUST,
+        turbines.turbine_from_table("T", 80.0, 70.0, SPEED, POWER, THRUST,
                                       thrust_wind_speed=[4.0, 9.0])
 
 
@@ -171,10 +178,10 @@ def test_offshore_is_required_and_sets_the_site_roughness():
     arguments = dict(name="f", layout=LAYOUT, turbine=turbine(), wind_speed=8.0, latitude=54.0,
                      turbulence=0.06)
     with pytest.raises(TypeError, match="offshore"):
-        validation.FarmCase(**arguments)
-    assert validation.FarmCase(**arguments, offshore=False).site_roughness == 0.03
-    assert validation.FarmCase(**arguments, offshore=True).site_roughness == 2e-4
-    assert validation.FarmCase(**arguments, offshore=False, roughness_length=0.1).site_roughness == 0.1
+        farm_case.FarmCase(**arguments)
+    assert farm_case.FarmCase(**arguments, offshore=False).site_roughness == 0.03
+    assert farm_case.FarmCase(**arguments, offshore=True).site_roughness == 2e-4
+    assert farm_case.FarmCase(**arguments, offshore=False, roughness_length=0.1).site_roughness == 0.1
 
 
 def test_a_farm_given_its_own_atmosphere_runs_the_given_reading():
@@ -254,7 +261,7 @@ ISSUE_LIST = [
     ("uncertainty reference out of range",
      lambda: farm(direction_uncertainty=uncertainty(reference_turbine=3)), "reference_turbine"),
     ("uncertainty 1e4 deg", lambda: uncertainty(constant=1e4), "constant"),
-    ("uncertainty a string", lambda: validation.DirectionUncertainty("x"), "constant"),
+    ("uncertainty a string", lambda: references.DirectionUncertainty("x"), "constant"),
     ("offshore a string", lambda: farm(offshore="yes"), "offshore"),
     ("turbulence unreachable", lambda: farm(turbulence=0.9), "turbulence"),
 ]

@@ -10,31 +10,8 @@ What runs on a case: ``atmospheres`` (the atmosphere every model runs on, the TI
 ``models`` (the FLORIS models run into tidy tables, with labels that carry their settings),
 ``metrics`` (the error tables). ``examples/validate.py`` writes the tables and figures.
 
-The names a user's farm needs are importable from here (docs/validation.md#your-own-farm):
-``FarmCase``, ``RowReference``, ``EfficiencyReference``, ``DirectionUncertainty``,
-``turbine_from_table``, ``streamwise_turbulence``, ``row_ratios``, ``farm_efficiency``,
-``row_errors``, ``efficiency_errors``, ``model_label`` and ``WAKE_MODELS``.
+A user's farm goes through the same modules (docs/validation.md#your-own-farm).
 
 May import: the base, the physics, the plugin, FLORIS and the other studies; never the registry
 or the package's top (docs/architecture.md).
 """
-
-from floris_ekman_veer.studies.validation.atmospheres import streamwise_turbulence
-from floris_ekman_veer.studies.validation.farm_case import FarmCase
-from floris_ekman_veer.studies.validation.metrics import efficiency_errors, row_errors
-from floris_ekman_veer.studies.validation.models import (
-    WAKE_MODELS,
-    farm_efficiency,
-    model_label,
-    row_ratios,
-)
-from floris_ekman_veer.studies.validation.references import (
-    DirectionUncertainty,
-    EfficiencyReference,
-    RowReference,
-)
-from floris_ekman_veer.studies.validation.turbines import turbine_from_table
-
-__all__ = ["WAKE_MODELS", "DirectionUncertainty", "EfficiencyReference", "FarmCase",
-           "RowReference", "efficiency_errors", "farm_efficiency", "model_label", "row_errors",
-           "row_ratios", "streamwise_turbulence", "turbine_from_table"]
