@@ -128,7 +128,8 @@ def sector_roughness(direction):
 def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.DataFrame:
     """The records (module docstring): one row per record, the instruments' columns and the
     generator's truth (``true_class``, ``true_obukhov_length``, ``true_calm``,
-    ``true_stuck_<h>m``, ``true_direction_80m``), in time order."""
+    ``true_stuck_<h>m``, ``true_direction_80m``, ``true_roughness_length``), in time order; each
+    cup's drawn calibration factor in ``table.attrs["true_cup_calibration"]``."""
     rng = np.random.default_rng(seed)
     time = pd.date_range("2025-01-01 00:00", periods=periods, freq=freq)
     n = time.size
@@ -178,12 +179,14 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     turning = abl.wind_angle(REFERENCE_HEIGHT)  # meteorological direction = const - wind_angle
 
     columns = {"time": time.strftime("%Y-%m-%d %H:%M")}
+    calibration = {}
     for h in CUP_HEIGHTS:
         true = abl.speed(h)
         intensity = np.asarray(abl.turbulence_intensity(h), float)
         for name, orientation in BOOMS.items():
             deficit = shadow_deficit(direction, orientation)
             bias = 1.0 + rng.normal(0.0, CUP_BIAS)
+            calibration[f"speed_{h:.0f}m_{name}"] = bias
             read = (true * (1.0 - deficit) * bias * (1.0 + rng.normal(0.0, CUP_ERROR, n))
                     + rng.normal(0.0, CUP_OFFSET_ERROR, n))
             spikes = rng.uniform(size=n) < SPIKE_FRACTION
@@ -228,6 +231,9 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
         table[f"true_stuck_{h:.0f}m"] = stuck[h]
     table["true_direction_80m"] = np.mod(direction, 360.0)
     table["true_roughness_length"] = roughness
+    # Each cup's drawn calibration (reading / truth): constant per cup, so kept beside the table
+    # (what the cup's calibration certificate would say) rather than as a column.
+    table.attrs["true_cup_calibration"] = calibration
     return table
 
 
