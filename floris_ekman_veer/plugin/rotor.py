@@ -29,7 +29,10 @@ from floris_ekman_veer.wake.fused import program
 
 # The area weight of a sub-point in the wake's overlap (rotor_cell_deficit): velocity above
 # WAKE_OVERLAP_VELOCITY, within ``reach`` (2 D) of the wake's rotor laterally.
-_OVERLAP = (f"where((du > {WAKE_OVERLAP_VELOCITY!r}) & (abs(dy + centre) < reach), weight, 0)")
+# ``edge`` is WAKE_OVERLAP_VELOCITY (FLORIS's count) or, for ``turbulence_overlap: wake_radius``,
+# the wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar & Porte-Agel
+# 2016).
+_OVERLAP = "where((du > edge) & (abs(dy + centre) < reach), weight, 0)"
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -52,6 +55,12 @@ PAIR_CHUNK = 1024
 #: combines it; all of them, their variances summed), tracked here on a turbine grid.
 WAKE_EXPANSIONS = ("ambient", "local_turbulence", "array_turbulence")
 ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
+
+#: The velocity models' ``turbulence_overlap`` choices: the part of a rotor a wake's added
+#: turbulence is weighted with, the area where its velocity exceeds WAKE_OVERLAP_VELOCITY
+#: (FLORIS's count) or where the rotor lies inside the wake radius 2 sigma (Niayifar &
+#: Porte-Agel 2016, docs/coupling.md#wakes-deep-in-an-array).
+TURBULENCE_OVERLAPS = ("wake_velocity", "wake_radius")
 
 #: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
 DEFICIT_VELOCITIES = ("incoming", "free_stream")
@@ -249,6 +258,11 @@ def rotor_cell_deficit(
     else:
         order = np.argsort(widths, kind="stable")
         groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
+    edge = np.float64(WAKE_OVERLAP_VELOCITY)
+    if track and model.turbulence_overlap == "wake_radius":
+        # The wake's velocity at 2 sigma from its centre, per rotor reached.
+        edge = np.exp(-2.0) * model.centre_deficit(x_pair, *(per_pair[k] for k in (
+            "k_w", "radius", "ct", "yaw"))) * per_pair["hub_speed"] * per_pair["speed_fraction"]
     # The deficit's factors that depend on the wake only, once per rotor reached.
     wake_parameters = model.wake_parameters(x_pair, *(per_pair[k] for k in (
         "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
@@ -296,6 +310,7 @@ def rotor_cell_deficit(
             # rotor laterally, here as the area of the disk where it holds.
             row_overlap[chunk] = column_sums(program(_OVERLAP)(
                 du=du, dy=dy, centre=centre[pe, re][None, :], reach=4.0 * pair["radius"],
+                edge=edge if edge.ndim == 0 else edge[pe][None, :],
                 weight=cells.weight_columns[:width, re]))
 
     map_pieces(integrate, pieces)

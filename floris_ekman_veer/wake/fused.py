@@ -84,11 +84,16 @@ _COSINE = "where(dy**2 + dz**2 > 0, dy / sqrt(where(dy**2 + dz**2 > 0, dy**2 + d
 _CURL = "(q0 + c * (q1 + c * (q2 + c * (q3 + c * q4))))"
 _SIGMA = f"(kx + xi0 / sqrt(1 - sin2b * (1 - c**2)) * {_CURL})"
 _DEFICIT = f"amplitude * exp(-(dy**2 + dz**2) / (2 * {_SIGMA}**2))"
+# The near wake's super-Gaussian of order n (wake/near_wake.py; its width factor is in kx, xi0).
+_SHAPED = f"amplitude * exp(-((dy**2 + dz**2) / (2 * {_SIGMA}**2))**(0.5 * order))"
 
 
-def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True):
+def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
+                            shape=None):
     """The per-wake factors of Eq. (du_model) (see :func:`rows_deficit_parameters`), evaluated
-    once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor."""
+    once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor;
+    with ``shape`` = (n, m) of the near wake (wake/near_wake.py) also the order n, the width
+    factor m scaling k_w x and xi0 (sigma is linear in both; m = 1 leaves them bit for bit)."""
     r_tube = initial_radius(radius, ct, yaw)
     parameters = {
         "amplitude": max_deficit(x, k_w, radius, ct, yaw),
@@ -96,6 +101,11 @@ def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
         "xi0": WIDTH_FACTOR * r_tube * np.abs(np.cos(yaw)),
         "sin2b": np.sin(yaw) ** 2,
     }
+    if shape is not None:
+        order, factor = shape
+        parameters["kx"] = parameters["kx"] * factor
+        parameters["xi0"] = parameters["xi0"] * factor
+        parameters["order"] = order
     if curl:
         parameters["strength"] = time_like_strength(friction_velocity, hub_speed, ct, yaw)
     return parameters
@@ -120,7 +130,7 @@ def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
         a2 = a3 = a4 = np.zeros(1)
     # xi_hat = 1 - (a2 (2c^2 - 1) + a3 (4c^3 - 3c) + a4 (8c^4 - 8c^2 + 1)) = sum_k q_k c^k.
     return {
-        **{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b")},
+        **{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b", "order") if k in wake},
         "q0": 1.0 + a2 - a4, "q1": 3.0 * a3, "q2": 8.0 * a4 - 2.0 * a2, "q3": -4.0 * a3,
         "q4": -8.0 * a4,
     }
@@ -130,4 +140,11 @@ def deficit_on_rows(dy, dz, parameters):
     """Delta u / U_h of Eq. (du_model) at points (dy, dz) from the factors of
     :func:`rows_deficit_parameters` (two numexpr passes: cos(theta), then the deficit)."""
     c = program(_COSINE)(dy=dy, dz=dz)
-    return program(_DEFICIT)(dy=dy, dz=dz, c=c, **parameters)
+    gaussian = {k: v for k, v in parameters.items() if k != "order"}
+    deficit = program(_DEFICIT)(dy=dy, dz=dz, c=c, **gaussian)
+    order = parameters.get("order")
+    if order is None or not np.any(order != 2.0):
+        return deficit
+    # Inside a potential core: the super-Gaussian there, the Gaussian (bit for bit) elsewhere.
+    shaped = program(_SHAPED)(dy=dy, dz=dz, c=c, **parameters)
+    return np.where(order == 2.0, deficit, shaped)

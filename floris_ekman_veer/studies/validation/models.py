@@ -119,7 +119,8 @@ def floris_input(case, reading: str, model) -> dict:
             "wake_deflection_parameters": {"ekman_veer": parameters.get("deflection", {}),
                                            "gauss": None, "empirical_gauss": None},
             "wake_velocity_parameters": velocity_parameters,
-            "wake_turbulence_parameters": {"crespo_hernandez": None, "wake_induced_mixing": None},
+            "wake_turbulence_parameters": {"crespo_hernandez": None, "wake_induced_mixing": None,
+                                           **parameters.get("turbulence", {})},
         },
     }
 
