@@ -25,12 +25,18 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 
-from floris_ekman_veer.studies.validation import metrics
-from floris_ekman_veer.studies.validation.cases import HORNS_REV, LILLGRUND
+from floris_ekman_veer.studies.validation import metrics, models
+from floris_ekman_veer.studies.validation.cases import (
+    HORNS_REV,
+    LILLGRUND,
+    SINGLE_WAKE_CASES,
+    constant_thrust_turbine,
+)
 
 #: Sample spacing of the direction-uncertainty average [deg] (as examples/validate.py).
 SAMPLE_STEP = 1.0
@@ -45,12 +51,12 @@ def pywake_models():
 
 
 def pywake_turbine(case):
-    """The case's FLORIS turbine table as a PyWake wind turbine."""
+    """The case's FLORIS turbine table (``case.turbine``) as a PyWake wind turbine."""
     from py_wake.wind_turbines import WindTurbine
     from py_wake.wind_turbines.power_ct_functions import PowerCtTabular
 
     table = case.turbine["power_thrust_table"]
-    return WindTurbine(name=case.turbine["turbine_type"], diameter=case.rotor_diameter,
+    return WindTurbine(name=str(case.turbine["turbine_type"]), diameter=case.rotor_diameter,
                        hub_height=case.hub_height,
                        powerCtFunction=PowerCtTabular(
                            ws=np.asarray(table["wind_speed"], dtype=float),
@@ -121,6 +127,33 @@ def farm_efficiency(case, label, model_class) -> pd.DataFrame:
                          "reference": reference.efficiency})
 
 
+def arc_profiles(case, model_class, step: float = 0.5) -> np.ndarray:
+    """U/U0 at hub height on the single-wake case's arcs (``models.arc_profiles``' layout: rows
+    ``case.distances``, columns ``models.arc_directions``), PyWake's model on uniform inflow at
+    the case's speed and total TI (as PyWake's validation gives them), the case's C_T."""
+    from py_wake.flow_map import Points
+    from py_wake.site import UniformSite
+
+    turbine = constant_thrust_turbine(case)
+    pywake = pywake_turbine(SimpleNamespace(
+        turbine=turbine, rotor_diameter=case.rotor_diameter, hub_height=case.hub_height))
+    site = UniformSite(p_wd=[1], ti=case.total_turbulence, ws=case.wind_speed)
+    theta = np.radians(models.arc_directions(step))
+    radius = np.asarray(case.distances)[:, None] * case.rotor_diameter
+    # PyWake's wind from 270 deg blows along +x, as FLORIS's.
+    x, y = radius * np.cos(theta), radius * np.sin(theta)
+    result = model_class(site, pywake)([0.0], [0.0], wd=[270.0], ws=[case.wind_speed], yaw=0)
+    flow = result.flow_map(Points(x.ravel(), y.ravel(), np.full(x.size, case.hub_height)))
+    return np.asarray(flow.WS_eff).reshape(x.shape) / case.wind_speed
+
+
+def _pooled(chosen) -> str:
+    if not chosen:
+        return "-"
+    rmse, bias, _ = metrics.pooled(chosen)
+    return f"{rmse:.3f} ({bias:+.3f})"
+
+
 def _cell(row) -> str:
     return f"{row.rmse:.3f} ({row.bias:+.3f})"
 
@@ -144,6 +177,21 @@ def main(argv=None) -> None:
                  for case in (HORNS_REV, LILLGRUND) for kind in ("averaged", "raw")]
         efficiency = metrics.efficiency_errors(farm_efficiency(HORNS_REV, label, model_class))
         print(f"| {label} | " + " | ".join(cells) + f" | {_cell(next(efficiency.itertuples()))} |")
+    print()
+    print("Single wakes: RMSE (bias) of U/U0 pooled over the arcs, against the measurements / "
+          "the LES")
+    print("| model | " + " | ".join(SINGLE_WAKE_CASES) + " |")
+    print("|---|" + "---|" * len(SINGLE_WAKE_CASES))
+    for label, model_class in pywake_models().items():
+        cells = []
+        for case in SINGLE_WAKE_CASES.values():
+            errors = metrics.arc_errors(case, arc_profiles(case, model_class))
+            parts = []
+            for reference in ("measured", "les"):
+                chosen = [e for e in errors if e["reference"] == reference]
+                parts.append(_pooled(chosen))
+            cells.append(" / ".join(parts))
+        print(f"| {label} | " + " | ".join(cells) + " |")
     print()
     for case in (HORNS_REV, LILLGRUND):
         chosen = rows[(rows["case"] == case.name) & (rows["kind"] == "averaged")]
