@@ -621,10 +621,11 @@ def farm(layout, wind_directions=WIND_DIRECTIONS, wind_speeds=WIND_SPEEDS, yaw=N
                  wind_speeds=list(wind_speeds),
                  turbulence_intensities=[0.06] * len(wind_speeds))
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = list(layout[0]), list(layout[1])
-    # The baselines pin the paper's k_w with FLORIS's free-stream sum of squares (the farm
-    # input's array coupling is pinned by test_array_coupling_*).
+    # The baselines pin the paper's model: its k_w and its Gaussian inside the potential core,
+    # with FLORIS's free-stream sum of squares (the farm input's array coupling is pinned by
+    # test_array_coupling_*, the near wake by tests/physics/test_near_wake.py).
     cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
-        wake_expansion="ambient", deficit_velocity="free_stream")
+        wake_expansion="ambient", deficit_velocity="free_stream", near_wake="potential_core")
     cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
     fmodel = FlorisModel(cfg)
     if yaw is not None:
