@@ -13,7 +13,7 @@ import numpy as np
 from floris import FlorisModel
 
 from floris_ekman_veer.studies import comparison
-from floris_ekman_veer.plugin import inflow, solve_cache
+from floris_ekman_veer.plugin.inflow import inflow, solve_cache
 
 N_CONDITIONS, N_TURBINES, REPEATS = 1000, 100, 5
 ATMOSPHERE = {

@@ -27,7 +27,7 @@ worst case, and the errors of an unwaked rotor (the ambient profile alone). ``--
 
 Multiple wakes: every turbine's power with the shipped settings (the farm input's wake settings:
 sosfs, crespo_hernandez, local_turbulence; 3 x 3 rotor cells) against the converged point-wise
-reference of tests/plugin/multiwake_reference.py (FLORIS's point-wise sosfs, wake-added turbulence and
+reference of tests/plugin/rotor/multiwake_reference.py (FLORIS's point-wise sosfs, wake-added turbulence and
 cubic mean on 4,096 equal-area points per rotor), for the layouts of MULTIWAKE_CASES in the
 SBL-6, SBL-4 and neutral atmospheres: the largest |P / P_ref - 1| over turbines and conditions.
 """
@@ -47,7 +47,7 @@ import floris_ekman_veer  # noqa: F401
 from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-from tests.plugin.multiwake_reference import (  # noqa: E402  (the tests' reference)
+from tests.plugin.rotor.multiwake_reference import (  # noqa: E402  (the tests' reference)
     FARM_3X3,
     SIDE_BY_SIDE,
     disk_quadrature,

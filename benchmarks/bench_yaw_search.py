@@ -15,8 +15,8 @@
    search.
 3. Rebuild: the 3 x 3 night farm with an Obukhov length per condition, both signs, with the
    optimiser subsets' condition rebuild and with FLORIS's full Core rebuild per evaluation
-   (plugin/optimizer_conditions.py ``_reinitialize_conditions``): time and bitwise comparison.
-4. Shortfall: 3-turbine rows held out from the yaw study (tests/studies/test_yaw_search.py): the farm
+   (plugin/floris_tools/optimizer_conditions.py ``_reinitialize_conditions``): time and bitwise comparison.
+4. Shortfall: 3-turbine rows held out from the yaw study (tests/studies/yaw/test_yaw_search.py): the farm
    power of FLORIS's single run and of the both-signs search against a brute-force search on a
    1-degree grid of all three yaws refined by Nelder-Mead (the reference the tests build), for
    bounds -25..25 deg.
@@ -35,11 +35,11 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 
 import floris_ekman_veer  # noqa: F401
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
 
 ROOT = Path(__file__).resolve().parents[1]
-from tests.studies import test_yaw_search as reference  # the tests' brute-force reference
+from tests.studies.yaw import test_yaw_search as reference  # the tests' brute-force reference
 
 OPTIONS = dict(minimum_yaw_angle=-25.0, maximum_yaw_angle=25.0, Ny_passes=[5, 4])
 
@@ -133,7 +133,7 @@ def rebuild(repeats: int):
     its own Obukhov length (one row-following run), both signs, with the optimiser subsets'
     condition rebuild and with FLORIS's full Core rebuild at every evaluation, interleaved, best
     of ``repeats``; the two results compared bit for bit."""
-    from floris_ekman_veer.plugin import optimizer_conditions as optimization
+    from floris_ekman_veer.plugin.floris_tools import optimizer_conditions as optimization
 
     quick = optimization._reinitialize_conditions
     full = FlorisModel._reinitialize  # bound to each subset as the condition rebuild is

@@ -59,7 +59,7 @@ from floris import FlorisModel, TimeSeries
 import floris_ekman_veer
 from floris_ekman_veer import annual_energy
 from floris_ekman_veer.studies.comparison import builtin_model
-from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, set_atmosphere
 
 INPUT = Path(__file__).resolve().parents[1] / "inputs" / "farm_night.yaml"
 N_CLASSES = 6
@@ -224,7 +224,7 @@ def at_rated(fmodel, series, stability, names) -> None:
     every turbine at the maximum of its power table (which a steered study does not optimise)
     and, for a tolerance that was considered instead, within 1e-4 and 1e-3 of the record's
     power of it (the loss to rated summed over the turbines)."""
-    from floris_ekman_veer.studies import condition_chunks as energy
+    from floris_ekman_veer.studies.energy import condition_chunks as energy
 
     model = fmodel.copy()
     atmosphere = {key: [stability[name]["atmosphere"][key] for name in names]
@@ -264,7 +264,7 @@ def steered(fmodel, series, stability, names, args) -> None:
     a LocalCluster; times, the extrapolation to 8,760 records and the bitwise check."""
     from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
-    from floris_ekman_veer.studies import condition_chunks as energy
+    from floris_ekman_veer.studies.energy import condition_chunks as energy
 
     n = min(args.steered, len(names))
     subset = TimeSeries(series.wind_directions[:n], series.wind_speeds[:n],

@@ -40,7 +40,7 @@ from floris import FlorisModel  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer.studies.comparison import builtin_inflow_settings  # noqa: E402
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"
 SIDE, SPACING = 10, 7 * 126.0

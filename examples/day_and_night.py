@@ -28,7 +28,7 @@ from floris import FlorisModel
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL
 from floris_ekman_veer.atmosphere.ekman import gdl_coefficients
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 #: The site of the shipped inputs and the paper's cases.

@@ -51,8 +51,8 @@ from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
 from floris_ekman_veer.studies.comparison import builtin_inflow_settings  # noqa: E402
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
-from floris_ekman_veer.plugin.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.plugin.inflow.inflow import ambient_velocity  # noqa: E402
 from floris_ekman_veer.studies.validity import validity_report, validity_summary  # noqa: E402
 
 FARM_INPUT = REPOSITORY / "inputs" / "farm_sbl6.yaml"

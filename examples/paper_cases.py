@@ -57,7 +57,7 @@ from floris.flow_visualization import visualize_cut_plane  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
 from floris_ekman_veer import EkmanABL  # noqa: E402
-from floris_ekman_veer.plugin.inflow import ambient_velocity  # noqa: E402
+from floris_ekman_veer.plugin.inflow.inflow import ambient_velocity  # noqa: E402
 from floris_ekman_veer.studies.validity import validity_report, validity_summary  # noqa: E402
 from floris_ekman_veer.wake.deficit import max_deficit, potential_core_length  # noqa: E402
 

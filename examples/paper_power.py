@@ -56,7 +56,7 @@ from paper_cases import (  # noqa: E402
 
 from floris import FlorisModel  # noqa: E402
 
-from floris_ekman_veer.plugin.turbine import induction_factor  # noqa: E402
+from floris_ekman_veer.plugin.rotor.turbine import induction_factor  # noqa: E402
 
 #: FLORIS's rotor quadrature for the downstream disk, per model: the inputs' own 3 x 3 turbine
 #: grid for this package's models, whose rotor cells integrate the disk

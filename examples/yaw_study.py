@@ -50,9 +50,9 @@ from floris_ekman_veer.studies.comparison import (  # noqa: E402
     comparison_set_kwargs,
     fair_builtin_set_kwargs,
 )
-from floris_ekman_veer.plugin.inflow import set_atmosphere  # noqa: E402
+from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere  # noqa: E402
 from floris_ekman_veer.studies.validity import validity_report, validity_summary  # noqa: E402
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning  # noqa: E402
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning  # noqa: E402
 
 DAY_INPUT = REPOSITORY / "inputs" / "farm_day.yaml"
 NIGHT_INPUT = REPOSITORY / "inputs" / "farm_night.yaml"

@@ -24,9 +24,9 @@ from floris_ekman_veer._version import __version__
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.example_inputs import example_input, example_inputs
 from floris_ekman_veer.registry import register
-from floris_ekman_veer.studies.distributed import ParFlorisModel
-from floris_ekman_veer.studies.energy import annual_energy
-from floris_ekman_veer.studies.optimization import optimize_yaw
+from floris_ekman_veer.studies.energy.distributed import ParFlorisModel
+from floris_ekman_veer.studies.energy.energy import annual_energy
+from floris_ekman_veer.studies.yaw.optimization import optimize_yaw
 from floris_ekman_veer.studies.site import fit_site
 from floris_ekman_veer.studies.validity import validity_report
 from floris_ekman_veer.warnings import (

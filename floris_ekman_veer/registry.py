@@ -3,7 +3,7 @@
 ``register()`` makes the wake models selectable by name in a FLORIS input
 (``velocity_model: ekman_veer``, ``deflection_model: ekman_veer``, ``velocity_model:
 bastankhah2014``), adds the ``actuator-disk`` turbine operation model and installs every FLORIS
-patch by walking the patch tables (plugin/patches.py: the Ekman inflow, the support of
+patch by walking the patch tables (plugin/floris_hooks/patches.py: the Ekman inflow, the support of
 ParFlorisModel, UncertainFlorisModel and the yaw optimisers, the conversion of FLORIS wake inputs,
 the veer-aware rotor and the models' solver). Importing ``floris_ekman_veer`` calls it.
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 import difflib
 from collections.abc import MutableMapping
 
-from floris_ekman_veer.plugin.names import (  # noqa: F401  (part of the registry's interface)
+from floris_ekman_veer.plugin.wake_models.names import (  # noqa: F401  (part of the registry's interface)
     DEFLECTION_MODEL_NAME,
     GAUSSIAN_2014_NAME,
     VELOCITY_MODEL_NAME,
@@ -92,7 +92,7 @@ def register_operation_model() -> type:
     """
     from floris.core.turbine import turbine as floris_turbine
 
-    from floris_ekman_veer.plugin.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
+    from floris_ekman_veer.plugin.rotor.turbine import OPERATION_MODEL_NAME, ActuatorDiskTurbine
 
     name_checked(floris_turbine.TURBINE_MODEL_MAP, OPERATION_MODEL_PATH)
     return register_in(
@@ -103,10 +103,10 @@ def register_operation_model() -> type:
 
 def patch_tables() -> tuple:
     """The tables of FLORIS patches :func:`register` installs (tuples of
-    :class:`~floris_ekman_veer.plugin.patches.Patch` rows): the plugin's
-    (plugin/patches.py) and the yaw optimisers' (docs/coupling.md#what-is-patched)."""
-    from floris_ekman_veer.plugin.patches import PATCHES
-    from floris_ekman_veer.plugin.optimizer_hooks import PATCHES as OPTIMIZER_PATCHES
+    :class:`~floris_ekman_veer.plugin.floris_hooks.patches.Patch` rows): the plugin's
+    (plugin/floris_hooks/patches.py) and the yaw optimisers' (docs/coupling.md#what-is-patched)."""
+    from floris_ekman_veer.plugin.floris_hooks.patches import PATCHES
+    from floris_ekman_veer.plugin.floris_tools.optimizer_hooks import PATCHES as OPTIMIZER_PATCHES
 
     return (PATCHES, OPTIMIZER_PATCHES)
 
@@ -117,8 +117,8 @@ def register() -> None:
     optimiser support, the wake inputs, the veer-aware rotor and the models' solver)."""
     from floris.core.wake import MODEL_MAP
 
-    from floris_ekman_veer.plugin.deflection_model import EkmanVeerVelocityDeflection
-    from floris_ekman_veer.plugin.models import EkmanVeerVelocityDeficit, Gaussian2014VelocityDeficit
+    from floris_ekman_veer.plugin.wake_models.deflection_model import EkmanVeerVelocityDeflection
+    from floris_ekman_veer.plugin.wake_models.models import EkmanVeerVelocityDeficit, Gaussian2014VelocityDeficit
 
     name_checked(MODEL_MAP, MODEL_PATHS)
     register_in(MODEL_MAP["velocity_model"], VELOCITY_MODEL_NAME, EkmanVeerVelocityDeficit,

@@ -15,7 +15,7 @@ to::
 or, before Python starts, ``FLORIS_EKMAN_VEER_WARNINGS=ignore`` (or a comma-separated list of
 class names) in the environment. The setting lives in that environment variable, which process
 pools inherit; it travels with every model the package sends to a ParFlorisModel worker
-(plugin/parallel.py) and is set on the Dask workers at each run (studies/distributed.py). ``silence_warnings(None)`` restores the
+(plugin/floris_tools/parallel.py) and is set on the Dask workers at each run (studies/energy/distributed.py). ``silence_warnings(None)`` restores the
 default. Python's own
 warning filters work as usual in the process where they are set.
 """

@@ -16,7 +16,7 @@ top level (``from floris_ekman_veer import ShallowBoundaryLayerWarning``), and e
 * said by the process the user runs: in ParFlorisModel's worker processes (multiprocessing,
   concurrent, Dask) the warnings are recorded and travel back with each chunk's result, and the
   parent reports them as a serial run would (one thrust-limit summary counting all the run's
-  conditions; nothing the parent already said), at the user's line (plugin/parallel.py).
+  conditions; nothing the parent already said), at the user's line (plugin/floris_tools/parallel.py).
 
 The classes and the silencing setting are ``floris_ekman_veer.warning_classes``; this module
 raises them, and is where the rest of the package imports them from.

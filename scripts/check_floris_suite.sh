@@ -89,7 +89,7 @@ if MODE == "package":
 def _state():
     state = {"mode": MODE, "imported": "floris_ekman_veer" in sys.modules, "installed": False}
     if state["imported"]:
-        from floris_ekman_veer.plugin import patching
+        from floris_ekman_veer.plugin.floris_hooks import patching
 
         state["installed"] = patching.is_installed()
         state["patched"] = sorted(f"{owner.__name__}.{name}" for owner, name in patching.ORIGINALS)

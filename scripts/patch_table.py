@@ -4,7 +4,7 @@ docs/coupling.md#what-is-patched, between its two marker lines:
     python scripts/patch_table.py          # rewrite the table
     python scripts/patch_table.py --check  # exit 1 if the page's table is not the installed one
 
-``tests/plugin/test_patches.py`` runs the check.
+``tests/plugin/floris_hooks/test_patches.py`` runs the check.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from floris_ekman_veer.plugin.patches import markdown_table
+from floris_ekman_veer.plugin.floris_hooks.patches import markdown_table
 from floris_ekman_veer.registry import patch_tables
 
 PAGE = Path(__file__).resolve().parent.parent / "docs" / "coupling.md"

@@ -11,7 +11,7 @@ import pytest
 from floris import FlorisModel
 from hypothesis import HealthCheck, Phase, settings
 
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin.inflow import inflow
 
 # Hypothesis profiles, selected by the environment variable HYPOTHESIS_PROFILE (README, "Set up"):
 # "ci" (default): few examples, derandomised (reproducible CI), no example database; "long": the

@@ -2,7 +2,7 @@
 the physics assertions next to their tests are what establishes correctness.
 
 * ``baseline_row``, ``yawed_baseline_row``, ``baseline_square``: NREL 5 MW farms in the farm_sbl6
-  atmosphere (tests/plugin/test_models.py, section 4; set its ``DEBUG = True`` to print them).
+  atmosphere (tests/plugin/wake_models/test_models.py, section 4; set its ``DEBUG = True`` to print them).
 * ``ARC_BASELINE``, ``ROWS_BASELINE``, ``EFFICIENCY_BASELINE``: the validation study's error tables
   on its reduced set (tests/studies/test_validation_cases.py).
 """

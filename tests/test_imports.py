@@ -76,8 +76,8 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
 def test_the_graph_is_read():
     edges = internal_edges()
     # Known edges, so that an empty graph (a broken parser) cannot pass the cycle test.
-    assert "floris_ekman_veer.plugin.inflow" in edges["floris_ekman_veer.plugin.parallel"]
-    assert "floris_ekman_veer.plugin.turbine" in edges["floris_ekman_veer.registry"]
+    assert "floris_ekman_veer.plugin.inflow.inflow" in edges["floris_ekman_veer.plugin.floris_tools.parallel"]
+    assert "floris_ekman_veer.plugin.rotor.turbine" in edges["floris_ekman_veer.registry"]
     assert "floris_ekman_veer.registry" in edges[PACKAGE]
 
 
@@ -117,8 +117,8 @@ def layer(name: str) -> str:
 def test_every_module_has_its_layer():
     layers = {name: layer(name) for name in MODULES}
     assert layers[f"{PACKAGE}.atmosphere.ekman"] == layers[f"{PACKAGE}.wake.deficit"] == "physics"
-    assert layers[f"{PACKAGE}.plugin.models"] == layers[f"{PACKAGE}.plugin.inflow"] == "plugin"
-    assert layers[f"{PACKAGE}.studies.optimization"] == "studies"
+    assert layers[f"{PACKAGE}.plugin.wake_models.models"] == layers[f"{PACKAGE}.plugin.inflow.inflow"] == "plugin"
+    assert layers[f"{PACKAGE}.studies.yaw.optimization"] == "studies"
     assert layers[f"{PACKAGE}.studies.validation.cases"] == "studies"
     assert layers[f"{PACKAGE}.registry"] == layers[PACKAGE] == "top"
     # every layer holds modules, so that no rule below passes on an empty layer
@@ -219,24 +219,24 @@ def package_channels() -> dict[str, list[tuple[int, str]]]:
 
 
 def test_hidden_channels_are_found():
-    elsewhere = {f"{PACKAGE}.plugin.inflow": {"_patch", "_cache"},
+    elsewhere = {f"{PACKAGE}.plugin.inflow.inflow": {"_patch", "_cache"},
                  f"{PACKAGE}.atmosphere.ekman": {"_solved_at", "_state"}}
     source = (
         "import importlib\n"
-        "from floris_ekman_veer.plugin import inflow\n"
-        "from floris_ekman_veer.plugin.inflow import _cache, set_atmosphere\n"
+        "from floris_ekman_veer.plugin.inflow import inflow\n"
+        "from floris_ekman_veer.plugin.inflow.inflow import _cache, set_atmosphere\n"
         "physics = importlib.import_module('floris_ekman_veer.atmosphere.ekman')\n"
-        "__import__('floris_ekman_veer.plugin.inflow')\n"
+        "__import__('floris_ekman_veer.plugin.inflow.inflow')\n"
         "inflow._patch()\n"
         "def fit(abl):\n"
         "    return abl._solved_at(1.0), abl._own(), _own(), abl.__class__, set_atmosphere\n"
         "def _own():\n"
         "    pass\n"
     )
-    found = hidden_channels(f"{PACKAGE}.atmosphere.fit", ast.parse(source), elsewhere)
+    found = hidden_channels(f"{PACKAGE}.atmosphere.fit.fit", ast.parse(source), elsewhere)
     assert [what for _, what in found] == [
-        f"imports _cache of {PACKAGE}.plugin.inflow", "calls import_module", "calls __import__",
-        f"uses _patch of {PACKAGE}.plugin.inflow", f"uses _solved_at of {PACKAGE}.atmosphere.ekman"]
+        f"imports _cache of {PACKAGE}.plugin.inflow.inflow", "calls import_module", "calls __import__",
+        f"uses _patch of {PACKAGE}.plugin.inflow.inflow", f"uses _solved_at of {PACKAGE}.atmosphere.ekman"]
     assert [line for line, _ in found] == [3, 4, 5, 6, 8]
 
 

@@ -11,14 +11,15 @@ from floris.core.wake import MODEL_MAP
 from floris.utilities import load_yaml
 
 import floris_ekman_veer
-from floris_ekman_veer.plugin import inflow, patching
+from floris_ekman_veer.plugin.floris_hooks import patching
+from floris_ekman_veer.plugin.inflow import inflow
 from floris_ekman_veer import registry
-from floris_ekman_veer.plugin.models import (
+from floris_ekman_veer.plugin.wake_models.models import (
     EkmanVeerVelocityDeficit,
     EkmanVeerVelocityDeflection,
     Gaussian2014VelocityDeficit,
 )
-from floris_ekman_veer.plugin.turbine import ActuatorDiskTurbine
+from floris_ekman_veer.plugin.rotor.turbine import ActuatorDiskTurbine
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 

@@ -22,7 +22,7 @@ from floris.utilities import load_yaml
 import floris_ekman_veer
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.plugin import shallow
+from floris_ekman_veer.plugin.inflow import shallow
 from tests.conftest import STABLE_ATMOSPHERE
 
 REPO = Path(__file__).resolve().parents[1]
@@ -40,7 +40,7 @@ def caught():
 
 def of(records, category):
     """The records of ``category``, without the notice that FLORIS's placeholder TI are not the
-    atmosphere's (tests/plugin/test_floris_input_messages.py tests it)."""
+    atmosphere's (tests/plugin/wake_models/test_floris_input_messages.py tests it)."""
     return [r for r in records if issubclass(r.category, category)
             and not str(r.message).startswith("flow_field.turbulence_intensities")]
 
@@ -226,7 +226,7 @@ def restore_setting():
 
 
 def test_silence_warnings_here_and_in_the_workers_it_sends_models_to(restore_setting):
-    from floris_ekman_veer.plugin.parallel import WorkerDict
+    from floris_ekman_veer.plugin.floris_tools.parallel import WorkerDict
 
     floris_ekman_veer.silence_warnings()
     with caught() as records:

@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from floris_ekman_veer.atmosphere import stability_closures
-from floris_ekman_veer.atmosphere.abl_inputs import (
+from floris_ekman_veer.atmosphere.inputs.abl_inputs import (
     checked_coriolis_parameter,
     checked_model_constants,
     checked_stability_input,
@@ -48,8 +48,8 @@ from floris_ekman_veer.atmosphere.constants import (
     ENTRAINMENT_RATIO,
     PAPER_POTENTIAL_TEMPERATURE,
 )
-from floris_ekman_veer.atmosphere.fit import fit_profile
-from floris_ekman_veer.atmosphere.input_ranges import (
+from floris_ekman_veer.atmosphere.fit.fit import fit_profile
+from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     MAX_MIXED_LAYER_HEIGHT,
     MIN_BOUNDARY_LAYER_HEIGHT,
     POTENTIAL_TEMPERATURE_RANGE,
@@ -456,7 +456,7 @@ class EkmanABL(WindProfile):
         directions [deg] at ``heights`` [m], per record (arrays (n_records, n_heights)): least
         squares in u* (hence G), the Obukhov length and optionally z0, the direction a free
         rotation; refuses records no atmosphere of the model fits. Options and fixed inputs:
-        :func:`floris_ekman_veer.atmosphere.fit.fit_profile` (docs/measurements.md)."""
+        :func:`floris_ekman_veer.atmosphere.fit.fit.fit_profile` (docs/measurements.md)."""
         return fit_profile(cls, heights, speeds, directions, **options_and_fixed_inputs)
 
     def __repr__(self):

@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from floris_ekman_veer.atmosphere.input_ranges import (
+from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE,
     MAX_GEOSTROPHIC_WIND,
     SENSIBLE_HEAT_FLUX_RANGE,

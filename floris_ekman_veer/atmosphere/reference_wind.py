@@ -15,7 +15,7 @@ import numpy as np
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer._validation import require_at
-from floris_ekman_veer.atmosphere.input_ranges import (
+from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     MIN_BOUNDARY_LAYER_HEIGHT,
     checked,
     require_broadcastable,

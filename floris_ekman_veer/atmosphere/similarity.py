@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from floris_ekman_veer.atmosphere.constants import BUSINGER_DYER_GAMMA, EARTH_ROTATION_RATE
-from floris_ekman_veer.atmosphere.input_ranges import MIN_ABS_LATITUDE, checked
+from floris_ekman_veer.atmosphere.inputs.input_ranges import MIN_ABS_LATITUDE, checked
 
 
 def coriolis_parameter_from_latitude(latitude):

@@ -15,7 +15,7 @@ import numpy as np
 
 from floris_ekman_veer.atmosphere import stability_closures
 from floris_ekman_veer.atmosphere.constants import air_heat_capacity
-from floris_ekman_veer.atmosphere.input_ranges import checked, checked_turbulence_constants
+from floris_ekman_veer.atmosphere.inputs.input_ranges import checked, checked_turbulence_constants
 from floris_ekman_veer.atmosphere.similarity import (
     stability_term,
     stress_shape,

@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from floris_ekman_veer.plugin.inflow import (
+from floris_ekman_veer.plugin.inflow.inflow import (
     CONFIG_PATH,
     AtmosphereSpec,
     ambient_velocity,

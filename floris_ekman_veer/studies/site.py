@@ -21,7 +21,7 @@ import pandas as pd
 from floris.wind_data import TimeSeries
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
                                             read_instruments)
 from floris_ekman_veer.studies.site_records import (
@@ -34,8 +34,8 @@ from floris_ekman_veer.studies.site_records import (
     reasons_text,
     screen_records,
 )
-from floris_ekman_veer.studies.energy import energy_by_period, record_energy
-from floris_ekman_veer.plugin.inflow import set_atmosphere
+from floris_ekman_veer.studies.energy.energy import energy_by_period, record_energy
+from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
 
 #: What :func:`fit_site` does with records that fit no atmosphere of the model.
 MISFIT_POLICIES = ("raise", "drop")

@@ -10,7 +10,7 @@ import pandas as pd
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.studies.mast import measured_turbulence
 from floris_ekman_veer.studies.vanes import (OFFSET_MIN_RECORDS, strong_wind_rows,
                                              with_offsets_from)

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from floris_ekman_veer._validation import real_array, require_floris_model
-from floris_ekman_veer.plugin.inflow import atmosphere_of, solve
+from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, solve
 from floris_ekman_veer.wake.deficit import initial_radius, potential_core_length
 
 #: The paper's Table 1 stability parameter of SBL-6, the most stable validated case.

@@ -5,7 +5,7 @@ this module evaluates the same formula where most factors are shared: per wake (
 the stream-tube radius, beta) and per height (t_hat and the three tanh of Eq. xi_emp depend on
 z only, through U(z)), leaving per point only the polar harmonics, the width and the Gaussian.
 numexpr (a FLORIS dependency) runs that per-point part in a single pass without temporaries.
-tests/plugin/test_rotor_average.py checks it against ``normalised_deficit`` to round-off.
+tests/plugin/rotor/test_rotor_average.py checks it against ``normalised_deficit`` to round-off.
 """
 
 from __future__ import annotations

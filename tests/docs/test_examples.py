@@ -22,7 +22,7 @@ STABLE = ("SBL-4", "SBL-5", "SBL-6")
 
 # The paper's case inputs keep FLORIS's turbulence_intensities, which the ekman_veer model does not
 # read (it takes I_u from the atmosphere): the ModelSettingsWarning saying so is tested in
-# tests/plugin/test_floris_input_messages.py, not here.
+# tests/plugin/wake_models/test_floris_input_messages.py, not here.
 pytestmark = pytest.mark.filterwarnings(
     "ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning")
 

@@ -35,7 +35,7 @@ from floris_ekman_veer.studies.validation.cases import DATA, HORNS_REV  # the va
 assert "site-packages" in str(DATA) and (DATA / "PyWake-LICENSE.txt").is_file(), DATA
 assert HORNS_REV.layout[0].size == 80 and len(list(DATA.glob("*.dat"))) == 60  # Lillgrund too
 assert (DATA / "Lillgrund_layout.csv").is_file() and (DATA / "SWT-2.3-93_power_ct.csv").is_file()
-import floris_ekman_veer.plugin.inflow, floris_ekman_veer.studies.energy  # every layer ships
+import floris_ekman_veer.plugin.inflow.inflow, floris_ekman_veer.studies.energy.energy  # every layer ships
 """
 
 

@@ -420,7 +420,7 @@ def test_gauss_and_ekman_veer_run_on_the_shipped_convective_day():
     """inputs/farm_day.yaml (H = +150 W/m^2, z_i = 1500 m) with ekman_veer and with FLORIS's gauss
     on the same inflow: finite; the convective inflow's higher I_u widens the ekman_veer wakes,
     so the waked rows lose less than on the neutral day (cnbl.yaml's atmosphere)."""
-    from floris_ekman_veer.plugin.inflow import set_atmosphere
+    from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
 
     fmodel = FlorisModel(INPUTS / "farm_day.yaml")
     fmodel.set(wind_speeds=[6.0, 9.0], wind_directions=[270.0, 270.0],

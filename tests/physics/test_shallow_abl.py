@@ -21,7 +21,7 @@ from scipy.optimize import brentq
 
 from floris_ekman_veer.atmosphere import turbulence as tb
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
 
 pytestmark = pytest.mark.usefixtures("inflow_hook")
 

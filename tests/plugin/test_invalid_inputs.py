@@ -18,7 +18,7 @@ from floris import FlorisModel
 from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
-from floris_ekman_veer.plugin.turbine import actuator_disk_turbine
+from floris_ekman_veer.plugin.rotor.turbine import actuator_disk_turbine
 from tests.conftest import STABLE_ATMOSPHERE
 
 VELOCITY = "wake.wake_velocity_parameters.ekman_veer"

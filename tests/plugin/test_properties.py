@@ -50,10 +50,10 @@ from hypothesis import assume, event, given
 from hypothesis import strategies as st
 
 import floris_ekman_veer
-import floris_ekman_veer.plugin.inflow
+import floris_ekman_veer.plugin.inflow.inflow
 from floris_ekman_veer import EkmanABL
-from floris_ekman_veer.plugin.shallow import ShallowBoundaryLayerWarning
-from floris_ekman_veer.plugin.turbine import actuator_disk_turbine
+from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
+from floris_ekman_veer.plugin.rotor.turbine import actuator_disk_turbine
 
 #: NREL 5 MW: power rises with speed up to its 25 m/s cut-out (FLORIS's table).
 NREL_5MW_CUT_OUT = 25.0
@@ -66,10 +66,10 @@ DISK = actuator_disk_turbine()
 pytestmark = [
     pytest.mark.filterwarnings("ignore::RuntimeWarning"),
     pytest.mark.filterwarnings(
-        "ignore::floris_ekman_veer.plugin.shallow.ShallowBoundaryLayerWarning"
+        "ignore::floris_ekman_veer.plugin.inflow.shallow.ShallowBoundaryLayerWarning"
     ),
     # drawn turbulence intensities, which the ekman_veer model does not read (that notice is
-    # tested in tests/plugin/test_floris_input_messages.py)
+    # tested in tests/plugin/wake_models/test_floris_input_messages.py)
     pytest.mark.filterwarnings(
         "ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning"),
 ]
@@ -353,8 +353,8 @@ def near_ground_flow(fmodel, x):
         x, np.linspace(-300.0, 300.0, 21), np.geomspace(1e-3, 3.0, 30), indexing="ij"
     ))
     u = fmodel.sample_flow_at_points(x, y, z)[0]
-    abl = floris_ekman_veer.plugin.inflow.solved_atmosphere(fmodel.core.flow_field)
-    ambient, _ = floris_ekman_veer.plugin.inflow.inflow_profile(abl, z, 100.0)
+    abl = floris_ekman_veer.plugin.inflow.inflow.solved_atmosphere(fmodel.core.flow_field)
+    ambient, _ = floris_ekman_veer.plugin.inflow.inflow.inflow_profile(abl, z, 100.0)
     return u, np.ravel(ambient), z
 
 
@@ -371,5 +371,5 @@ def test_superposed_wakes_never_reverse_the_flow():
     assert plane.u.min() >= 0.0
     hub = fmodel.sample_flow_at_points(np.linspace(600.0, 3000.0, 25), np.zeros(25),
                                        np.full(25, 100.0))[0]
-    speed = floris_ekman_veer.plugin.inflow.solved_atmosphere(fmodel.core.flow_field).speed(100.0)
+    speed = floris_ekman_veer.plugin.inflow.inflow.solved_atmosphere(fmodel.core.flow_field).speed(100.0)
     assert np.all(hub < speed) and hub.min() < 0.6 * speed  # the wakes are there

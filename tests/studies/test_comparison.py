@@ -6,7 +6,7 @@ from floris import FlorisModel, UncertainFlorisModel
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.studies import comparison
-from floris_ekman_veer.plugin import inflow
+from floris_ekman_veer.plugin.inflow import inflow
 
 from conftest import STABLE_ATMOSPHERE, make_config
 

@@ -1,5 +1,5 @@
 """Records that a real site logs never sink a fit, and every refusal names its input
-(atmosphere/fit.py and studies/site.py; docs/measurements.md#a-year-of-records): a light-wind
+(atmosphere/fit/fit.py and studies/site.py; docs/measurements.md#a-year-of-records): a light-wind
 record among others, a state next to the ABL top's kinks, repeated time stamps, bad options,
 directions in radians, vectorised simple inputs."""
 
@@ -297,7 +297,7 @@ def _check_site(records):
     leaves out with a reason, and every fitted state is one the atmosphere accepts as input."""
     import warnings
 
-    from floris_ekman_veer.atmosphere.input_ranges import (MIN_BOUNDARY_LAYER_HEIGHT,
+    from floris_ekman_veer.atmosphere.inputs.input_ranges import (MIN_BOUNDARY_LAYER_HEIGHT,
                                                    SENSIBLE_HEAT_FLUX_RANGE)
     from floris_ekman_veer.studies.site import EXCLUSION_KINDS
 

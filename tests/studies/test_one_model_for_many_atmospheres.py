@@ -11,8 +11,8 @@ from floris import FlorisModel
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
 from floris_ekman_veer import optimize_yaw
-from floris_ekman_veer.plugin import optimizer_conditions as optimization
-from floris_ekman_veer.plugin.inflow import atmosphere_of, set_atmosphere
+from floris_ekman_veer.plugin.floris_tools import optimizer_conditions as optimization
+from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, set_atmosphere
 
 FARM = Path(__file__).resolve().parents[2] / "inputs" / "farm_sbl6.yaml"
 
@@ -82,7 +82,7 @@ def test_record_energy_is_annual_energy_of_the_site_classes(records_row):
     from floris import TimeSeries
 
     from floris_ekman_veer import annual_energy
-    from floris_ekman_veer.studies.energy import record_energy
+    from floris_ekman_veer.studies.energy.energy import record_energy
 
     flow_field = records_row.core.flow_field
     series = TimeSeries(flow_field.wind_directions, flow_field.wind_speeds,

@@ -12,7 +12,7 @@ from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizatio
 
 import floris_ekman_veer
 from floris_ekman_veer import EkmanABL, fit_site, optimize_yaw
-from floris_ekman_veer.plugin.inflow import solved_atmosphere
+from floris_ekman_veer.plugin.inflow.inflow import solved_atmosphere
 from tests.conftest import make_config
 
 REPO = Path(__file__).resolve().parents[2]
@@ -49,7 +49,7 @@ def row_model():
 
 
 # FLORIS's default sosfs with the incoming-speed deficits is row_model's set-up: its
-# ModelSettingsWarning is tested in tests/plugin/test_models.py::test_summed_wakes_are_asked_for_with_incoming_deficits.
+# ModelSettingsWarning is tested in tests/plugin/wake_models/test_models.py::test_summed_wakes_are_asked_for_with_incoming_deficits.
 ROW_MODEL_SETTINGS = pytest.mark.filterwarnings(
     "ignore:wake.model_strings.combination_model:floris_ekman_veer.ModelSettingsWarning")
 
@@ -85,7 +85,7 @@ def test_floris_run_gives_back_the_fitted_profiles():
 
 @ROW_MODEL_SETTINGS
 # The records' turbulence intensities, which ekman_veer does not read (a notice tested in
-# tests/plugin/test_floris_input_messages.py), go to the GCH comparison.
+# tests/plugin/wake_models/test_floris_input_messages.py), go to the GCH comparison.
 @pytest.mark.filterwarnings("ignore:flow_field.turbulence_intensities:floris_ekman_veer.ModelSettingsWarning")
 def test_annual_energy_and_optimize_yaw_run_per_record():
     records, _ = records_of([8.0, 8.0, 9.0], [np.inf, 150.0, 150.0], [270.0, 270.0, 272.0],
@@ -102,7 +102,7 @@ def test_annual_energy_and_optimize_yaw_run_per_record():
               turbulence_intensities=site.turbulence_intensities[1:2])
     classes, record_classes = site.stability()
     assert record_classes == list(records["time"]) and len(classes) == 3
-    from floris_ekman_veer.plugin.inflow import set_atmosphere
+    from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
     set_atmosphere(alone, classes[record_classes[1]]["atmosphere"],
                    wind_directions=site.wind_directions[1:2], wind_speeds=site.wind_speeds[1:2],
                    turbulence_intensities=site.turbulence_intensities[1:2])

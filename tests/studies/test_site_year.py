@@ -125,7 +125,7 @@ def test_the_fitted_year_runs_as_one_floris_model(site):
     power = fmodel.get_farm_power()
     assert power.shape == (len(site.labels),) and np.all(np.isfinite(power))
     # The atmosphere FLORIS solves per record is the fitted one.
-    abl = floris_ekman_veer.plugin.inflow.solved_atmosphere(fmodel.core.flow_field)
+    abl = floris_ekman_veer.plugin.inflow.inflow.solved_atmosphere(fmodel.core.flow_field)
     np.testing.assert_allclose(np.ravel(abl.geostrophic_wind),
                                site.profile_fit.geostrophic_wind, rtol=1e-3)
 

@@ -23,7 +23,7 @@ import pandas as pd
 from floris import FlorisModel, UncertainFlorisModel
 from floris.uncertain_floris_model import map_turbine_values_uncertain
 
-from floris_ekman_veer.plugin.input_checks import reads_wind_shear, uses_wake_models
+from floris_ekman_veer.plugin.wake_models.input_checks import reads_wind_shear, uses_wake_models
 from floris_ekman_veer.studies.comparison import (
     BUILTIN_WAKES,
     GCH_SWITCHES,

@@ -1,0 +1,367 @@
+"""One turbine's wake on the rotor cells it reaches, for the velocity models' call on a turbine
+grid (docs/coupling.md#rotor-average).
+
+:func:`rotor_cell_deficit` integrates the wake over the cells of plugin/rotor/rotor_cells.py that it can
+reach: the culling of the rotors and sub-point rows out of reach, the chunking of the sub-points
+(on numexpr's threads, :func:`map_pieces`), the superposition on the other wakes
+(plugin/rotor/rotor_wakes.py) and the wake-added turbulence. Pure geometry and numpy (numexpr for the
+sub-points): no FLORIS import.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import functools
+import os
+import threading
+import warnings
+
+import attrs
+import numexpr as ne
+import numpy as np
+
+from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, column_sums, row_interpolation
+from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
+from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
+from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.fused import program
+
+# The area weight of a sub-point in the wake's overlap (rotor_cell_deficit): velocity above
+# WAKE_OVERLAP_VELOCITY, within ``reach`` (2 D) of the wake's rotor laterally.
+# ``edge`` is WAKE_OVERLAP_VELOCITY (FLORIS's count) or, for ``turbulence_overlap: wake_radius``,
+# the wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar & Porte-Agel
+# 2016).
+_OVERLAP = "where((du > edge) & (abs(dy + centre) < reach), weight, 0)"
+
+#: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
+#: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
+#: rotor points can lie a round-off (~1e-13 m) downstream of x_i, where the wake is already 2a
+#: deep: without the margin a turbine sits in its own wake (tests/plugin/wake_models/test_models.py). FLORIS's gauss
+#: model uses the same 0.1 m.
+ROTOR_PLANE_MARGIN = 0.1
+
+#: A sub-point row of a rotor is integrated in a wake where the deficit, with the widest width
+#: the wake can have, exceeds this fraction of U_h somewhere on the row; elsewhere the wake is 0
+#: (a power change of at most 3e-5 of a turbine that sees no other wake, far less where wakes
+#: combine).
+NEGLIGIBLE_DEFICIT = 1e-5
+
+#: Rotors whose wake centre is evaluated at their sub-point rows at once.
+PAIR_CHUNK = 1024
+
+#: The velocity models' ``wake_expansion`` choices (plugin/wake_models/models.py): the paper's ambient k_w,
+#: and the two that add the upstream wakes' turbulence at a rotor (its largest, as FLORIS
+#: combines it; all of them, their variances summed), tracked here on a turbine grid.
+WAKE_EXPANSIONS = ("ambient", "local_turbulence", "array_turbulence")
+ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
+
+#: The velocity models' ``turbulence_overlap`` choices: the part of a rotor a wake's added
+#: turbulence is weighted with, the area where its velocity exceeds WAKE_OVERLAP_VELOCITY
+#: (FLORIS's count) or where the rotor lies inside the wake radius 2 sigma (Niayifar &
+#: Porte-Agel 2016, docs/coupling.md#wakes-deep-in-an-array).
+TURBULENCE_OVERLAPS = ("wake_velocity", "wake_radius")
+
+#: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
+DEFICIT_VELOCITIES = ("incoming", "free_stream")
+
+#: Sub-point rows (of a rotor in a wake) integrated at once: bounds the sub-point arrays to
+#: about 0.3 MB each.
+ROW_CHUNK = 4096
+
+#: A sheared band thinner than this many sub-row spacings (its Gaussian width across the band)
+#: is no longer integrated to 1 % in power by the rotor cells (benchmarks/bench_rotor_average.py).
+MIN_BAND_PER_ROW = 0.4
+
+
+#: The thread pool of :func:`map_pieces`, per process (a forked worker makes its own: the
+#: parent's threads do not exist in it) and number of threads.
+_POOL: dict = {}
+_POOL_LOCK = threading.Lock()
+
+
+def worker_threads() -> int:
+    """Threads a wake's pieces run on: numexpr's, i.e. the cores FLORIS's gauss runs its sums
+    on (``numexpr.set_num_threads`` or NUMEXPR_NUM_THREADS set both)."""
+    return ne.get_num_threads()
+
+
+def map_pieces(function, pieces) -> list:
+    """``[function(piece) for piece in pieces]``, on :func:`worker_threads` threads (numpy and
+    numexpr release the GIL). A piece's numbers do not depend on the thread that runs it or on
+    what runs beside it: the results are the same bit for bit with 1 or N threads."""
+    threads = min(worker_threads(), len(pieces))
+    if threads <= 1:
+        return [function(piece) for piece in pieces]
+    key = (os.getpid(), threads)
+    with _POOL_LOCK:  # (solves in several threads of a process share the pool)
+        pool = _POOL.get(key)
+        if pool is None:
+            _POOL.clear()  # (another process's or size's pool: not ours to use)
+            pool = _POOL[key] = concurrent.futures.ThreadPoolExecutor(
+                threads, thread_name_prefix="floris_ekman_veer")
+    return list(pool.map(function, pieces))
+
+
+@attrs.define(frozen=True)
+class TurbineWake:
+    """Turbine i's quantities at the points where its wake is evaluated (the grid's points, or
+    the sub-points of the rotor cells it reaches), as the velocity models take them (radians,
+    metres)."""
+
+    dx: np.ndarray
+    dy: np.ndarray
+    dz: np.ndarray
+    yaw: np.ndarray
+    ct: np.ndarray
+    radius: np.ndarray
+    hub_speed: np.ndarray
+    k_w: np.ndarray
+    local_u: np.ndarray
+    local_v: np.ndarray
+    friction_velocity: np.ndarray
+
+
+def rotor_cell_deficit(
+    model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+    turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
+):
+    """d_k of every rotor cell of the grid after turbine i's wake (the module docstring), for a
+    velocity model's call on a turbine grid (docs/coupling.md#rotor-average).
+
+    Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
+    (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
+    width) are integrated; the wake is 0 elsewhere. The wake is superposed on the others at
+    the sub-points (``wakes``, :class:`RotorWakes`) and each reached cell returns the
+    increment FLORIS's combination turns into the combined cell deficit; the rest 0.
+
+    ``model`` is the velocity model (plugin/wake_models/models.py): its ``expansion_rate`` (k_w),
+    ``width_bound`` and ``amplitude_bound`` (how far its wake reaches), ``sub_point_deficit``
+    (Delta u / U_h of a :class:`TurbineWake`), ``wake_expansion`` and ``deficit_velocity``
+    (with "incoming" the wake's velocity is scaled by turbine i's U_i / U_i,0 of the wakes
+    superposed so far, docs/coupling.md#wakes-deep-in-an-array). ``ambient`` is the grid's
+    :class:`~floris_ekman_veer.plugin.inflow.ambient.Ambient` with its ``rotor``, ``wakes`` the solve's
+    :class:`RotorWakes`; yaw in radians, ct the model's thrust coefficient.
+    """
+    rotor = ambient.rotor
+    cells = rotor.cells
+    n_findex, n_turbines = rotor.x.shape
+    result = np.zeros((n_findex, n_turbines, cells.n**2))
+    dx = rotor.x - x_i[:, 0, 0]
+    f, j = np.nonzero(dx > ROTOR_PLANE_MARGIN)
+    if f.size == 0:
+        return result.reshape(u_initial.shape)
+    abl = ambient.abl
+    hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
+    added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
+    track = (added_rule is not None and wakes.rule is not None
+             and wakes.turbulence_model is not None)
+    incoming = model.deficit_velocity == "incoming" and wakes.rule is not None
+    if track or incoming:
+        # Turbine i among the rotors, per condition.
+        source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
+                           axis=1)
+    # U_i / U_i,0 of turbine i: its wake's C(x) scales with the speed it stands in
+    # (docs/coupling.md#wakes-deep-in-an-array); 1 for an unwaked rotor.
+    speed_fraction = 1.0
+    if incoming:
+        conditions = np.arange(n_findex)
+        speed_fraction = wakes.incoming_fraction(
+            conditions * n_turbines + source,
+            u_initial.reshape(n_findex, n_turbines, -1)[conditions, source],
+        )[:, None, None, None]
+    if track:
+        # The turbulence at turbine i with the overlaps as areas (RotorWakes).
+        turbulence = wakes.turbulence[np.arange(n_findex), source][:, None, None, None]
+    else:
+        # FLORIS's turbulence at turbine i may vary over its rotor points (wake-added
+        # turbulence is counted per point); its wake takes one expansion rate, from the
+        # rotor's mean.
+        turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
+    k_w = model.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
+                              ambient.floris_turbulence)
+    pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+    per_pair = {
+        "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
+        "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
+        "speed_fraction": speed_fraction,
+    }
+    per_pair = {k: pick(v) for k, v in per_pair.items()}
+    x_pair = dx[f, j]
+    width = model.width_bound(x_pair, per_pair["k_w"], per_pair["radius"], per_pair["ct"],
+                             per_pair["yaw"])
+    # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
+    # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
+    amplitude = model.amplitude_bound(x_pair, per_pair["k_w"], per_pair["radius"],
+                                     per_pair["ct"], per_pair["yaw"])
+    reach_squared = 2.0 * width**2 * np.log(
+        np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
+    rows_at = getattr(deflection_field_i, "rows_at", None)
+    if rows_at is not None and cells.n > 1:
+        # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
+        # widened by its spread plus R/4 on either side (the centre at the rows beyond
+        # +-R/2, twice the linear extrapolation, and between them) are not integrated and
+        # their rows not evaluated.
+        # (the n point heights' extremes column by column: numpy's reductions along a short
+        # axis cost more than the comparisons)
+        points = deflection_field_i[f, j, 0, :].T
+        top, bottom = functools.reduce(np.maximum, points), functools.reduce(np.minimum, points)
+        margin = top - bottom + 0.25 * rotor.radius[f, j]
+        offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
+        lateral_gap = np.maximum(np.maximum(offset - top, bottom - offset)
+                                 - margin - rotor.radius[f, j], 0.0)
+        vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
+                                  - rotor.radius[f, j], 0.0)
+        near = lateral_gap**2 + vertical_gap**2 < reach_squared
+        f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
+        per_pair = {k: v[near] for k, v in per_pair.items()}
+        if f.size == 0:
+            return result.reshape(u_initial.shape)
+    if rows_at is None:
+        # Another deflection model: its centre at the point rows, interpolated in height.
+        # (A sum over the n points, not a matrix product: BLAS would block the product by
+        # the number of pairs, i.e. by the batch.)
+        centre = np.sum(deflection_field_i[f, j, 0, :, None]
+                        * row_interpolation(cells.n, cells.row_z), axis=1)
+    else:
+        # In chunks of rotors, so that the deflection's temporaries stay small.
+        centre = np.concatenate(map_pieces(
+            lambda k: rows_at(f[k:k + PAIR_CHUNK], j[k:k + PAIR_CHUNK]),
+            range(0, f.size, PAIR_CHUNK)))
+    lateral = (rotor.y[f, j] - y_i[f, 0, 0, 0])[:, None] - centre  # (pairs, rows)
+    dz = rotor.kind_heights[rotor.kind[f, j]] - hub_height_i[f, 0, 0, 0][:, None]
+    kind = rotor.kind[f, j]
+    radius_j = rotor.radius[f, j][:, None]
+    gap = np.maximum(np.abs(lateral) - radius_j * cells.row_chord, 0.0) ** 2 + dz**2
+    # Row by row: only the rows the wake reaches are integrated.
+    p, r = np.nonzero(gap < reach_squared[:, None])  # (pair, row) entries
+    if p.size == 0:
+        return result.reshape(u_initial.shape)
+    reached = p[np.flatnonzero(np.diff(p, prepend=-1))]  # p is sorted
+    _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
+                      radius_j[reached], cells, rotor.warned)
+    flat = f * n_turbines + j
+    moment = rotor.moment[f, j]
+    n2 = cells.n**2
+    # Per entry (a pair's row): the moment removed on each cell stretch the row crosses
+    # and the row's overlap, summed into the pairs' cells once after the loop, in entry
+    # order (a pair's rows in ascending order): a condition's sums then do not depend on
+    # the grouping and chunking below, which depend on the whole batch.
+    nodes = cells.nodes
+    stretches = np.zeros((p.size, cells.sub_y.shape[1] // nodes))
+    row_overlap = np.zeros(p.size) if track else None
+    # Many rows: rows of equal width (sub-points with weight) together, in chunks, without
+    # padding; few: all at once (the padding costs less than more calls).
+    widths = cells.row_width[r]
+    if p.size <= ROW_CHUNK:
+        groups = [np.arange(p.size)]
+    else:
+        order = np.argsort(widths, kind="stable")
+        groups = np.split(order, np.flatnonzero(np.diff(widths[order])) + 1)
+    edge = np.float64(WAKE_OVERLAP_VELOCITY)
+    if track and model.turbulence_overlap == "wake_radius":
+        # The wake's velocity at 2 sigma from its centre, per rotor reached.
+        edge = np.exp(-2.0) * model.centre_deficit(x_pair, *(per_pair[k] for k in (
+            "k_w", "radius", "ct", "yaw"))) * per_pair["hub_speed"] * per_pair["speed_fraction"]
+    # The deficit's factors that depend on the wake only, once per rotor reached.
+    wake_parameters = model.wake_parameters(x_pair, *(per_pair[k] for k in (
+        "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
+    pieces = [(group[start:start + ROW_CHUNK], int(np.max(widths[group])))
+              for group in groups for start in range(0, group.size, ROW_CHUNK)]
+
+    def integrate(piece):
+        """Superpose the wake on one piece of (pair, row) entries: pieces touch disjoint
+        entries and sub-points, so they run at once (:func:`map_pieces`). The sub-points are
+        held column-major, (width, entries): the per-entry factors then run along numexpr's
+        inner loop without being copied out to every sub-point."""
+        chunk, width = piece
+        pe, re = p[chunk], r[chunk]
+        fe = f[pe]
+        pair = {k: v[pe][None, :] for k, v in per_pair.items()}
+        u_rows = rotor.kind_u[fe, kind[pe], re][None, :]
+        v_rows = rotor.kind_v[fe, kind[pe], re][None, :]
+        dy = lateral[pe, re][None, :] + radius_j[pe, 0][None, :] * cells.sub_y_columns[:width, re]
+        wake = TurbineWake(
+            dx=x_pair[pe][None, :],
+            dy=dy,
+            dz=dz[pe, re][None, :],
+            yaw=pair["yaw"],
+            ct=pair["ct"],
+            radius=pair["radius"],
+            hub_speed=pair["hub_speed"],
+            k_w=pair["k_w"],
+            local_u=u_rows * pair["cos"] + v_rows * pair["sin"],
+            local_v=v_rows * pair["cos"] - u_rows * pair["sin"],
+            friction_velocity=pair["friction_velocity"],
+        )
+        # No flow (at and below z0): no wake.
+        ambient_u = np.where(wake.local_u > 0, u_rows, 0.0)
+        du = model.sub_point_deficit(
+            wake, {k: v[pe][None, :] for k, v in wake_parameters.items()},
+        ) * (pair["hub_speed"] * pair["speed_fraction"])
+        removed = wakes.superpose_columns(flat[pe], re, du, ambient_u, moment[pe][None, :])
+        # Each stretch's nodes added in turn.
+        stretch = removed[::nodes]
+        for node in range(1, nodes):
+            stretch = stretch + removed[node::nodes]
+        stretches[chunk, :width // nodes] = stretch.T
+        if track:
+            # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
+            # rotor laterally, here as the area of the disk where it holds.
+            row_overlap[chunk] = column_sums(program(_OVERLAP)(
+                du=du, dy=dy, centre=centre[pe, re][None, :], reach=4.0 * pair["radius"],
+                edge=edge if edge.ndim == 0 else edge[pe][None, :],
+                weight=cells.weight_columns[:width, re]))
+
+    map_pieces(integrate, pieces)
+    removed = np.bincount((p[:, None] * n2 + cells.cell_grid[r, ::nodes]).ravel(),
+                          weights=stretches.ravel(), minlength=f.size * n2)
+    overlap = np.bincount(p, weights=row_overlap, minlength=f.size) if track else None
+    u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
+    result[f[reached], j[reached]] = wakes.cell_returns(
+        flat[reached], removed.reshape(f.size, n2)[reached], u_cell,
+        moment[reached][:, None])
+    if track:
+        _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
+                        axial_induction_i, overlap[reached], ambient, added_rule)
+    return result.reshape(u_initial.shape)
+
+
+def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):
+    """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
+    the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it,
+    combined by ``rule`` (RotorWakes.add_turbulence)."""
+    column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+    x_j, x_source = ambient.rotor.x[f, j], column(x_i)
+    diameter = 2.0 * column(radius_i)
+    ambient_turbulence = column(ambient.floris_turbulence)
+    added = wakes.turbulence_model.function(
+        ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
+    added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
+        x_j <= x_source + 15.0 * diameter)
+    wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
+
+
+def _check_resolution(x, per_pair, reached, centre, radius_j, cells, warned):
+    """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
+    if "rows" in warned:
+        return
+    k_w, radius, ct, yaw = (per_pair[k][reached] for k in ("k_w", "radius", "ct", "yaw"))
+    width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
+        stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
+    height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
+    shear = np.abs(centre[:, -1] - centre[:, 0]) / height
+    thickness = width / np.sqrt(1.0 + shear**2)
+    spacing = 2.0 * radius_j[:, 0] / cells.rows
+    if np.any(thickness < MIN_BAND_PER_ROW * spacing):
+        warned.add("rows")
+        ratio = float(np.min(thickness / spacing))
+        warnings.warn(
+            f"a veer-sheared wake band is {ratio:.2f} sub-row spacings thin on a rotor, "
+            f"below the {MIN_BAND_PER_ROW} that its rotor-cell average resolves to 1 % in "
+            f"power: raise solver.turbine_grid_points (now {cells.n}; the cells' "
+            f"sub-quadrature has {cells.rows} rows per rotor, {ROWS_PER_POINT} per grid "
+            "point)",
+            RuntimeWarning,
+            stacklevel=4,
+        )

@@ -1,0 +1,185 @@
+"""The wakes superposed at the rotor cells' sub-points during one solve, and the deficit each
+cell returns to FLORIS.
+
+The ``ekman_veer`` velocity models return at a point of FLORIS's turbine grid the deficit ``d_k``
+whose cube removes the exact power deficit of the point's cell (plugin/rotor/rotor_cells.py),
+``U_k^3 (1 - (1 - d_k)^3) = n^2 sum_s w_s (U_s^3 - (U_s - Delta u_s)^3)`` over the cell's
+sub-points s (:func:`equivalent_deficit`), with Delta u_s all wakes so far superposed point-wise
+at the sub-points by FLORIS's own rule (:class:`RotorWakes`; each call returns the increment that
+FLORIS's combination of the point values turns into the combined cell deficit). FLORIS's
+equal-weight cubic mean of ``U_k (1 - d_k)`` is then the sub-quadrature of the disk integral of
+u^3 (ambient and all wakes), and its thrust and power follow (the first moment for the actuator
+disk, plugin/rotor/rotor_cells.py ``TURBINE_MOMENTS``). numpy and numexpr: no FLORIS import.
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+
+from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells
+from floris_ekman_veer.wake.fused import program
+
+
+def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
+    """d_k of each cell from the cell's removed moment n^2 sum_{s in k} w_s (U_s^m - u_s^m)
+    (m = 3: power; m = 1: the velocity deficit itself): U_k^m (1 - (1 - d_k)^m) = removed.
+
+    ``removed``, ``u_cell`` (the cells' U_k): (..., n^2); ``moment`` (..., 1). A cell without
+    inflow (U_k = 0) has no wake.
+    """
+    cubic = moment == 3.0
+    ambient = np.where(cubic, u_cell**3, u_cell)
+    flowing = ambient > 0.0
+    fraction = np.where(flowing, removed / np.where(flowing, ambient, 1.0), 0.0)
+    # The cells' quadrature areas are exact to the strips' resolution (a few per cent for the
+    # wake cells): a wake that stops nearly all flow through a cell could exceed it by as much.
+    # The cell then has no flow (d = 1) rather than a negative one.
+    fraction = np.minimum(fraction, 1.0)
+    return np.where(cubic, 1.0 - np.cbrt(1.0 - fraction), fraction)
+
+
+#: FLORIS's combination models (class names) as the point-wise rules that superpose wake
+#: velocities du [m/s] at the cells' sub-points: sum of squares (sosfs), linear sum (fls), max.
+COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
+
+#: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
+#: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
+WAKE_OVERLAP_VELOCITY = 0.05
+
+_SUPERPOSED = {"sosfs": "sqrt(old**2 + du**2)", "fls": "old + du",
+               "max": "where(du > old, du, old)", None: "du"}
+#: The same rules in numpy, for the stored combination (the same bits as numexpr's).
+_SUPERPOSE = {"sosfs": lambda old, du: np.sqrt(old**2 + du**2), "fls": np.add,
+              "max": lambda old, du: np.where(du > old, du, old)}
+# weight (u_old^m - u_new^m) with u = U - wake: the moment the new wake removes at a sub-point,
+# per rule with the combined wake ``new`` written out (one pass over the sub-points).
+_REMOVED = {rule: ("where(U > 0, weight * where(m > 2, (new - old) * ((U - old)**2 + (U - old) * "
+                   "(U - new) + (U - new)**2), new - old), 0)").replace("new", f"({combined})")
+            for rule, combined in _SUPERPOSED.items()}
+
+
+@attrs.define(eq=False)
+class RotorWakes:
+    """The wakes superposed so far at the cells' sub-points of every rotor, during one solve.
+
+    FLORIS's solver combines the values the velocity model returns at the grid's points; on
+    rotor cells, combining the cells' deficits would combine wakes that do not overlap inside
+    a cell as if they did (two bands side by side), and the sum of squares of cube-equivalent
+    deficits is not the sum of squares of the velocities. So the wakes are superposed here,
+    point-wise at the sub-points by FLORIS's own rule, and each call returns the increment that
+    FLORIS's combination of the cell values turns into the cell's exact share of the combined
+    wakes' moment (docs/coupling.md#rotor-average). The turbulence at each rotor is the
+    wake-added turbulence with the overlap as the area of the disk in the wake.
+
+    Attributes:
+        cells: the rotor cells.
+        rule: "sosfs", "fls", "max" (FLORIS's combination model), or None: unknown, each call
+            returns its own wake's cell deficits.
+        combined: (n_findex * n_turbines * rows, columns) combined wake velocity [m/s] at the
+            sub-points, one block per rotor and row (RotorCells.sub_y's).
+        removed: (n_findex * n_turbines, n^2) n^2 sum_{s in k} w_s (U_s^m - u_s^m) of the
+            combined wakes.
+        wake: (n_findex * n_turbines, n^2) the wake velocity U_k d_k FLORIS holds at each point.
+        turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
+            ambient one.
+        turbulence_model: FLORIS's wake-added turbulence model, or None.
+    """
+
+    cells: RotorCells
+    rule: str | None
+    combined: np.ndarray
+    removed: np.ndarray
+    wake: np.ndarray
+    turbulence: np.ndarray
+    turbulence_model: object = None
+
+    @classmethod
+    def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,
+              ambient_turbulence) -> RotorWakes:
+        """An empty farm for ``wake_models`` (FLORIS's WakeModelManager or None)."""
+        rule = None
+        turbulence_model = None
+        if wake_models is not None:
+            rule = COMBINATION_RULES.get(type(wake_models.combination_model).__name__)
+            turbulence_model = wake_models.turbulence_model
+        pairs = n_findex * n_turbines
+        # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
+        # quadrature error, for half the memory.
+        combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),
+                            dtype=np.float32)
+        turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
+                                     (n_findex, n_turbines)).copy()
+        return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
+                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model)
+
+    def superpose(self, pair, row, du, ambient_u, moment) -> np.ndarray:
+        """Add one wake at sub-point rows: ``pair`` (entries,) flat rotor index (condition *
+        n_turbines + turbine), ``row`` (entries,) the row, ``du`` (entries, w) the wake's velocity
+        deficit [m/s] at the row's first w sub-points (w at least each row's width; beyond it,
+        the zero-weight padding), ``ambient_u`` (entries, 1) U at
+        the row (0 where there is no flow), ``moment`` (entries, 1). Returns (entries, w) the
+        moment the wake removes at each sub-point, weight (u_before^m - u_after^m)."""
+        return self.superpose_columns(pair, row, du.T, np.transpose(ambient_u),
+                                      np.transpose(moment)).T
+
+    def superpose_columns(self, pair, row, du, ambient_u, moment) -> np.ndarray:
+        """:meth:`superpose` with the sub-points column-major: ``du`` (w, entries),
+        ``ambient_u`` and ``moment`` (1, entries); returns (w, entries)."""
+        cells = self.cells
+        width = du.shape[0]
+        if self.rule is None:
+            old = np.zeros_like(du)
+        else:
+            # The rows' stored blocks, padding included: a padding sub-point's weight is 0, so
+            # what it holds never reaches a cell.
+            # (Stored row-major: each block's values are together in memory.)
+            index = pair * cells.rows + row
+            old = np.take(self.combined, index, axis=0)[:, :width].T.astype(float, order="C")
+        removed = program(_REMOVED[self.rule])(old=old, du=du, U=ambient_u,
+                                               weight=cells.weight_columns[:width, row],
+                                               m=moment)
+        if self.rule is not None:
+            self.combined[index, :width] = _SUPERPOSE[self.rule](old, du).T
+        return removed
+
+    def cell_returns(self, pair, removed, u_cell, moment) -> np.ndarray:
+        """What the velocity model returns at the cells of rotors ``pair`` (flat indices, each
+        once) after its wake was superposed, removing ``removed`` (pairs, n^2) of the cells'
+        moment (sum_{s in k} w_s (u_before^m - u_after^m)): the deficit d whose combination by
+        FLORIS's rule with the points' current wake velocity gives U_k d_k of the combined
+        wakes; ``u_cell`` (pairs, n^2) the cells' U_k, ``moment`` (pairs, 1). Returns
+        (pairs, n^2)."""
+        removed = self.cells.n**2 * removed
+        if self.rule is not None:
+            removed += self.removed[pair]
+            self.removed[pair] = removed
+        total = u_cell * equivalent_deficit(removed, u_cell, moment)
+        if self.rule == "sosfs":
+            increment = np.sqrt(np.maximum(total**2 - self.wake[pair] ** 2, 0.0))
+        elif self.rule == "fls":
+            increment = total - self.wake[pair]
+        else:  # max, or each wake alone
+            increment = total
+        if self.rule is not None:
+            self.wake[pair] = total
+        flowing = u_cell > 0.0
+        return np.where(flowing, increment / np.where(flowing, u_cell, 1.0), 0.0)
+
+    def add_turbulence(self, f, j, added, ambient, rule="max") -> None:
+        """One wake's added turbulence at rotors (f, j) (each once): ``max`` is FLORIS's
+        combination, TI = max(TI, sqrt(added^2 + TI_0^2)); ``quadrature`` adds its variance,
+        TI = sqrt(TI^2 + added^2), so that TI^2 = TI_0^2 + the sum over the upstream wakes
+        (docs/coupling.md#wakes-deep-in-an-array)."""
+        if rule == "quadrature":
+            self.turbulence[f, j] = np.hypot(self.turbulence[f, j], added)
+        else:
+            self.turbulence[f, j] = np.maximum(self.turbulence[f, j], np.hypot(added, ambient))
+
+    def incoming_fraction(self, pair, u_cell) -> np.ndarray:
+        """U_i / U_i,0 of rotors ``pair`` (flat indices): the mean over their cells of the
+        velocity in the wakes superposed so far, U_k - U_k d_k, over that of the inflow U_k
+        (``u_cell``, (pairs, n^2)); 1 for a rotor no wake has reached."""
+        ambient = u_cell.sum(axis=1)
+        waked = self.wake[pair].sum(axis=1)
+        return 1.0 - waked / np.where(ambient > 0.0, ambient, 1.0)

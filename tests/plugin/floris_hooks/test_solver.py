@@ -1,0 +1,185 @@
+"""The package's solver (plugin/floris_hooks/solver.py) against FLORIS's own sequential solver running the
+same wake models: random layouts, hub heights, yaw, wind and atmospheres, every shipped farm
+input, each combination rule and both wake expansions. The comparison runs FLORIS's solver
+itself, so it stays valid whatever the models' physics becomes."""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from floris import FlorisModel
+from floris.core import core as floris_core
+from floris.core import solver as floris_solver
+from floris.utilities import load_yaml
+from hypothesis import given
+from hypothesis import strategies as st
+
+import floris_ekman_veer  # noqa: F401
+from floris_ekman_veer.plugin.floris_hooks import solver
+
+INPUTS = Path(__file__).resolve().parents[3] / "inputs"
+FARMS = ("farm_sbl6", "farm_night", "farm_day")
+#: (velocity model, veer): M-1, M-2, M-3.
+MODELS = (("ekman_veer", True), ("ekman_veer", False), ("bastankhah2014", False))
+
+
+def farm_config(farm, model, veer, combination, expansion, seed, n_turbines=8):
+    """A shipped farm input with a random layout (some hub heights raised) and the model."""
+    rng = np.random.default_rng(seed)
+    config = copy.deepcopy(load_yaml(INPUTS / f"{farm}.yaml"))
+    wake = config["wake"]
+    wake["model_strings"]["velocity_model"] = model
+    wake["model_strings"]["combination_model"] = combination
+    wake["wake_deflection_parameters"]["ekman_veer"]["veer"] = veer
+    block = wake["wake_velocity_parameters"].setdefault(model, {})
+    block["wake_expansion"] = expansion  # (the atmosphere stays in the ekman_veer block)
+    # Rows along x with random spacing and stagger: many rotors in partial wakes.
+    side = int(np.ceil(np.sqrt(n_turbines)))
+    column, row = np.divmod(np.arange(n_turbines), side)
+    config["farm"]["layout_x"] = (column * 126.0 * rng.uniform(3.0, 8.0, n_turbines)).tolist()
+    config["farm"]["layout_y"] = (row * 126.0 * rng.uniform(1.0, 4.0)
+                                  + rng.uniform(-60.0, 60.0, n_turbines)).tolist()
+    return config
+
+
+def solve(config, speeds, directions, yaw, floris_own):
+    """Turbine powers, velocities and turbulence of one run, by FLORIS's sequential solver
+    (``floris_own``) or the package's."""
+    original = floris_core.sequential_solver
+    if floris_own:
+        floris_core.sequential_solver = solver.floris_sequential_solver()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fmodel = FlorisModel(copy.deepcopy(config))
+            fmodel.set(wind_speeds=speeds, wind_directions=directions,
+                       turbulence_intensities=np.full(len(speeds), 0.06), yaw_angles=yaw)
+            fmodel.run()
+    finally:
+        floris_core.sequential_solver = original
+    flow = fmodel.core.flow_field
+    return (fmodel.get_turbine_powers(), flow.u_sorted, flow.turbulence_intensity_field_sorted,
+            flow.turbulence_intensity_field_sorted_avg)
+
+
+@given(
+    farm=st.sampled_from(FARMS),
+    model=st.sampled_from(MODELS),
+    combination=st.sampled_from(("sosfs", "fls", "max")),
+    expansion=st.sampled_from(("ambient", "local_turbulence")),
+    seed=st.integers(0, 2**16),
+)
+def test_solver_equals_floris_sequential_solver(farm, model, combination, expansion, seed):
+    config = farm_config(farm, *model, combination, expansion, seed)
+    rng = np.random.default_rng(seed + 1)
+    n = 6
+    speeds = rng.uniform(4.0, 15.0, n)
+    directions = rng.uniform(0.0, 360.0, n)
+    yaw = rng.uniform(-25.0, 25.0, (n, len(config["farm"]["layout_x"])))
+    new = solve(config, speeds, directions, yaw, floris_own=False)
+    old = solve(config, speeds, directions, yaw, floris_own=True)
+    # Waked and unwaked rotors both present: the comparison covers the reach.
+    assert np.any(old[0] < 0.95 * np.max(old[0], axis=1, keepdims=True))
+    for a, b in zip(new, old, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=0.0)
+
+
+def test_solver_equals_floris_on_the_shipped_farms_and_a_large_batch():
+    """The shipped inputs as they are, 40 conditions, every rotor yawed; speeds up to 19 m/s,
+    where the stable inputs' fixed stability stays inside the physical domain
+    (docs/atmosphere.md#physical-domain)."""
+    rng = np.random.default_rng(3)
+    n = 40
+    speeds, directions = rng.uniform(3.0, 19.0, n), rng.uniform(0.0, 360.0, n)
+    for farm in FARMS:
+        config = load_yaml(INPUTS / f"{farm}.yaml")
+        yaw = rng.uniform(-30.0, 30.0, (n, len(config["farm"]["layout_x"])))
+        new = solve(config, speeds, directions, yaw, floris_own=False)
+        old = solve(config, speeds, directions, yaw, floris_own=True)
+        for a, b in zip(new, old, strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-12, atol=0.0, err_msg=farm)
+
+
+def _solver_calls(config, monkeypatch):
+    calls = []
+    monkeypatch.setattr(solver, "rotor_solver",
+                        lambda *args: calls.append(args) or pytest.fail("not expected"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fmodel = FlorisModel(config)
+        try:
+            fmodel.run()
+        except pytest.fail.Exception:
+            pass
+    return len(calls)
+
+
+def test_dispatch_picks_the_solver_for_the_package_models_on_turbine_grids(monkeypatch):
+    sbl6 = load_yaml(INPUTS / "farm_sbl6.yaml")
+    assert _solver_calls(copy.deepcopy(sbl6), monkeypatch) == 1
+    # FLORIS's gauss, GCH's whole-farm terms and a cubature grid keep FLORIS's solver.
+    gauss = copy.deepcopy(sbl6)
+    gauss["wake"]["model_strings"].update(velocity_model="gauss", deflection_model="gauss")
+    gch = copy.deepcopy(sbl6)
+    gch["wake"]["enable_secondary_steering"] = True
+    cubature = copy.deepcopy(sbl6)
+    cubature["solver"] = {"type": "turbine_cubature_grid", "turbine_grid_points": 3}
+    for config in (gauss, gch, cubature):
+        assert _solver_calls(config, monkeypatch) == 0
+
+
+def test_full_flow_solver_gives_the_same_values(monkeypatch):
+    """FLORIS's plane and point solvers solve the turbine grid first (with this solver now):
+    the same plane and points as with FLORIS's own solver."""
+    config = load_yaml(INPUTS / "farm_night.yaml")
+
+    def outputs():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fmodel = FlorisModel(copy.deepcopy(config))
+            fmodel.set(wind_speeds=[9.0], wind_directions=[275.0],
+                       turbulence_intensities=[0.06], yaw_angles=[[20.0, -15.0, 5.0] * 3])
+            plane = fmodel.calculate_horizontal_plane(height=90.0, x_resolution=40,
+                                                      y_resolution=30)
+            fmodel.set(wind_speeds=[9.0], wind_directions=[275.0],
+                       turbulence_intensities=[0.06], yaw_angles=[[20.0, -15.0, 5.0] * 3])
+            points = fmodel.sample_flow_at_points(np.full(5, 1400.0), np.linspace(-100, 900, 5),
+                                                  np.full(5, 90.0))
+        return plane.df.u.to_numpy(), points
+
+    new = outputs()
+    monkeypatch.setattr(floris_solver, "sequential_solver", solver.floris_sequential_solver())
+    monkeypatch.setattr(floris_core, "sequential_solver", solver.floris_sequential_solver())
+    old = outputs()
+    for a, b in zip(new, old, strict=True):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=0.0)
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_threads_give_the_same_bits(threads, monkeypatch):
+    """The pieces of a wake on 1 or N threads (many pieces: small ROW_CHUNK): bitwise equal."""
+    import numexpr
+
+    from floris_ekman_veer.plugin.rotor import rotor
+
+    config = farm_config("farm_sbl6", "ekman_veer", True, "sosfs", "local_turbulence", 7, 16)
+    rng = np.random.default_rng(8)
+    n = 10
+    speeds, directions = rng.uniform(5.0, 13.0, n), rng.uniform(0.0, 360.0, n)
+    yaw = rng.uniform(-25.0, 25.0, (n, 16))
+    monkeypatch.setattr(rotor, "ROW_CHUNK", 64)
+    before = numexpr.get_num_threads()
+    try:
+        numexpr.set_num_threads(1)
+        one = solve(config, speeds, directions, yaw, floris_own=False)
+        numexpr.set_num_threads(threads)
+        assert rotor.worker_threads() == threads
+        many = solve(config, speeds, directions, yaw, floris_own=False)
+    finally:
+        numexpr.set_num_threads(before)
+    for a, b in zip(one, many, strict=True):
+        np.testing.assert_array_equal(a, b)
