@@ -1,6 +1,6 @@
 """A SYNTHETIC year of met-mast records with the effects of real instruments, seeded
 (docs/measurements.md#a-real-mast): the year examples/site_report.py fits and the fixture of
-tests/studies/test_mast_instruments.py.
+tests/studies/site/test_mast_instruments.py.
 
 The mast is the usual one of a wind-resource campaign (IEC 61400-12-1 Annex G; the IEA Wind
 Task 43 data model's measurement points): cup anemometers on two booms at 40, 60 and 80 m, one

@@ -20,7 +20,7 @@ Run it from anywhere (after ``pip install .``, or from a checkout):
 4. Writes the figure of measured vs fitted profiles and the FLORIS input with the per-record
    atmosphere block (PNG and YAML to DIR, default ./output).
 
-``run_example(reduced=True)`` is the same on four records (tests/studies/test_site.py).
+``run_example(reduced=True)`` is the same on four records (tests/studies/site/test_site.py).
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ from floris_ekman_veer.registry import register
 from floris_ekman_veer.studies.energy.distributed import ParFlorisModel
 from floris_ekman_veer.studies.energy.energy import annual_energy
 from floris_ekman_veer.studies.yaw.optimization import optimize_yaw
-from floris_ekman_veer.studies.site import fit_site
+from floris_ekman_veer.studies.site.pipeline import fit_site
 from floris_ekman_veer.studies.validity import validity_report
 from floris_ekman_veer.warnings import (
     DirectionUnitsWarning,

@@ -162,7 +162,7 @@ def test_every_public_name_refuses_bad_input_naming_it(name, fmodel):
 def test_shear_and_veer_refuses_bad_tolerances_and_ragged_conditions_naming_them(inputs, named):
     """The tolerances are this function's inputs, named as such (not as the fit's speed_noise
     they become), and conditions of different lengths are named with their shapes."""
-    from floris_ekman_veer.studies.shear_and_veer import atmosphere_from_shear_and_veer
+    from floris_ekman_veer.studies.site.shear_and_veer import atmosphere_from_shear_and_veer
 
     call = dict(hub_speed=8.0, hub_height=90.0, rotor_diameter=126.0, shear_exponent=0.2,
                 latitude=52.0)

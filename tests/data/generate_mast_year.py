@@ -1,6 +1,6 @@
 """Generate tests/data/mast_year.csv.gz: a SYNTHETIC year of hourly met-mast records (8,760) with
 every kind of record a real mast logs, for the site workflow's end-to-end test
-(tests/studies/test_site_year.py, docs/measurements.md#a-year-of-records).
+(tests/studies/site/test_site_year.py, docs/measurements.md#a-year-of-records).
 
 A 150 m mast at 52 N over grass (z0 = 0.05 m), cup anemometers and vanes at 30, 70, 110 and
 150 m; the hub-height (90 m) wind speed is Weibull (k 2, scale 8.5 m/s), its direction a slow

@@ -69,6 +69,7 @@ from floris_ekman_veer.atmosphere.fit.fit_inputs import (
     at_direction_heights,
     check_option_names,
     checked_fit_data,
+    require_distinct_heights,
     warn_if_radians,
 )
 from floris_ekman_veer.atmosphere.fit.fit_model import ProfileModel
@@ -160,7 +161,9 @@ def fit_profile(abl_class, heights, speeds, directions=None, *,
         :class:`ProfileFit` (unknowns, direction offset, residuals per record).
     """
     check_option_names(abl_class, fixed_inputs)
+    require_distinct_heights("heights", heights)
     if direction_heights is not None:
+        require_distinct_heights("direction_heights", direction_heights)
         heights, speeds, directions = at_direction_heights(heights, speeds, directions,
                                                             direction_heights)
     if stability not in STABILITY_CHOICES:

@@ -139,6 +139,25 @@ def checked_turbulence(turbulence_intensity, noise, n, z0, fit_roughness):
     return height, value, np.full(n, float(noise))
 
 
+def require_distinct_heights(name, heights):
+    """ValueError naming a height given twice in one record's ``heights`` (or
+    ``direction_heights``): two data at one height are two readings of one instrument, or a
+    typing error; which one the profile should meet is unknown."""
+    z = np.asarray(heights)
+    if z.dtype.kind not in "iuf" or z.ndim not in (1, 2) or z.shape[-1] < 2:
+        return  # (the shape and type checks name such heights)
+    rows = np.atleast_2d(z).astype(float)
+    ordered = np.sort(rows, axis=1)
+    repeated = np.flatnonzero(np.any(np.diff(ordered, axis=1) == 0, axis=1))
+    if repeated.size:
+        i = int(repeated[0])
+        value = ordered[i][:-1][np.diff(ordered[i]) == 0][0]
+        where = np.flatnonzero(rows[i] == value).tolist()
+        record = f" of record {i}" if z.ndim == 2 else ""
+        raise ValueError(f"fit_profile: {name}{record} repeat {value:g} m (columns {where}); give "
+                         "each height once (one speed or direction per height)")
+
+
 def at_direction_heights(heights, speeds, directions, direction_heights):
     """(heights, speeds, directions) on the heights of both the speeds and the directions
     (``fit_profile(direction_heights=...)``): the speeds NaN (missing) at a direction's height,

@@ -306,18 +306,36 @@ def _chunk_of(conditions, rows, study, optimizer_kwargs) -> Chunk:
                  options_for_conditions(optimizer_kwargs, index), study["steering_chunk_size"])
 
 
-def energy_by_period(energy: AnnualEnergy, periods) -> pd.DataFrame:
-    """The study's energy per model and period (``periods``: a name per condition of the wind
-    data, e.g. its month), as :func:`annual_energy`'s table: the periods sum to the year."""
+def energy_by_month(energy: AnnualEnergy, times) -> pd.DataFrame:
+    """A typical year's energy per calendar month, January to December (``times``: the wind
+    data's time stamps, one per condition): per model and month the mean farm power of each year
+    present, averaged over those years, times the month's hours (February 28.25 days), so that
+    a month with gaps reads as its weather, not as a weak month; ``coverage`` is the share of
+    the month's records present over those years (from the records' median interval), and
+    ``years`` how many years hold it. A month with no record is NaN (``years`` 0). With every
+    month fully covered, the twelve sum to the year's AEP of the same records."""
+    times = pd.DatetimeIndex(times)
+    step = (pd.Series(times).sort_values().diff().median() / pd.Timedelta("1h")
+            if len(times) > 1 else 1.0)
+    step = step if np.isfinite(step) and step > 0 else 1.0
+    days = np.array([31.0, 28.25, 31.0, 30.0, 31.0, 30.0, 31.0, 31.0, 30.0, 31.0, 30.0, 31.0])
     rows = []
     for model, conditions in energy.conditions.items():
-        period = np.asarray(periods, dtype=object)[conditions.index.to_numpy()]
-        for name in pd.unique(period):
-            these = conditions[period == name]
-            baseline = aep(these["frequency"], these["farm_power_baseline"])
-            steered = (aep(these["frequency"], these["farm_power_steered"])
-                       if these["farm_power_steered"].notna().any() else np.nan)
-            rows.append({"model": model, "period": name, "frequency": these["frequency"].sum(),
+        at = times[conditions.index.to_numpy()]
+        frame = pd.DataFrame({"year": at.year, "month": at.month,
+                              "baseline": conditions["farm_power_baseline"].to_numpy(),
+                              "steered": conditions["farm_power_steered"].to_numpy()})
+        for month in range(1, 13):
+            these = frame[frame["month"] == month]
+            per_year = these.groupby("year")[["baseline", "steered"]].mean()
+            hours = 24.0 * days[month - 1]
+            expected = sum(pd.Period(f"{y}-{month:02d}").days_in_month * 24.0 / step
+                           for y in per_year.index)
+            baseline = float(per_year["baseline"].mean()) * hours / 1e9 if len(these) else np.nan
+            steered = (float(per_year["steered"].mean()) * hours / 1e9
+                       if these["steered"].notna().any() else np.nan)
+            rows.append({"model": model, "month": month, "years": len(per_year),
+                         "coverage": len(these) / expected if expected else 0.0,
                          "n_conditions": len(these), "aep_baseline_gwh": baseline,
                          "aep_steered_gwh": steered,
                          "gain_percent": 100.0 * (steered / baseline - 1.0)})

@@ -39,8 +39,9 @@ class AnnualEnergy:
     #: wind data), columns ``stability``, ``frequency``, ``farm_power_baseline`` and
     #: ``farm_power_steered`` [W] (NaN without an optimiser).
     conditions: dict = attrs.field(factory=dict)
-    #: A fitted year's energy per month (``SiteAtmosphere.annual_energy``): one row per model
-    #: and month, the columns of ``table`` with ``period`` for ``stability``; else None.
+    #: A fitted record set's typical year per calendar month (``SiteAtmosphere.annual_energy``):
+    #: one row per model and month (1-12), the years holding it, its data ``coverage``, and the
+    #: columns of ``table`` (``energy.energy_by_month``); else None.
     by_month: pd.DataFrame | None = None
 
     def plot(self, ax=None):

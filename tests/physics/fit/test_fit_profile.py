@@ -215,7 +215,7 @@ def test_bad_data_are_refused():
     with pytest.raises(ValueError, match=r"speeds must be finite"):
         EkmanABL.fit_profile(MAST, np.where(MAST > 100, np.inf, s), d, **SITE)
     with pytest.raises(ValueError, match=r"heights must be > roughness_length"):
-        EkmanABL.fit_profile(np.where(MAST > 100, 0.01, MAST), s, d, **SITE)
+        EkmanABL.fit_profile(np.where(MAST > 100, MAST * 1e-4, MAST), s, d, **SITE)
     with pytest.raises(ValueError, match=r"heights must be \(n_heights,\)"):
         EkmanABL.fit_profile(MAST[:3], s, d, **SITE)
     with pytest.raises(ValueError, match=r"directions must have the shape of speeds"):
@@ -229,7 +229,7 @@ def test_bad_data_are_refused():
 
 
 # A drawn near-northerly profile with little veer has every direction within 0 to 2 pi, as
-# radians would: the DirectionUnitsWarning it gets is tested in tests/studies/test_fit_robustness.py.
+# radians would: the DirectionUnitsWarning it gets is tested in tests/studies/site/test_fit_robustness.py.
 @pytest.mark.filterwarnings("ignore::floris_ekman_veer.DirectionUnitsWarning")
 @given(
     speed=st.floats(4.0, 16.0),

@@ -15,7 +15,7 @@ from floris_ekman_veer import EkmanABL, fit_site, optimize_yaw
 from floris_ekman_veer.plugin.inflow.inflow import solved_atmosphere
 from tests.conftest import make_config
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 MAST = REPO / "inputs" / "site" / "synthetic_mast.csv"
 HEIGHTS = np.arange(30.0, 151.0, 20.0)
 SITE = dict(latitude=52.0, roughness_length=0.05)
@@ -179,7 +179,7 @@ def test_shipped_synthetic_mast_is_labelled_and_fitted():
 def test_hub_speed_with_veer_or_shear_is_an_atmosphere():
     """One of rotor veer and shear with the hub speed determines u* and L: the veer is met
     exactly and the shear follows (docs/measurements.md#simpler-site-inputs)."""
-    from floris_ekman_veer.studies.shear_and_veer import atmosphere_from_shear_and_veer
+    from floris_ekman_veer.studies.site.shear_and_veer import atmosphere_from_shear_and_veer
 
     bottom, top = 27.0, 153.0
     for veer in (2.0, 10.0, 20.0):

@@ -1,8 +1,11 @@
-"""A met mast's vanes (docs/measurements.md#a-real-mast): stuck vanes (icing) removed and named,
-and the vane offsets, what a vane reads minus the true direction relative to the vane nearest the
-reference height, given or estimated from the strong-wind records (near-neutral) as the median
-turning from the reference vane minus the model's own neutral turning
-(docs/measurements.md#vane-offsets)."""
+"""A met mast's vanes (docs/measurements.md#a-real-mast), for stages 2 and 3 of the site fit
+(readings.py, offsets.py): stuck vanes (icing) removed and named, and the vane offsets, what a
+vane reads minus the true direction relative to the vane nearest the reference height, given or
+estimated from the strong-wind records (near-neutral) as the median turning from the reference
+vane minus the model's own neutral turning (docs/measurements.md#vane-offsets), with the
+median's standard error and, beside it, the reference turning's systematic uncertainty: the
+model's neutral turning between the vanes against the surface layer's (none, by Monin-Obukhov
+similarity)."""
 
 from __future__ import annotations
 
@@ -104,8 +107,9 @@ def with_offsets_from(instruments, rows, reference_height: float,
 
 
 def offsets_given(direction_offsets, vane_heights):
-    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
-                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
+    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "systematic_deg": np.nan,
+                          "records": 0, "source": "reference"},
+                         index=pd.Index(vane_heights, name="height"))
     if direction_offsets is None or isinstance(direction_offsets, str):
         if isinstance(direction_offsets, str) and direction_offsets != "estimate":
             raise ValueError(f"fit_site: direction_offsets must be 'estimate', None or "
@@ -122,7 +126,7 @@ def offsets_given(direction_offsets, vane_heights):
         if isinstance(offset, bool) or not np.isscalar(offset) or not np.isfinite(offset):
             raise ValueError(f"fit_site: direction_offsets[{height!r}] must be a number of "
                              f"degrees; got {offset!r}")
-        table.iloc[match[0], :] = [float(offset), np.nan, 0, "given"]
+        table.iloc[match[0], :] = [float(offset), np.nan, np.nan, 0, "given"]
     return table
 
 
@@ -132,8 +136,9 @@ def estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_he
     ``rows`` (module docstring)."""
     ref = reference_index(vane_heights, reference_height)
     cup = reference_index(cup_heights, reference_height)
-    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "records": 0,
-                          "source": "reference"}, index=pd.Index(vane_heights, name="height"))
+    table = pd.DataFrame({"offset_deg": 0.0, "uncertainty_deg": np.nan, "systematic_deg": np.nan,
+                          "records": 0, "source": "reference"},
+                         index=pd.Index(vane_heights, name="height"))
     strong = np.zeros(directions.shape[0], dtype=bool)
     strong[rows] = True
     strong &= np.isfinite(speeds[:, cup]) & np.isfinite(directions[:, ref])
@@ -147,6 +152,11 @@ def estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_he
         model = neutral_turning(speeds[rows, cup], cup_heights[cup],
                                 np.array([height, vane_heights[ref]]))
         turning = wrapped_angle(directions[rows, k] - directions[rows, ref])
-        median, error = median_and_error(wrapped_angle(turning - (model[:, 0] - model[:, 1])))
-        table.loc[height, :] = [median, error, rows.size, "estimated"]
+        reference = model[:, 0] - model[:, 1]
+        median, error = median_and_error(wrapped_angle(turning - reference))
+        # The reference turning's own uncertainty: the model's neutral turning between the
+        # vanes against the surface layer's, which Monin-Obukhov similarity makes zero (the
+        # stress and the wind aligned in the constant-flux layer); systematic, not statistical.
+        systematic = abs(float(np.median(reference)))
+        table.loc[height, :] = [median, error, systematic, rows.size, "estimated"]
     return table

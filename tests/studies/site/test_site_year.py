@@ -14,10 +14,10 @@ from floris import FlorisModel
 
 import floris_ekman_veer
 from floris_ekman_veer import fit_site
-from floris_ekman_veer.studies.site import EXCLUSION_KINDS
+from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS
 from tests.data.generate_mast_year import HEIGHTS, main as generate
 
-YEAR = Path(__file__).resolve().parents[1] / "data" / "mast_year.csv.gz"
+YEAR = Path(__file__).resolve().parents[2] / "data" / "mast_year.csv.gz"
 SITE = dict(latitude=52.0, roughness_length=0.05, speed_noise=0.1, direction_noise=0.5)
 #: What each true kind of record becomes: the fit's kinds it may be given (a convective hour
 #: with little shear deficit is a neutral fit, a front's slight backing may read as a misfit; a

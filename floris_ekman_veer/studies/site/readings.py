@@ -1,16 +1,6 @@
-"""A met mast's instruments, read as wind-resource practice reads them, before the fit
-(docs/measurements.md#a-real-mast).
-
-Columns of the records (the names carry the measurement point's height, as the IEA Wind Task 43
-data model's measurement points carry ``height_m``, and the boom as its ``boom_orientation_deg``):
-
-* ``speed_<h>m``: the mean speed [m/s] of the one cup at ``h`` m; or ``speed_<h>m_<boom>``, one
-  per boom at that height (e.g. ``speed_80m_a``, ``speed_80m_b``), the booms' orientations given
-  as ``booms={"a": 135.0, "b": 315.0}`` [deg, from the mast to the cup, clockwise from north];
-* ``speed_<h>m_std`` or ``speed_<h>m_<boom>_std``: the cup's standard deviation [m/s] over the
-  record (Task 43's statistic ``sd``): the measured turbulence intensity sigma_u / U;
-* ``direction_<h>m``: a vane's mean direction [deg, meteorological] at its own height;
-* ``..._min``, ``..._max`` (and a vane's ``_std``): other statistics, left alone.
+"""Stage 2 of the site fit (pipeline.py): the cleaned readings, the records' speeds,
+turbulence and directions as wind-resource practice reads a met mast's instruments before any fit
+(docs/measurements.md#a-real-mast). Works on stage 1's :class:`~.columns.MastColumns`.
 
 What :func:`read_instruments` makes of them:
 
@@ -22,47 +12,33 @@ What :func:`read_instruments` makes of them:
   disagrees beyond the cups' uncertainty (clear cups) or beyond the wake's measured ratio (a cup
   in the wake) in a record is removed at that height and named ("cups disagree"); a pair whose
   median ratio over the year departs from 1 by more than :data:`PAIR_TOLERANCE` is named in
-  ``cup_pairs``;
-* stuck vanes (icing): a vane repeating its reading for :data:`STUCK_RECORDS` records or more
-  while another vane turns is removed there and named ("stuck vane");
-* vane offsets: what a vane reads minus the true direction, relative to a reference vane (the
-  one nearest the reference height: only relative offsets show in a profile), estimated from
-  the records themselves as the median turning from the reference vane in strong-wind records
-  (near-neutral) minus the model's own neutral turning between those heights, with the median's
-  standard error; or given (``direction_offsets={38: -4.1}``); subtracted from the readings.
+  ``cup_pairs``; a cup reading 0 (or stalled at its starting threshold) beside a working
+  partner is dead, not a calm: its reading removed and named ("dead cup"), the partner used;
+* stuck vanes (icing): a vane repeating its reading for :data:`~.vanes.STUCK_RECORDS` records
+  or more while another vane turns is removed there and named ("stuck vane");
+* given vane offsets (``direction_offsets={38: -4.1}``) subtracted from the readings; estimated
+  ones are stage 3's (offsets.py), which reads the cups again with them (:func:`read_cups_again`).
 
-The vanes' part (stuck vanes, the offsets) is ``studies/vanes.py``; this module reads the columns
-and the cups and puts the instruments together.
+Also the readings as the fit's data (:func:`fit_heights`, :func:`fit_data`) and the measured
+turbulence intensity (:func:`measured_turbulence`).
 """
 
 from __future__ import annotations
-
-import re
 
 import attrs
 import numpy as np
 import pandas as pd
 
-from floris_ekman_veer.studies.vanes import (
+from floris_ekman_veer.studies.site.columns import MastColumns
+from floris_ekman_veer.studies.site.vanes import (
     direction_near,
     median_and_error,
     offsets_given,
     reference_index,
-    strong_wind_rows,
     unstick,
-    with_offsets_from,
     wrapped_angle,
 )
 
-#: Column names: the height in metres, a cup's boom, a cup's standard deviation.
-_NUMBER = r"(\d+(?:\.\d+)?)"
-#: Statistics of a record other than the mean (Task 43's statistic types): the cups' ``std`` is
-#: read; ``min`` and ``max`` and the vanes' statistics are left alone.
-STATISTICS = ("std", "min", "max")
-_STATISTIC = "|".join(STATISTICS)
-SPEED_COLUMN = re.compile(
-    rf"^speed_{_NUMBER}m(?:_(?!(?:{_STATISTIC})$)([A-Za-z][A-Za-z0-9]*))?(?:_({_STATISTIC}))?$")
-DIRECTION_COLUMN = re.compile(rf"^direction_{_NUMBER}m(?:_({_STATISTIC}))?$")
 #: Half-width [deg] of the sector around boom orientation + 180 deg in which a cup is in the
 #: mast's wake (IEC 61400-12-1 Annex G: a lattice mast's wake reaches about +-20-30 deg).
 SHADOW_HALF_WIDTH = 30.0
@@ -82,85 +58,23 @@ MAX_SHADOW_DEFICIT = 0.4
 #: Median ratio of a pair beyond 1 +- this: the pair disagrees (two class-1 calibrations, 1 %
 #: each, at two standard deviations of their ratio).
 PAIR_TOLERANCE = 0.03
+#: A speed column reading this many times the cups above it (or, for the top cups over
+#: :data:`UNIT_MIN_RECORDS` records or more, the cups below) in median is in km/h (3.6 times
+#: m/s): no wind falls with height by that much, and a year's shear never reaches it.
+KMH_RATIO = (2.8, 4.6)
+UNIT_MIN_RECORDS = 24
+#: No site's median wind reaches this [m/s] over :data:`UNIT_SITE_RECORDS` records: a speed
+#: column above it is in km/h (every column, so that no ratio shows it).
+MAX_MEDIAN_SPEED = 25.0
+UNIT_SITE_RECORDS = 720
+#: A cup reading this much or less [m/s] (0, or its starting threshold: IEC 61400-12-1 class-1
+#: cups start at 0.3-0.5 m/s) beside a partner reading :data:`DEAD_CUP_PARTNER` or more at its
+#: height is dead or stalled, not in a calm.
+DEAD_CUP_SPEED = 0.5
+DEAD_CUP_PARTNER = 2.0
 #: What is named per value removed.
-FLAG_KINDS = ("infinite reading", "cups disagree", "stuck vane")
+FLAG_KINDS = ("infinite reading", "dead cup", "cups disagree", "stuck vane")
 
-
-@attrs.frozen(eq=False)
-class MastColumns:
-    """The instruments of the records: per cup height the (boom, speed column, std column or
-    None) of its cups, per vane height its column."""
-
-    cups: dict
-    vanes: dict
-
-    @property
-    def cup_heights(self):
-        return np.array(sorted(self.cups))
-
-    @property
-    def vane_heights(self):
-        return np.array(sorted(self.vanes))
-
-    @property
-    def has_std(self):
-        return any(std is not None for cups in self.cups.values() for _, _, std in cups)
-
-
-def mast_columns(records: pd.DataFrame, booms=None) -> MastColumns:
-    """The instruments in ``records``' columns (module docstring); ValueError naming a column
-    that begins like one but is none, a boom without its orientation, or too few heights."""
-    if not isinstance(records, pd.DataFrame):
-        raise ValueError(f"records must be a pandas DataFrame; got {type(records).__name__}")
-    booms = {} if booms is None else dict(booms)
-    for name, orientation in booms.items():
-        if (isinstance(orientation, (bool, np.bool_))
-                or not isinstance(orientation, (int, float, np.integer, np.floating))
-                or not np.isfinite(orientation)):
-            raise ValueError(f"fit_site: booms[{name!r}] must be the boom's orientation in deg "
-                             f"(from the mast to the cup, clockwise from north); got "
-                             f"{orientation!r}")
-    cups, stds, vanes, unknown = {}, {}, {}, []
-    for column in map(str, records.columns):
-        if (m := SPEED_COLUMN.match(column)):
-            where = (float(m[1]), m[2])
-            if m[3] is None:
-                cups[where] = column
-            elif m[3] == "std":
-                stds[where] = column
-        elif (m := DIRECTION_COLUMN.match(column)):
-            if m[2] is None:
-                vanes[float(m[1])] = column
-        elif column.startswith(("speed_", "direction_")):
-            unknown.append(column)
-    if unknown:
-        raise ValueError(
-            f"records: columns {unknown} are named like measurements but read as none: name "
-            "them speed_<height>m, speed_<height>m_<boom>, speed_<height>m[_<boom>]_std (or _min, "
-            "_max) or direction_<height>m with the height a number >= 0 in metres (e.g. "
-            "speed_80m_a)")
-    lone = sorted(set(stds) - set(cups))
-    if lone:
-        raise ValueError(f"records: standard-deviation columns {[stds[k] for k in lone]} have "
-                         "no mean-speed column of their cup")
-    by_height = {}
-    for (height, boom), column in sorted(cups.items(), key=lambda kv: (kv[0][0], kv[0][1] or "")):
-        by_height.setdefault(height, []).append((boom, column, stds.get((height, boom))))
-    for height, group in by_height.items():
-        named = [boom for boom, _, _ in group if boom is not None]
-        if named and len(named) < len(group):
-            raise ValueError(f"records: at {height:g} m the cups {[c for _, c, _ in group]} mix "
-                             "a cup without a boom and cups with one: name every cup's boom")
-        missing = [c for boom, c, _ in group if boom is not None and boom not in booms]
-        if missing:
-            raise ValueError(f"records: columns {missing} name booms without an orientation: "
-                             f"give fit_site(..., booms={{name: orientation_deg}}) (got booms="
-                             f"{booms})")
-    if len(by_height) < 2:
-        raise ValueError(
-            "records need speed columns at two heights or more, named speed_<height>m (e.g. "
-            f"speed_90m); got columns {list(records.columns)}")
-    return MastColumns(cups=by_height, vanes=vanes)
 
 
 @attrs.frozen(eq=False)
@@ -172,7 +86,9 @@ class Instruments:
             its standard deviation [m/s] (NaN: none usable);
         vane_heights, directions: the vanes' directions with their offsets removed [deg];
         offsets: per vane height (index) ``offset_deg`` (reading minus true direction, relative
-            to the reference vane), ``uncertainty_deg`` (standard error), ``records`` and
+            to the reference vane), ``uncertainty_deg`` (standard error), ``systematic_deg``
+            (the reference turning's: the model's neutral turning against the surface
+            layer's), ``records`` and
             ``source`` ("reference", "estimated", "given", or "not estimated");
         cup_pairs: per cup height with two cups or more: the cups, their median ratio over the
             records where none is in the mast's wake, its standard error, the records, and
@@ -220,13 +136,11 @@ def _remove_bad(values, columns, flags):
     return np.where(bad, np.nan, values)
 
 
-def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_height: float,
-                     neutral_turning, *, booms=None, direction_offsets="estimate",
-                     shadow_half_width: float = SHADOW_HALF_WIDTH,
-                     labels=None) -> Instruments:
+def read_instruments(records: pd.DataFrame, columns: MastColumns, *, booms=None,
+                     direction_offsets="estimate",
+                     shadow_half_width: float = SHADOW_HALF_WIDTH, labels=None) -> Instruments:
     """The records' speeds, turbulence and directions as the fit reads them (module
-    docstring). ``neutral_turning(speeds, height, heights)``: the model's neutral direction at
-    ``heights`` minus that at ``height`` [deg, meteorological] for the speeds [m/s] there;
+    docstring), the given vane offsets removed (``"estimate"`` or None: none yet);
     ``labels``: the records' names (time stamps) in the reasons (default: their rows)."""
     labels = [str(i) for i in range(len(records))] if labels is None else list(labels)
     booms = {} if booms is None else dict(booms)
@@ -235,6 +149,7 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
             or not 0 <= shadow_half_width < 90):
         raise ValueError(f"fit_site: shadow_half_width must be a number in [0, 90) deg; got "
                          f"{shadow_half_width!r}")
+    check_speed_units(records, columns)
     flags = _Flags()
     vane_heights = columns.vane_heights
     directions = None
@@ -245,28 +160,92 @@ def read_instruments(records: pd.DataFrame, columns: MastColumns, reference_heig
     offsets = offsets_given(direction_offsets, vane_heights)
     if directions is not None:
         directions = directions - offsets["offset_deg"].to_numpy()[None, :]  # given ones
-    cup_heights = columns.cup_heights
-    cup_flags = _Flags()
     speeds, speed_std, pairs = _combine_cups(records, columns, directions, vane_heights, booms,
-                                             shadow_half_width, cup_flags)
-    instruments = Instruments(cup_heights=cup_heights, speeds=speeds,
-                              speed_std=speed_std if columns.has_std else None,
-                              vane_heights=vane_heights, directions=directions, offsets=offsets,
-                              cup_pairs=pairs, flags=flags.table())
-    if isinstance(direction_offsets, str) and directions is not None and vane_heights.size > 1:
-        instruments = with_offsets_from(instruments, strong_wind_rows(instruments,
-                                                                      reference_height),
-                                        reference_height, neutral_turning)
-        # The mast's wake again with the vanes' offsets removed: its sector and its ratio
-        # against the direction are sharper (a vane 4 deg off moves the wake's centre 4 deg).
-        cup_flags = _Flags()
-        speeds, speed_std, pairs = _combine_cups(records, columns, instruments.directions,
-                                                 vane_heights, booms, shadow_half_width,
-                                                 cup_flags)
-        instruments = attrs.evolve(instruments, speeds=speeds, cup_pairs=pairs,
-                                   speed_std=speed_std if columns.has_std else None)
-    flags.rows.extend(cup_flags.rows)
-    return attrs.evolve(instruments, flags=flags.table())
+                                             shadow_half_width, flags)
+    return Instruments(cup_heights=columns.cup_heights, speeds=speeds,
+                       speed_std=speed_std if columns.has_std else None,
+                       vane_heights=vane_heights, directions=directions, offsets=offsets,
+                       cup_pairs=pairs, flags=flags.table())
+
+
+def check_speed_units(records: pd.DataFrame, columns: MastColumns) -> None:
+    """ValueError naming a speed column that reads in km/h, not m/s (:data:`KMH_RATIO`,
+    :data:`MAX_MEDIAN_SPEED`): its speeds would fall with height, or be a storm all year."""
+    heights = [h for h in columns.cup_heights for _ in columns.cups[h]]
+    names = [c for h in columns.cup_heights for _, c, _ in columns.cups[h]]
+    values = _numbers(records, names)
+    values = np.where(np.isfinite(values) & (values > 0), values, np.nan)
+    counts = np.sum(np.isfinite(values), axis=0)
+    medians = np.array([np.median(v[np.isfinite(v)]) if n else np.nan
+                        for v, n in zip(values.T, counts)])
+    heights = np.asarray(heights)
+    for k, name in enumerate(names):
+        if not counts[k]:
+            continue
+        above = (heights > heights[k]) & np.isfinite(medians)
+        below = (heights < heights[k]) & np.isfinite(medians)
+        if above.any():
+            ratio = medians[k] / np.median(medians[above])
+        elif below.any() and counts[k] >= UNIT_MIN_RECORDS:
+            ratio = medians[k] / np.median(medians[below])
+        else:
+            ratio = np.nan
+        if KMH_RATIO[0] <= ratio <= KMH_RATIO[1] or (
+                counts[k] >= UNIT_SITE_RECORDS and medians[k] > MAX_MEDIAN_SPEED):
+            shown = (f"{ratio:.2f} times the cups {'above' if above.any() else 'below'} it"
+                     if np.isfinite(ratio) else f"a median of {medians[k]:.1f}")
+            raise ValueError(
+                f"records: speed column {name!r} reads {shown} (median {medians[k]:.2f}): it is "
+                "likely in km/h (3.6 times m/s); give the speeds in m/s (divide by 3.6)")
+
+
+def read_cups_again(instruments: Instruments, records: pd.DataFrame, columns: MastColumns, *,
+                    booms=None, shadow_half_width: float = SHADOW_HALF_WIDTH) -> Instruments:
+    """``instruments`` with its cups read again with its vanes' directions as they are now
+    (offsets removed): the mast wake's sector and its ratio against the direction are sharper
+    (a vane 4 deg off moves the wake's centre 4 deg). The vanes' flags are kept, the cups'
+    replaced."""
+    booms = {} if booms is None else dict(booms)
+    cup_flags = _Flags()
+    speeds, speed_std, pairs = _combine_cups(records, columns, instruments.directions,
+                                             instruments.vane_heights, booms, shadow_half_width,
+                                             cup_flags)
+    flags = instruments.flags
+    flags = pd.concat([flags[flags["column"].isin(list(columns.vanes.values()))],
+                       cup_flags.table()], ignore_index=True)
+    return attrs.evolve(instruments, speeds=speeds, cup_pairs=pairs,
+                        speed_std=speed_std if columns.has_std else None,
+                        flags=flags.sort_values("row", kind="stable").reset_index(drop=True))
+
+
+def fit_heights(instruments: Instruments, columns: MastColumns):
+    """(heights, speeds, directions, speed column names per height) as the fit takes them:
+    vanes at heights other than the cups' give their directions at their own heights (the
+    speeds there missing, and the directions missing at the cups' heights)."""
+    cups, vanes = instruments.cup_heights, instruments.vane_heights
+    names = {h: ", ".join(c for _, c, _ in columns.cups[h]) for h in cups}
+    directions = instruments.directions
+    if directions is None or (cups.size == vanes.size and np.allclose(cups, vanes)):
+        return cups, instruments.speeds, directions, [names[h] for h in cups]
+    heights = np.union1d(cups, vanes)
+    n = instruments.speeds.shape[0]
+    speeds = np.full((n, heights.size), np.nan)
+    speeds[:, np.searchsorted(heights, cups)] = instruments.speeds
+    at_heights = np.full((n, heights.size), np.nan)
+    at_heights[:, np.searchsorted(heights, vanes)] = directions
+    return heights, speeds, at_heights, [names.get(h, f"(no cup at {h:g} m)") for h in heights]
+
+
+def fit_data(instruments: Instruments, rows):
+    """``fit_profile``'s data of the records ``rows``: the cups' heights and speeds, and the
+    vanes' directions with their own heights (``direction_heights``) where those differ."""
+    cups, vanes = instruments.cup_heights, instruments.vane_heights
+    data = {"heights": cups, "speeds": instruments.speeds[rows], "directions": None}
+    if instruments.directions is not None:
+        data["directions"] = instruments.directions[rows]
+        if not (cups.size == vanes.size and np.allclose(cups, vanes)):
+            data["direction_heights"] = vanes
+    return data
 
 
 def _combine_cups(records, columns, directions, vane_heights, booms, half_width, flags):
@@ -288,6 +267,7 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
         if len(group) == 1:
             speeds[:, i], variance[:, i] = values[:, 0], stds[:, 0] ** 2
             continue
+        values, stds = _remove_dead(values, stds, names, height, flags)
         wind = direction_near(directions, vane_heights, height, n)
         orientation = np.array([booms[b] for b, _, _ in group])
         # Each cup's angle from its wake's centre: the wind from its boom's orientation + 180.
@@ -336,6 +316,22 @@ def _combine_cups(records, columns, directions, vane_heights, booms, half_width,
     pairs = pd.DataFrame(pairs, columns=["height", "cups", "median_ratio", "uncertainty",
                                          "records", "disagree", "wake_deficit"])
     return speeds, np.sqrt(variance), pairs
+
+
+def _remove_dead(values, stds, names, height, flags):
+    """A cup reading :data:`DEAD_CUP_SPEED` or less (0, or stalled at its starting threshold)
+    beside a partner reading :data:`DEAD_CUP_PARTNER` or more is dead, not a calm: its reading
+    (and standard deviation) removed and named ("dead cup"), the partner used in its place
+    (as where it is missing: out of the mast's wake)."""
+    with np.errstate(invalid="ignore"):
+        partner = np.fmax.reduce(np.where(np.isfinite(values), values, -np.inf), axis=1)
+        dead = (values <= DEAD_CUP_SPEED) & (partner[:, None] >= DEAD_CUP_PARTNER)
+    for k in np.flatnonzero(dead.any(axis=0)):
+        flags.add(np.flatnonzero(dead[:, k]), names[k], "dead cup",
+                  lambda r, k=k: f"the cup reads {values[r, k]:g} m/s beside "
+                  f"{', '.join(f'{c} {values[r, j]:g}' for j, c in enumerate(names) if j != k)}"
+                  f" m/s at {height:g} m (a dead or stalled cup, not a calm): the partner is used")
+    return np.where(dead, np.nan, values), np.where(dead, np.nan, stds)
 
 
 def _wake_ratio(angle, wake, clear_mean, half_width):

@@ -1,48 +1,29 @@
-"""A site's measured wind profiles as a FLORIS run: fitted atmosphere per record, a FLORIS
-``TimeSeries``, annual energy and yaw optimisation (docs/measurements.md#from-the-fit-to-floris).
-
-Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with columns
-``speed_<height>m`` [m/s] and ``direction_<height>m`` [deg, meteorological] (e.g. ``speed_90m``,
-``direction_90m``; NaN for a missing value), or a real mast's cups on booms, their standard
-deviations and vanes at their own heights (studies/mast.py, docs/measurements.md#a-real-mast),
-and optionally a ``time`` column naming the records.
-:func:`fit_site` fits every record (``EkmanABL.fit_profile``, one vectorised call) and gives, per
-record, FLORIS's inputs at the reference height: the wind speed and direction of the fitted
-profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and the atmosphere
-block with one entry per record. Driven by those wind speeds, the block gives back the fitted
-ABLs (checked when it is made). ``SiteAtmosphere.summary()`` reports the site.
+"""Stage 5 of the site fit (pipeline.py): the atmospheres, per record kept FLORIS's inputs at
+the reference height (docs/measurements.md#from-the-fit-to-floris): the wind speed and direction
+of the fitted profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and
+the atmosphere block with one entry per record. Driven by those wind speeds, the block gives back
+the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere` carries them to FLORIS (a
+``TimeSeries``, :meth:`~SiteAtmosphere.apply`, annual energy), and
+:meth:`SiteAtmosphere.summary` reports the site (:class:`SiteSummary`).
 """
 
 from __future__ import annotations
+
+import warnings
 
 import attrs
 import numpy as np
 import pandas as pd
 from floris.wind_data import TimeSeries
 
+import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
-from floris_ekman_veer.studies.mast import (SHADOW_HALF_WIDTH, mast_columns, measured_turbulence,
-                                            read_instruments)
-from floris_ekman_veer.studies.site_records import (
-    EXCLUSION_KINDS,
-    fit_data,
-    fit_heights,
-    more_excluded_text,
-    neutral_turning,
-    offsets_from_neutral_fits,
-    reasons_text,
-    screen_records,
-)
-from floris_ekman_veer.studies.energy.energy import energy_by_period, record_energy
 from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
-
-#: What :func:`fit_site` does with records that fit no atmosphere of the model.
-MISFIT_POLICIES = ("raise", "drop")
-#: The reference height may lie at most this many times above the highest measurement: the
-#: fitted profile is not extrapolated further than the mast's own height again.
-MAX_EXTRAPOLATION = 2.0
-
+from floris_ekman_veer.studies.energy.energy import energy_by_month, record_energy
+from floris_ekman_veer.studies.site.baseline import NeutralBaseline
+from floris_ekman_veer.studies.site.readings import Instruments
+from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS, RecordFit
+from floris_ekman_veer.studies.site.wra_file import MastMetadata
 
 #: The fitted records' classes, by their Obukhov length (ProfileFit.stability_class).
 STABILITY_CLASSES = ("convective", "neutral", "stable")
@@ -67,6 +48,10 @@ class SiteSummary:
             its standard error and whether the pair disagrees.
         flags: the instruments' values removed, per kind and column: the count, the first time
             stamp and one reason.
+        baseline: the neutral baseline per sector (roughness length with its uncertainty factor,
+            neutral TI with its standard error, the model's neutral TI; baseline.py).
+        tops_below_reference: fitted records whose layer is so shallow that their I_u at the
+            reference height is 0 (its top below 1 / 1.62 of it; warned by :func:`fit_site`).
     """
 
     exclusions: pd.DataFrame
@@ -79,6 +64,8 @@ class SiteSummary:
     offsets: pd.DataFrame | None
     cup_pairs: pd.DataFrame | None
     flags: pd.DataFrame
+    tops_below_reference: int = 0
+    baseline: pd.DataFrame | None = None
 
     def plot_class_by_hour(self, ax=None):
         """Stacked bars of the fitted classes' fractions per hour of day; returns the Axes."""
@@ -110,8 +97,14 @@ class SiteSummary:
         if self.offsets is not None and len(self.offsets):
             parts.append("vane offsets applied [deg] (reading minus true, relative to the "
                          "reference vane):\n" + self.offsets.to_string(float_format="{:.2f}".format))
+        if self.baseline is not None:
+            parts.append("neutral baseline per sector (strong-wind records):\n"
+                         + self.baseline.to_string(float_format="{:.4g}".format))
         if self.cup_pairs is not None and len(self.cup_pairs):
             parts.append("cup pairs:\n" + self.cup_pairs.to_string(float_format="{:.4f}".format))
+        if self.tops_below_reference:
+            parts.append(f"{self.tops_below_reference} fitted records have their boundary layer "
+                         "top so far below the reference height that their I_u there is 0")
         if len(self.flags):
             parts.append("values removed:\n" + self.flags.drop(columns="example").to_string())
         if self.class_by_hour is not None:
@@ -151,12 +144,26 @@ class SiteAtmosphere:
     #: Per fitted record its row in the records, and the count of records given.
     rows: np.ndarray | None = None
     n_records: int | None = None
-    #: What the mast's instruments gave (studies/mast.py): the vane offsets applied, the cup
-    #: pairs' agreement, and the values removed (``row``, ``time``, ``column``, ``kind``,
-    #: ``reason``).
+    #: What the mast's instruments gave (stages 2-3, readings.py and offsets.py): the vane
+    #: offsets applied, the cup pairs' agreement, and the values removed (``row``, ``time``,
+    #: ``column``, ``kind``, ``reason``).
     offsets: pd.DataFrame | None = None
     cup_pairs: pd.DataFrame | None = None
     flags: pd.DataFrame | None = None
+    #: The site's neutral baseline (baseline.py): the roughness rose and neutral turbulence.
+    baseline: NeutralBaseline | None = None
+    #: The mast's metadata file as read (wra_file.py: location, logger's UTC offset, columns).
+    metadata: MastMetadata | None = None
+
+    @property
+    def neutral_roughness_lengths(self) -> np.ndarray | None:
+        """Per fitted record its sector's neutral (effective) roughness length [m]."""
+        return None if self.baseline is None else self.baseline.roughness_lengths[self.rows]
+
+    @property
+    def neutral_turbulence_intensities(self) -> np.ndarray | None:
+        """Per fitted record its sector's measured neutral turbulence intensity (NaN: none)."""
+        return None if self.baseline is None else self.baseline.turbulence_intensities[self.rows]
 
     @property
     def stability_classes(self) -> np.ndarray:
@@ -166,7 +173,10 @@ class SiteAtmosphere:
     def timestamps(self) -> pd.DatetimeIndex | None:
         """The fitted records' labels as times (None where they do not read as times)."""
         try:
-            return pd.DatetimeIndex(pd.to_datetime(pd.Series(self.labels), errors="raise"))
+            with warnings.catch_warnings():
+                # (pandas' notice that it parses each label alone: names that are no times)
+                warnings.simplefilter("ignore", UserWarning)
+                return pd.DatetimeIndex(pd.to_datetime(pd.Series(self.labels), errors="raise"))
         except (ValueError, TypeError):
             return None
 
@@ -203,6 +213,8 @@ class SiteAtmosphere:
             kept_fraction_not_calm=len(self.labels) / max(total - calm, 1),
             classes=pd.Series(classes).value_counts().reindex(list(STABILITY_CLASSES)),
             class_by_hour=by_hour, offsets=self.offsets, cup_pairs=self.cup_pairs,
+            tops_below_reference=int(np.count_nonzero(self.turbulence_intensities <= 0.0)),
+            baseline=None if self.baseline is None else self.baseline.sectors,
             flags=flags.groupby(["kind", "column"]).agg(
                 records=("row", "size"), first=("time", "first"), example=("reason", "first")))
 
@@ -256,8 +268,9 @@ class SiteAtmosphere:
         ``client=`` a ``dask.distributed.Client`` runs the chunks on its cluster, bitwise the
         serial numbers, docs/coupling.md#annual-energy), as a site report gives it: ``table``
         by fitted stability class (convective, neutral, stable) and the year, ``by_month``
-        the energy per month of the records' time stamps (None when the records' names are no
-        time stamps).
+        a typical year's energy per calendar month, January to December, averaged over the
+        years present, with each month's data coverage (None when the records' names are no
+        time stamps; ``energy_by_month``).
 
         The records run as chunks of one vectorised FLORIS model each, with the per-record
         atmosphere block (as :meth:`apply`), never a model per class."""
@@ -266,162 +279,64 @@ class SiteAtmosphere:
                                classes=list(self.stability_classes), **options)
         times = self.timestamps()
         if times is not None:
-            energy = attrs.evolve(energy, by_month=energy_by_period(energy,
-                                                                    times.strftime("%Y-%m")))
+            energy = attrs.evolve(energy, by_month=energy_by_month(energy, times))
         return energy
 
 
-def fit_site(records: pd.DataFrame, reference_height: float, *,
-             stability_input: str = "stability_parameter", on_misfit: str = "raise",
-             time_column: str | None = None, booms: dict | None = None,
-             direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
-             **fit_options_and_inputs) -> SiteAtmosphere:
-    """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
-
-    The mast's instruments are read first (studies/mast.py, docs/measurements.md#a-real-mast):
-    vanes at their own heights, their offsets estimated and removed, stuck vanes and bad or
-    disagreeing readings removed and named, redundant cups chosen out of the mast's wake, and
-    the cups' standard deviations (``speed_<h>m_std``) given to the fit as the measured
-    turbulence intensity at the cup height nearest ``reference_height``.
-
-    Records a mast logs that no atmosphere of the model describes (docs/measurements.md#a-year-of-records)
-    are named by their time stamp and a reason: a zero (or negative) speed reading, too few
-    data, calm, a direction backing with height (a front), speeds falling with height, less
-    shear than a neutral layer (convective, with the default stable fit; ``stability="either"``
-    fits convective layers), a profile the model cannot follow (misfit), a repeated time
-    stamp, or a fitted state the atmosphere block cannot give back. One record never aborts the others' fits.
-
-    Args:
-        records: DataFrame with ``speed_<h>m`` (or ``speed_<h>m_<boom>``), optionally
-            ``speed_<h>m[_<boom>]_std``, ``direction_<h>m`` and a time column.
-        reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually),
-            above 10 roughness lengths and at most twice the highest measurement.
-        stability_input: the stability input of the atmosphere block (``stability_parameter``,
-            ``obukhov_length`` or ``cooling_rate``; the block is checked to give back the fit).
-        on_misfit: ``"raise"`` (ValueError naming the first such record, its time stamp and
-            why) or ``"drop"`` (leave such records out: ``dropped`` lists them,
-            ``excluded`` gives each one's reason and ``summary()`` the counts).
-        time_column: the column naming the records in messages and classes (default: ``time``
-            where the records have it, else their index).
-        booms: ``{boom: orientation_deg}`` of cups named ``speed_<h>m_<boom>``: the direction
-            from the mast to the cup, clockwise from north.
-        direction_offsets: ``"estimate"`` (default: each vane's offset relative to the vane
-            nearest ``reference_height``, from the strong-wind records), ``{vane height:
-            offset_deg}`` (the reading minus the true direction; vanes not named: 0), or None.
-        shadow_half_width: [deg] half-width of a cup's mast-wake sector (default 30).
-        **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
-            (``latitude``, ``roughness_length``, ``speed_noise``...).
-    """
-    if on_misfit not in MISFIT_POLICIES:
-        raise ValueError(f"fit_site: on_misfit must be one of {list(MISFIT_POLICIES)}; got "
-                         f"{on_misfit!r}")
-    if {"on_misfit", "labels", "direction_heights"} & set(fit_options_and_inputs):
-        raise ValueError("fit_site sets fit_profile's on_misfit, labels and direction_heights "
-                         "itself (from its own on_misfit, the time column and the vanes' "
-                         "columns)")
-    if (isinstance(reference_height, (bool, np.bool_))
-            or not isinstance(reference_height, (int, float, np.integer, np.floating))
-            or not np.isfinite(reference_height) or reference_height <= 0):
-        raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
-                         f"got {reference_height!r}")
-    columns = mast_columns(records, booms)
-    if time_column is not None and time_column not in records.columns:
-        raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
-                         f"(columns: {list(records.columns)}); give None to name the records "
-                         "by their index")
-    time_column = "time" if time_column is None else time_column
-    labels = (records[time_column].astype(str).tolist() if time_column in records.columns
-              else [str(i) for i in records.index])
-    if len(records) == 0:
-        raise ValueError("fit_site: records is empty")
-    z0 = np.max(np.asarray(fit_options_and_inputs.get("roughness_length", 0.0), float))
-    if not reference_height > 10.0 * z0:
-        raise ValueError(f"fit_site: reference_height must be > 10 roughness lengths "
-                         f"(roughness_length {z0:g} m: above the roughness sublayer, where the "
-                         f"fitted profile is a wind a turbine meets); got {reference_height!r} m")
-    top = max(columns.cup_heights.max(), columns.vane_heights.max(initial=0.0))
-    if reference_height > MAX_EXTRAPOLATION * top:
-        raise ValueError(f"fit_site: reference_height must be at most {MAX_EXTRAPOLATION:g} "
-                         f"times the highest measurement ({top:g} m: the fitted profile is not "
-                         f"extrapolated further); got {reference_height!r} m")
-    instruments = read_instruments(
-        records, columns, float(reference_height), neutral_turning(fit_options_and_inputs),
-        booms=booms, direction_offsets=direction_offsets, shadow_half_width=shadow_half_width,
-        labels=labels)
-    if (isinstance(direction_offsets, str)
-            and (instruments.offsets["source"] == "estimated").any()):
-        instruments = offsets_from_neutral_fits(instruments, float(reference_height),
-                                                 fit_options_and_inputs)
-    heights, speeds, directions, speed_columns = fit_heights(instruments, columns)
-    excluded = screen_records(speed_columns, labels, heights, speeds, directions,
-                       3 if fit_options_and_inputs.get("fit_roughness") else 2)
-    if on_misfit == "raise" and excluded:
-        row, (kind, text) = next(iter(sorted(excluded.items())))
-        raise ValueError(f"fit_site: record {labels[row]} cannot be fitted: {text}"
-                         + more_excluded_text(excluded, labels, row) + ". Give on_misfit='drop' to leave out "
-                         "such records (SiteAtmosphere.summary() tells what was left out and why)")
-    fit_inputs = dict(fit_options_and_inputs)
-    # (a measured turbulence intensity is a pair (height, value), each one number or a column)
-    turbulence = fit_inputs.pop("turbulence_intensity", None)
-    if turbulence is None and instruments.speed_std is not None:
-        turbulence = measured_turbulence(instruments, float(reference_height))
-    # (fixed inputs may be one per record; the fit's options, a noise pair say, are not)
-    per_record = {k: v for k, v in fit_inputs.items() if k not in FIT_OPTIONS and np.ndim(v) == 1}
-    candidates = np.setdiff1d(np.arange(len(records)), np.fromiter(excluded, int, len(excluded)))
-    if candidates.size == 0:
-        raise ValueError(f"fit_site: no record can be fitted ({reasons_text(excluded)})")
-    inputs = {**fit_inputs, **{k: np.asarray(v)[candidates] for k, v in per_record.items()}}
-    if turbulence is not None:
-        inputs["turbulence_intensity"] = tuple(
-            np.asarray(v, float)[candidates] if np.ndim(v) == 1 else v for v in turbulence)
-    abl = EkmanABL.fit_profile(
-        **fit_data(instruments, candidates),
-        on_misfit="raise" if on_misfit == "raise" else "flag",
-        labels=[labels[i] for i in candidates], **inputs,
-    )
-    fit = abl.profile_fit
-    for k in np.flatnonzero(~np.asarray(fit.fits)):
-        excluded[int(candidates[k])] = fit.reason(k)
-    kept = np.flatnonzero(fit.fits)
-    z_ref = float(reference_height)
-    if kept.size:
-        abl = fit.subset(kept) if kept.size < candidates.size else abl
-        fit = abl.profile_fit
-        same, _ = fit.given_back(fit.atmosphere(stability_input), z_ref)
-        if on_misfit == "raise" and not np.all(same):
-            fit.atmosphere(stability_input, reference_height=z_ref)  # raises, naming the records
-        for k in np.flatnonzero(~same):
-            excluded[int(candidates[kept[k]])] = (
-                "two states", f"its fitted state has a second one, deeper, with the same speed at "
-                f"{z_ref:g} m, which the atmosphere block gives and which does not fit the data "
-                f"(give the stability as another stability_input)")
-        if not np.all(same):
-            kept = kept[same]
-            abl = fit.subset(np.flatnonzero(same))
-            fit = abl.profile_fit
-    if kept.size == 0:
-        raise ValueError(f"fit_site: no record fits an atmosphere of the model "
-                         f"({reasons_text(excluded)})")
+def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: list,
+                    reference_height: float, baseline: NeutralBaseline | None = None, *,
+                    stability_input: str = "stability_parameter") -> SiteAtmosphere:
+    """The :class:`SiteAtmosphere` of stage 4's fit: FLORIS's inputs per record kept at
+    ``reference_height`` (module docstring), what was left out and why, and what the
+    instruments gave (offsets, cup pairs, values removed)."""
+    excluded = record_fit.excluded
     rows = sorted(excluded)
     table = pd.DataFrame({"time": [labels[i] for i in rows],
                           "kind": [excluded[i][0] for i in rows],
                           "reason": [excluded[i][1] for i in rows]},
                          index=pd.Index(rows, name="row"))
-    flags = instruments.flags
+    flags = instruments.flags.copy()
     flags.insert(1, "time", [labels[i] for i in flags["row"]])
+    abl = record_fit.abl
+    fit = abl.profile_fit
+    z_ref = float(reference_height)
+    turbulence = np.asarray(abl.turbulence_intensity(z_ref), float).reshape(-1)
+    warn_tops_below(abl, list(fit.labels), z_ref, turbulence)
     return SiteAtmosphere(
         labels=list(fit.labels),
         abl=abl,
         reference_height=z_ref,
         wind_speeds=fit.speed(np.array([z_ref]))[:, 0],
         wind_directions=fit.direction(np.array([z_ref]))[:, 0],
-        turbulence_intensities=np.asarray(abl.turbulence_intensity(z_ref), float).reshape(-1),
+        turbulence_intensities=turbulence,
         atmosphere=fit.atmosphere(stability_input),
         dropped=list(table["time"]),
         excluded=table,
-        rows=candidates[kept],
-        n_records=len(records),
+        rows=record_fit.rows,
+        n_records=len(labels),
         offsets=instruments.offsets,
         cup_pairs=instruments.cup_pairs,
         flags=flags,
+        baseline=baseline,
     )
+
+
+def warn_tops_below(abl: EkmanABL, labels: list, reference_height: float, turbulence) -> None:
+    """A ShallowBoundaryLayerWarning naming the records whose fitted layer is so shallow
+    (light-wind stable nights) that the model's turbulence ends below the reference height:
+    I_u is continued above the layer top h to where its variance vanishes, 1.62 h, and is 0
+    above (docs/atmosphere.md#shallow-boundary-layer), and so is their turbulence intensity at
+    the reference height."""
+    top = np.asarray(abl.boundary_layer_height, float).reshape(-1)
+    none = np.flatnonzero(np.asarray(turbulence) <= 0.0)
+    if none.size == 0:
+        return
+    shown = ", ".join(f"{labels[k]} (top {top[k]:.0f} m)" for k in none[:3])
+    package_warnings.warn(
+        f"fit_site: {none.size} of {top.size} fitted records have their boundary layer top so "
+        f"far below the reference height {reference_height:g} m ({shown}"
+        f"{', ...' if none.size > 3 else ''}) that their turbulence intensity there is 0 (the "
+        "model's I_u ends at 1.62 times the top): light-wind stable layers, in which a wake at "
+        "that height meets no ambient turbulence. Give records from a mast reaching the rotor's "
+        "top, or leave such hours out (SiteAtmosphere.summary() counts them)",
+        package_warnings.ShallowBoundaryLayerWarning)

@@ -11,8 +11,9 @@ import pytest
 
 import floris_ekman_veer
 from floris_ekman_veer import fit_site
-from floris_ekman_veer.studies import mast
-from floris_ekman_veer.studies.site_records import neutral_turning as _neutral_turning
+from floris_ekman_veer.studies.site.columns import mast_columns
+from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
+from floris_ekman_veer.studies.site.readings import read_instruments
 from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, N_ICING, VANE_HEIGHTS, VANE_OFFSETS,
                                      mast_year, shadow_deficit)
 
@@ -26,8 +27,10 @@ def year():
 
 @pytest.fixture(scope="module")
 def instruments(year):
-    return mast.read_instruments(year, mast.mast_columns(year, BOOMS), 80.0,
-                                 _neutral_turning(SITE), booms=BOOMS)
+    """The site fit's stages 1-3 (studies/site/pipeline.py), called one by one."""
+    columns = mast_columns(year, BOOMS)
+    readings = read_instruments(year, columns, booms=BOOMS)
+    return estimate_vane_offsets(readings, year, columns, 80.0, SITE, booms=BOOMS)
 
 
 @pytest.fixture(scope="module")
@@ -74,9 +77,9 @@ def test_cups_out_of_the_mast_wake_are_chosen_and_both_averaged_where_clear():
                           "speed_80m": [8.0, 8.0, 8.0, 8.0],
                           "direction_40m": [135.0, 315.0, 45.0, 45.0],
                           "direction_80m": [135.0, 315.0, 45.0, 45.0]})
-    columns = mast.mast_columns(frame, {"a": 135.0, "b": 315.0})
-    got = mast.read_instruments(frame, columns, 80.0, _neutral_turning(SITE),
-                                booms={"a": 135.0, "b": 315.0}, direction_offsets=None)
+    columns = mast_columns(frame, {"a": 135.0, "b": 315.0})
+    got = read_instruments(frame, columns, booms={"a": 135.0, "b": 315.0},
+                           direction_offsets=None)
     # From 135 deg the cup on boom b (315) is behind the mast: a is used; from 315, b is used
     # (a reads 17 % low behind the mast); from 45 neither is in the wake: the mean; a pair
     # 2.5 m/s apart there disagrees and is named.
@@ -105,6 +108,12 @@ def test_vane_offsets_are_found_within_a_tenth_of_the_half_degree(instruments, s
             if offset:
                 assert row["source"] == "estimated" and row["records"] > 300
                 assert 0.0 < row["uncertainty_deg"] < 0.15
+    # Beside the statistical error, the reference turning's systematic uncertainty: the model's
+    # neutral turning from the 78 m vane (about 0.5 deg down to 38 m, 0.2 deg to 58 m at
+    # 12-18 m/s) against the surface layer's none, larger than the statistical part.
+    systematic = site.offsets["systematic_deg"]
+    assert 0.4 < systematic.loc[38.0] < 0.6 and 0.15 < systematic.loc[58.0] < 0.3
+    assert np.all(systematic.loc[[38.0, 58.0]] > site.offsets["uncertainty_deg"].loc[[38.0, 58.0]])
     # Given offsets are applied as given (the reading minus the truth).
     given = fit_site(mast_year(periods=48), 80.0, on_misfit="drop", booms=BOOMS,
                      direction_offsets={38: -4.1, 58: 2.6}, **SITE)
@@ -240,10 +249,19 @@ def test_annual_energy_of_a_fitted_year_is_by_class_and_month_with_one_warning_e
     counts = pd.Series(site.stability_classes).value_counts()
     for name, n in counts.items():
         assert table.loc[name, "n_conditions"] == n
-    by_month = energy.by_month.set_index("period")
-    assert list(by_month.index) == ["2025-01", "2025-07"]
-    assert by_month["aep_baseline_gwh"].sum() == pytest.approx(table.loc["all", "aep_baseline_gwh"],
-                                                               rel=1e-12)
+    # A typical year by calendar month: January and July hold data, each 60 hours of its 744
+    # (coverage 60/744), the other months none; each month's energy is its mean power times
+    # its hours, whatever its gaps.
+    by_month = energy.by_month.set_index("month")
+    assert list(by_month.index) == list(range(1, 13))
+    assert by_month.loc[[1, 7], "years"].tolist() == [1, 1]
+    np.testing.assert_allclose(by_month.loc[[1, 7], "coverage"], [60 / 744, 60 / 744])
+    assert by_month.drop(index=[1, 7])["aep_baseline_gwh"].isna().all()
+    power = energy.conditions["ekman_veer"]["farm_power_baseline"].to_numpy()
+    months = pd.DatetimeIndex(site.timestamps()).month
+    for month in (1, 7):
+        assert by_month.loc[month, "aep_baseline_gwh"] == pytest.approx(
+            power[months == month].mean() * 744 / 1e9, rel=1e-12)
     # Eight chunks, one warning per class, located at this line, with speeds to 0.01 m/s.
     ours = [w for w in caught if issubclass(w.category, floris_ekman_veer.FlorisEkmanVeerWarning)]
     assert len(ours) == len({w.category for w in ours}) >= 1

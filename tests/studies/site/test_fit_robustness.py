@@ -1,5 +1,5 @@
 """Records that a real site logs never sink a fit, and every refusal names its input
-(atmosphere/fit/fit.py and studies/site.py; docs/measurements.md#a-year-of-records): a light-wind
+(atmosphere/fit/fit.py and studies/site/; docs/measurements.md#a-year-of-records): a light-wind
 record among others, a state next to the ABL top's kinks, repeated time stamps, bad options,
 directions in radians, vectorised simple inputs."""
 
@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from floris_ekman_veer import EkmanABL, fit_site
-from floris_ekman_veer.studies.shear_and_veer import atmosphere_from_shear_and_veer
+from floris_ekman_veer.studies.site.shear_and_veer import atmosphere_from_shear_and_veer
 
 SITE = dict(latitude=52.0, roughness_length=0.05)
 Z = np.arange(30.0, 151.0, 20.0)
@@ -196,8 +196,9 @@ def test_unclear_inputs_get_messages_naming_them():
                                          r"m/s fits no atmosphere"):
         atmosphere_from_shear_and_veer(9.0, 90.0, 126.0, 0.2, 10.0, **SITE)
     records = pd.DataFrame({f"speed_{z:.0f}m": [s[j]] for j, z in enumerate(Z)})
-    with pytest.raises(ValueError, match=r"fit_site: reference_height must be > 10 roughness "
-                                         r"lengths.*got 0.01 m"):
+    with pytest.raises(ValueError, match=r"fit_site: roughness_length must be a number in "
+                                         r"\(0, 0.001\) m \(below a tenth of the reference "
+                                         r"height 0.01 m\); got 0.05"):
         fit_site(records, 0.01, **SITE)
 
 
@@ -299,7 +300,7 @@ def _check_site(records):
 
     from floris_ekman_veer.atmosphere.inputs.input_ranges import (MIN_BOUNDARY_LAYER_HEIGHT,
                                                    SENSIBLE_HEAT_FLUX_RANGE)
-    from floris_ekman_veer.studies.site import EXCLUSION_KINDS
+    from floris_ekman_veer.studies.site.record_fit import EXCLUSION_KINDS
 
     with warnings.catch_warnings():
         # (no numpy overflow or invalid-value warning from the fit's trial states)

@@ -1,0 +1,271 @@
+"""Stage 3 of the site fit (pipeline.py), with the vane offsets: the site's own neutral baseline
+(docs/measurements.md#the-sites-neutral-baseline).
+
+From the strong-wind records (the speed at the cup nearest the reference height at least
+:data:`~.vanes.OFFSET_MIN_SPEED`: mechanical mixing makes them near-neutral, the premise of
+wind-resource practice's roughness rose, Troen & Petersen 1989, European Wind Atlas, ch. 8;
+IEC 61400-12-1 Annex B), per direction sector:
+
+* the effective roughness length z0: the z0 at which the model's own neutral profile (Eq.
+  U_model with L = inf) gives the sector's median ratio of the speed at the cup nearest the
+  reference height to the speed at the lowest cup, at the sector's median speed. An effective
+  z0 holds what the log law's z0 alone does not (a hilltop's speed-up flattens the profile,
+  upwind roughness changes steepen it): it is the roughness that makes the model's neutral
+  profile the site's own. Its uncertainty is the ratio's standard error (of the median, from the
+  MAD) carried through that inversion, given as a factor (z0 times or divided by it), and beside
+  it the systematic factor of the cups' calibration (:data:`CUP_CALIBRATION`);
+* the neutral turbulence intensity: the median of the cups' sigma_u / U at that cup, with its
+  standard error, beside the model's neutral I_u there (Eq. Iu_model) at the sector's z0; their
+  ratio is the terrain's excess turbulence (Wieringa 1993; Panofsky & Dutton 1984, ch. 7).
+
+Sectors of :data:`SECTOR_WIDTH` deg (12, as a wind atlas's rose); a sector with fewer than
+:data:`BASELINE_MIN_RECORDS` strong-wind records takes those of a wider window about its centre
+(widened by half a sector at a time), so where the data are thin the rose has fewer independent
+sectors, and says so (``half_width_deg``). Each record's neutral roughness and turbulence are
+its sector's (by the direction at the vane nearest the reference height), the all-direction
+values where it has none.
+"""
+
+from __future__ import annotations
+
+from numbers import Real
+
+import attrs
+import numpy as np
+import pandas as pd
+
+from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.studies.site.readings import Instruments
+from floris_ekman_veer.studies.site.vanes import (OFFSET_MIN_SPEED, direction_near,
+                                                  median_and_error, reference_index,
+                                                  wrapped_angle)
+
+#: Width [deg] of the roughness rose's sectors (12 sectors).
+SECTOR_WIDTH = 30.0
+#: Strong-wind records a sector's estimate needs (else its window widens).
+BASELINE_MIN_RECORDS = 20
+#: The roughness lengths [m] over which the model's neutral shear is inverted: open sea to
+#: city centre (Wieringa 1993's table).
+ROUGHNESS_RANGE = (1e-5, 2.0)
+_GRID = np.geomspace(*ROUGHNESS_RANGE, 61)
+#: A cup's calibration uncertainty, relative (IEC 61400-12-1 Annex E: about 1 % for a class-1
+#: cup): it does not average out over records, and a 1 % error of the shear ratio moves z0 by a
+#: factor of about 1.5 between 40 and 80 m; given as its own factor beside the statistical one.
+CUP_CALIBRATION = 0.01
+
+
+@attrs.frozen(eq=False)
+class NeutralBaseline:
+    """The site's neutral baseline (module docstring).
+
+    Attributes:
+        sectors: per sector centre [deg] (index) ``half_width_deg`` (the window its records come
+            from), ``records``, ``roughness_length`` [m], ``roughness_factor`` (its statistical
+            uncertainty as a factor), ``roughness_factor_calibration`` (the cups' calibration's),
+            ``speed_ratio`` (the measured median shear ratio) and its
+            ``speed_ratio_error``, ``neutral_ti`` and ``neutral_ti_error`` (NaN without the
+            cups' standard deviations), ``model_neutral_ti`` (the model's I_u at the sector's z0)
+            and ``source`` ("estimated", "given").
+        heights: (lower, upper) cup heights [m] of the shear ratio (the turbulence's: the cup
+            nearest the reference height).
+        roughness_lengths, turbulence_intensities: per record of the records its sector's
+            neutral roughness length [m] and neutral turbulence intensity (NaN: none measured).
+        sector_of: per record its sector's centre [deg] (NaN: no direction).
+    """
+
+    sectors: pd.DataFrame
+    heights: tuple
+    roughness_lengths: np.ndarray
+    turbulence_intensities: np.ndarray
+    sector_of: np.ndarray
+
+    def __str__(self) -> str:
+        return (f"neutral baseline (records from {OFFSET_MIN_SPEED:g} m/s; shear between "
+                f"{self.heights[0]:g} and {self.heights[1]:g} m):\n"
+                + self.sectors.to_string(float_format="{:.4g}".format))
+
+
+def checked_roughness(roughness_length, reference_height: float):
+    """``roughness_length`` as fit_site takes it: "estimate", a number [m] > 0, or
+    ``{sector centre deg: z0}``; ValueError naming the entry otherwise."""
+    if isinstance(roughness_length, str):
+        if roughness_length != "estimate":
+            raise ValueError(f"fit_site: roughness_length must be 'estimate', a number [m] or "
+                             f"{{sector centre deg: z0 m}}; got {roughness_length!r}")
+        return roughness_length
+    limit = reference_height / 10.0
+    entries = (roughness_length.items() if isinstance(roughness_length, dict)
+               else [(None, roughness_length)])
+    if isinstance(roughness_length, dict) and not roughness_length:
+        raise ValueError("fit_site: roughness_length {} names no sector; give {sector centre "
+                         "deg: z0 m}, a number or 'estimate'")
+    for sector, z0 in entries:
+        where = "roughness_length" if sector is None else f"roughness_length[{sector!r}]"
+        if sector is not None and (isinstance(sector, bool) or not isinstance(sector, Real)
+                                   or not 0.0 <= sector < 360.0):
+            raise ValueError(f"fit_site: roughness_length's sectors must be their centres in "
+                             f"[0, 360) deg; got {sector!r}")
+        if sector is None and np.ndim(z0) == 1:
+            z0 = np.asarray(z0, float)  # (one per record: fit_profile checks its length)
+            bad = ~(np.isfinite(z0) & (z0 > 0) & (z0 < limit))
+            if bad.any():
+                k = int(np.flatnonzero(bad)[0])
+                raise ValueError(f"fit_site: roughness_length[{k}] must be in (0, {limit:g}) m "
+                                 f"(below a tenth of the reference height); got {z0[k]!r}")
+            continue
+        if (isinstance(z0, bool) or not isinstance(z0, Real) or not np.isfinite(z0)
+                or not 0 < z0 < limit):
+            raise ValueError(f"fit_site: {where} must be a number in (0, {limit:g}) m (below a "
+                             f"tenth of the reference height {reference_height:g} m); got {z0!r}")
+    return roughness_length
+
+
+def neutral_baseline(instruments: Instruments, reference_height: float,
+                     fit_options_and_inputs: dict, roughness_length="estimate", *,
+                     cups_per_height=None) -> NeutralBaseline:
+    """The site's neutral baseline from the records (module docstring). ``roughness_length``:
+    "estimate", or a number or ``{sector centre: z0}`` given (then only the turbulence is
+    estimated, and each record takes the given roughness of the sector nearest its direction).
+    ValueError when "estimate" finds fewer than :data:`BASELINE_MIN_RECORDS` strong-wind
+    records (give the roughness length)."""
+    n = instruments.speeds.shape[0]
+    cups = instruments.cup_heights
+    # The turbulence's cup is the one nearest the reference height; the shear is read between
+    # the lowest cup and that one (the highest where that one is the lowest).
+    cup = reference_index(cups, reference_height)
+    lower, upper = 0, (cup if cup > 0 else cups.size - 1)
+    speeds = instruments.speeds
+    counts = list(cups_per_height or [1] * cups.size)
+    direction = direction_near(instruments.directions, instruments.vane_heights,
+                               reference_height, n)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = speeds[:, upper] / speeds[:, lower]
+        intensity = (instruments.speed_std[:, cup] / speeds[:, cup]
+                     if instruments.speed_std is not None else np.full(n, np.nan))
+    strong = (np.isfinite(speeds[:, cup]) & (speeds[:, cup] >= OFFSET_MIN_SPEED)
+              & np.isfinite(ratio) & (ratio > 0))
+    given = not isinstance(roughness_length, str)
+    if not given and np.count_nonzero(strong) < BASELINE_MIN_RECORDS:
+        raise ValueError(
+            f"fit_site: roughness_length='estimate' needs {BASELINE_MIN_RECORDS} records or more "
+            f"with {OFFSET_MIN_SPEED:g} m/s or more at {cups[cup]:g} m (near-neutral: the "
+            f"site's neutral profile); the records have {np.count_nonzero(strong)}. Give the "
+            "roughness length (a number [m] or {sector centre deg: z0 m})")
+    centres = np.arange(0.0, 360.0, SECTOR_WIDTH)
+    rows = []
+    for centre in centres:
+        half = SECTOR_WIDTH / 2.0
+        while True:
+            near = np.abs(wrapped_angle(direction - centre)) < half
+            use = strong & near
+            if np.count_nonzero(use) >= BASELINE_MIN_RECORDS or half >= 180.0:
+                break
+            half += SECTOR_WIDTH / 2.0
+        if half >= 180.0:
+            use = strong  # (every direction, and the records without one)
+        shear, shear_error = median_and_error(ratio[use])
+        ti, ti_error = median_and_error(intensity[use])
+        rows.append({"centre_deg": centre, "half_width_deg": min(half, 180.0),
+                     "records": int(np.count_nonzero(use)), "speed": float(np.median(
+                         speeds[use, upper])) if use.any() else np.nan,
+                     "speed_ratio": shear, "speed_ratio_error": shear_error,
+                     "neutral_ti": ti, "neutral_ti_error": ti_error})
+    table = pd.DataFrame(rows).set_index("centre_deg")
+    fixed = {k: (float(np.median(v)) if np.ndim(v) else v)
+             for k, v in fit_options_and_inputs.items()
+             if k not in FIT_OPTIONS and k != "roughness_length"}
+    heights = (float(cups[lower]), float(cups[upper]))
+    if given:
+        table["roughness_length"] = _given_at(roughness_length, table.index.to_numpy())
+        table["roughness_factor"] = np.nan
+        table["roughness_factor_calibration"] = np.nan
+        table["source"] = "given"
+    else:
+        calibration = CUP_CALIBRATION * np.sqrt(1.0 / counts[lower] + 1.0 / counts[upper])
+        z0, factor, inside, systematic = _inverted(table, heights, fixed, calibration)
+        table["roughness_length"], table["roughness_factor"] = z0, factor
+        table["roughness_factor_calibration"] = systematic
+        # (a shear beyond the model's neutral range, open sea to city centre, is given the
+        # range's end and named: no effective roughness of the model makes it)
+        table["source"] = np.where(inside, "estimated", "range end")
+    table["model_neutral_ti"] = _model_turbulence(table, heights[1], float(cups[cup]), fixed)
+    table = table.drop(columns="speed")
+    sector = np.full(n, np.nan)
+    known = np.isfinite(direction)
+    sector[known] = centres[np.argmin(np.abs(wrapped_angle(
+        direction[known, None] - centres[None, :])), axis=1)]
+    at = np.searchsorted(centres, np.where(known, sector, 0.0))
+    ti_all, _ = median_and_error(intensity[strong])
+    turbulence = np.where(known, table["neutral_ti"].to_numpy()[at], ti_all)
+    if isinstance(roughness_length, dict):
+        values = np.array([float(v) for v in roughness_length.values()])
+        roughness = np.where(known, _given_at(roughness_length, np.where(known, direction, 0.0)),
+                             float(np.exp(np.mean(np.log(values)))))
+    elif given:
+        roughness = np.broadcast_to(np.asarray(roughness_length, float), (n,)).copy()
+    else:
+        z0 = table["roughness_length"].to_numpy()
+        roughness = np.where(known, z0[at], float(np.exp(np.mean(np.log(z0)))))
+    return NeutralBaseline(sectors=table, heights=heights, roughness_lengths=roughness,
+                           turbulence_intensities=turbulence, sector_of=sector)
+
+
+def _given_at(roughness_length, centres):
+    """At the directions [deg] the given roughness: the number (the geometric median of one per
+    record), or the given sector's nearest each."""
+    if not isinstance(roughness_length, dict):
+        value = np.asarray(roughness_length, float)
+        return np.full(centres.size, float(np.exp(np.median(np.log(value)))))
+    keys = np.array([float(k) for k in roughness_length])
+    values = np.array([float(v) for v in roughness_length.values()])
+    nearest = np.argmin(np.abs(wrapped_angle(centres[:, None] - keys[None, :])), axis=1)
+    return values[nearest]
+
+
+def _neutral_ratio(z0, speed, heights, fixed):
+    """The model's neutral U(upper) / U(lower) at z0 [m] with ``speed`` at the upper height."""
+    abl = EkmanABL.from_reference_wind(speed, heights[1], obukhov_length=np.inf,
+                                       **{**fixed, "roughness_length": z0})
+    return np.asarray(abl.speed(heights[1]), float) / np.asarray(abl.speed(heights[0]), float)
+
+
+def _inverted(table, heights, fixed, calibration):
+    """Per sector the z0 whose model neutral ratio is the measured one, and its uncertainty
+    factor (module docstring), and whether the measured ratio lies inside the grid's range.
+    One vectorised solve over sectors and the z0 grid."""
+    grid = _GRID[_GRID < heights[0] / 10.0]
+    speed = table["speed"].to_numpy()
+    m = speed.size
+    ratios = _neutral_ratio(np.tile(grid, m), np.repeat(speed, grid.size), heights,
+                            fixed).reshape(m, grid.size)
+    log_grid = np.log(grid)
+    z0 = np.empty(m)
+    factor = np.empty(m)
+    inside = np.zeros(m, bool)
+    systematic = np.empty(m)
+    for k in range(m):
+        # (the neutral ratio grows with z0: interpolated in ln z0; outside the range, its end)
+        measured, error = table["speed_ratio"].iloc[k], table["speed_ratio_error"].iloc[k]
+        at = np.interp([measured - error, measured, measured + error], ratios[k], log_grid)
+        z0[k] = np.exp(at[1])
+        factor[k] = np.exp(0.5 * (at[2] - at[0]))
+        inside[k] = ratios[k, 0] <= measured <= ratios[k, -1]
+        off = measured * calibration
+        ends = np.interp([measured - off, measured + off], ratios[k], log_grid)
+        systematic[k] = np.exp(0.5 * (ends[1] - ends[0]))
+    return z0, factor, inside, systematic
+
+
+def _model_turbulence(table, height, turbulence_height, fixed):
+    """The model's neutral I_u at ``turbulence_height`` per sector at its z0 and its median
+    speed at ``height``."""
+    speed = table["speed"].to_numpy()
+    ok = np.isfinite(speed)
+    out = np.full(speed.size, np.nan)
+    if ok.any():
+        abl = EkmanABL.from_reference_wind(speed[ok], height, obukhov_length=np.inf,
+                                           **{**fixed, "roughness_length":
+                                              table["roughness_length"].to_numpy()[ok]})
+        out[ok] = np.asarray(abl.turbulence_intensity(turbulence_height), float).reshape(-1)
+    return out

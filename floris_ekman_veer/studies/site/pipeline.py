@@ -1,0 +1,159 @@
+"""The site fit as its stages, in the order a reader follows them (docs/measurements.md#a-real-mast,
+docs/architecture.md): a site's measured wind profiles as per-record FLORIS inputs.
+
+Records are a pandas DataFrame, one row per record (a 10-minute mean, say), with columns
+``speed_<height>m`` [m/s] and ``direction_<height>m`` [deg, meteorological] (e.g. ``speed_90m``,
+``direction_90m``; NaN for a missing value), or a real mast's cups on booms, their standard
+deviations and vanes at their own heights (columns.py), and optionally a ``time`` column naming
+the records. :func:`fit_site` runs, each stage a module a user can call and inspect:
+
+1. the instruments the columns hold (:func:`.columns.mast_columns`), named by the mast's IEA
+   Wind Task 43 metadata file where one is given (:func:`.wra_file.read_wra_file`);
+2. the cleaned readings: bad and stuck readings removed and named, redundant cups out of the
+   mast's wake (:func:`.readings.read_instruments`);
+3. the site's neutral baseline (its roughness rose and neutral turbulence,
+   :func:`.baseline.neutral_baseline`) and the vane offsets, both from the strong-wind,
+   near-neutral records (:func:`.offsets.estimate_vane_offsets`);
+4. the per-record fit: records no fit should see named, every other one fitted
+   (:func:`.record_fit.fit_records`);
+5. the atmospheres: FLORIS's inputs per record (:func:`.atmospheres.site_atmosphere`).
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+import pandas as pd
+
+from floris_ekman_veer.studies.site.atmospheres import SiteAtmosphere, site_atmosphere
+from floris_ekman_veer.studies.site.baseline import checked_roughness, neutral_baseline
+from floris_ekman_veer.studies.site.columns import mast_columns
+from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
+from floris_ekman_veer.studies.site.readings import SHADOW_HALF_WIDTH, read_instruments
+from floris_ekman_veer.studies.site.record_fit import fit_records
+from floris_ekman_veer.studies.site.wra_file import read_wra_file
+
+#: What :func:`fit_site` does with records that fit no atmosphere of the model.
+MISFIT_POLICIES = ("raise", "drop")
+#: The reference height may lie at most this many times above the highest measurement: the
+#: fitted profile is not extrapolated further than the mast's own height again.
+MAX_EXTRAPOLATION = 2.0
+
+
+def fit_site(records: pd.DataFrame, reference_height: float, *,
+             stability_input: str = "stability_parameter", on_misfit: str = "raise",
+             time_column: str | None = None, booms: dict | None = None,
+             direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
+             roughness_length="estimate", metadata=None,
+             **fit_options_and_inputs) -> SiteAtmosphere:
+    """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
+
+    The mast's instruments are read first (columns.py, readings.py, offsets.py;
+    docs/measurements.md#a-real-mast):
+    vanes at their own heights, their offsets estimated and removed, stuck vanes and bad or
+    disagreeing readings removed and named, redundant cups chosen out of the mast's wake, and
+    the cups' standard deviations (``speed_<h>m_std``) given to the fit as the measured
+    turbulence intensity at the cup height nearest ``reference_height``.
+
+    Records a mast logs that no atmosphere of the model describes (docs/measurements.md#a-year-of-records)
+    are named by their time stamp and a reason: a zero (or negative) speed reading, too few
+    data, calm, a direction backing with height (a front), speeds falling with height, less
+    shear than a neutral layer (convective, with the default stable fit; ``stability="either"``
+    fits convective layers), a profile the model cannot follow (misfit), a repeated time
+    stamp, or a fitted state the atmosphere block cannot give back. One record never aborts the others' fits.
+
+    Args:
+        records: DataFrame with ``speed_<h>m`` (or ``speed_<h>m_<boom>``), optionally
+            ``speed_<h>m[_<boom>]_std``, ``direction_<h>m`` and a time column.
+        reference_height: FLORIS's ``reference_wind_height`` [m] (the hub height, usually),
+            above 10 roughness lengths and at most twice the highest measurement.
+        stability_input: the stability input of the atmosphere block (``stability_parameter``,
+            ``obukhov_length`` or ``cooling_rate``; the block is checked to give back the fit).
+        on_misfit: ``"raise"`` (ValueError naming the first such record, its time stamp and
+            why) or ``"drop"`` (leave such records out: ``dropped`` lists them,
+            ``excluded`` gives each one's reason and ``summary()`` the counts).
+        time_column: the column naming the records in messages and classes (default: ``time``
+            where the records have it, else their index).
+        booms: ``{boom: orientation_deg}`` of cups named ``speed_<h>m_<boom>``: the direction
+            from the mast to the cup, clockwise from north.
+        direction_offsets: ``"estimate"`` (default: each vane's offset relative to the vane
+            nearest ``reference_height``, from the strong-wind records), ``{vane height:
+            offset_deg}`` (the reading minus the true direction; vanes not named: 0), or None.
+        shadow_half_width: [deg] half-width of a cup's mast-wake sector (default 30).
+        roughness_length: ``"estimate"`` (default: the site's own effective roughness per
+            30-deg sector from its strong-wind, near-neutral records, baseline.py and
+            docs/measurements.md#the-sites-neutral-baseline), a number [m], one per record, or
+            ``{sector centre deg: z0 m}`` (each record takes the sector nearest its direction).
+        metadata: the path of the mast's IEA Wind Task 43 WRA data model file (JSON; wra_file.py,
+            docs/measurements.md#the-masts-own-metadata): its logger columns are read as the
+            records' columns, its booms as ``booms`` and its location as ``latitude``; given
+            ``booms`` or ``latitude`` that contradict it, or a column it names that the records
+            lack, are refused naming both.
+        **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
+            (``latitude``, ``roughness_length``, ``speed_noise``...).
+    """
+    if on_misfit not in MISFIT_POLICIES:
+        raise ValueError(f"fit_site: on_misfit must be one of {list(MISFIT_POLICIES)}; got "
+                         f"{on_misfit!r}")
+    if {"on_misfit", "labels", "direction_heights"} & set(fit_options_and_inputs):
+        raise ValueError("fit_site sets fit_profile's on_misfit, labels and direction_heights "
+                         "itself (from its own on_misfit, the time column and the vanes' "
+                         "columns)")
+    if (isinstance(reference_height, (bool, np.bool_))
+            or not isinstance(reference_height, (int, float, np.integer, np.floating))
+            or not np.isfinite(reference_height) or reference_height <= 0):
+        raise ValueError(f"fit_site: reference_height must be a number > 0 m (not a string); "
+                         f"got {reference_height!r}")
+    # 1. the instruments (from the mast's metadata file where given)
+    mast = None
+    if metadata is not None:
+        mast = read_wra_file(metadata)
+        records = mast.named_records(records)
+        if booms is not None and mast.booms and dict(booms) != mast.booms:
+            raise ValueError(f"fit_site: booms={booms} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose booms are {mast.booms}; give one of them")
+        booms = booms if booms is not None else (mast.booms or None)
+        given = fit_options_and_inputs.get("latitude", mast.latitude)
+        if np.ndim(given) or not np.isclose(given, mast.latitude, atol=1e-6):
+            raise ValueError(f"fit_site: latitude={given!r} contradicts the mast's metadata file "
+                             f"{str(metadata)!r}, whose location is at {mast.latitude:g} deg; "
+                             "give one of them")
+        fit_options_and_inputs = {**fit_options_and_inputs, "latitude": mast.latitude}
+    columns = mast_columns(records, booms)
+    if time_column is not None and time_column not in records.columns:
+        raise ValueError(f"fit_site: time_column {time_column!r} is not a column of records "
+                         f"(columns: {list(records.columns)}); give None to name the records "
+                         "by their index")
+    time_column = "time" if time_column is None else time_column
+    labels = (records[time_column].astype(str).tolist() if time_column in records.columns
+              else [str(i) for i in records.index])
+    if len(records) == 0:
+        raise ValueError("fit_site: records is empty")
+    checked_roughness(roughness_length, float(reference_height))
+    top = max(columns.cup_heights.max(), columns.vane_heights.max(initial=0.0))
+    if reference_height > MAX_EXTRAPOLATION * top:
+        raise ValueError(f"fit_site: reference_height must be at most {MAX_EXTRAPOLATION:g} "
+                         f"times the highest measurement ({top:g} m: the fitted profile is not "
+                         f"extrapolated further); got {reference_height!r} m")
+    z_ref = float(reference_height)
+    # 2. the cleaned readings
+    instruments = read_instruments(records, columns, booms=booms,
+                                   direction_offsets=direction_offsets,
+                                   shadow_half_width=shadow_half_width, labels=labels)
+    # 3. the neutral baseline and the vane offsets (whose reference turning is the model's
+    # neutral one at the site's roughness)
+    baseline = neutral_baseline(instruments, z_ref, fit_options_and_inputs, roughness_length,
+                                cups_per_height=[len(columns.cups[h]) for h in columns.cup_heights])
+    fit_inputs = {**fit_options_and_inputs, "roughness_length": (
+        roughness_length if np.ndim(roughness_length) == 0 and not isinstance(
+            roughness_length, (str, dict)) else baseline.roughness_lengths)}
+    if isinstance(direction_offsets, str):
+        instruments = estimate_vane_offsets(instruments, records, columns, z_ref, fit_inputs,
+                                            booms=booms, shadow_half_width=shadow_half_width)
+    # 4. the per-record fit
+    record_fit = fit_records(instruments, columns, labels, z_ref, fit_inputs,
+                             stability_input=stability_input, on_misfit=on_misfit)
+    # 5. the atmospheres
+    site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
+                           stability_input=stability_input)
+    return site if mast is None else attrs.evolve(site, metadata=mast)

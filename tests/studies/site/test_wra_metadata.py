@@ -1,0 +1,106 @@
+"""The mast's own metadata: an IEA Wind Task 43 WRA data model file (JSON, schema v1.x
+structure) read by fit_site (studies/site/wra_file.py, docs/measurements.md#the-masts-own-metadata):
+its columns, booms, location and logger UTC offset used; a file that contradicts the records or
+the call refused naming both."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from floris_ekman_veer import fit_site
+from floris_ekman_veer.studies.site.wra_file import read_wra_file
+
+from instrumented_mast_year import mast_year
+
+
+def point(name, kind, height, columns, boom=None, dead_band=None):
+    mounting = {"date_from": "2025-01-01T00:00:00", "boom_orientation_deg": boom}
+    if dead_band is not None:
+        mounting["vane_dead_band_orientation_deg"] = dead_band
+    return {"name": name, "measurement_type_id": kind, "height_m": height,
+            "height_reference_id": "ground_level", "mounting_arrangement": [mounting],
+            "logger_measurement_config": [{
+                "date_from": "2025-01-01T00:00:00", "slope": 0.0458, "offset": 0.2,
+                "column_name": [{"column_name": c, "statistic_type_id": s, "is_ignored": False}
+                                for c, s in columns]}]}
+
+
+def task43_file(tmp_path, heights=(80, 60, 40), latitude=53.3):
+    """A Task 43 file of the instrumented mast: two cups per height on booms at 135 and 315 deg
+    (logger names Spd_<h>mA_Avg, ..._SD), vanes at 78, 58 and 38 m (Dir_<h>m_Avg)."""
+    points = []
+    for h in heights:
+        for boom, angle in (("A", 135.0), ("B", 315.0)):
+            points.append(point(f"Spd_{h}m{boom}", "wind_speed", float(h),
+                                [(f"Spd_{h}m{boom}_Avg", "avg"), (f"Spd_{h}m{boom}_SD", "sd"),
+                                 (f"Spd_{h}m{boom}_Max", "max")], boom=angle))
+    for h in (78, 58, 38):
+        points.append(point(f"Dir_{h}m", "wind_direction", float(h), [(f"Dir_{h}m_Avg", "avg")],
+                            boom=315.0, dead_band=135.0))
+    model = {"author": "test", "organisation": "floris-ekman-veer", "date": "2026-01-01",
+             "version": "1.2.0-2023.01", "plant_name": "upland", "plant_type": "onshore_wind",
+             "measurement_location": [{
+                 "uuid": "00000000-0000-0000-0000-000000000001", "name": "M1",
+                 "latitude_ddeg": latitude, "longitude_ddeg": -1.9,
+                 "measurement_station_type_id": "mast",
+                 "logger_main_config": [{"logger_model_name": "logger", "date_from":
+                                         "2025-01-01T00:00:00", "offset_from_utc_hrs": 1.0}],
+                 "measurement_point": points}]}
+    path = tmp_path / "mast.json"
+    path.write_text(json.dumps(model))
+    return path
+
+
+def logger_records(periods=400):
+    """The instrumented year's first records with the logger's own column names."""
+    year = mast_year(periods=periods)
+    names = {"time": "time"}
+    for h in (80, 60, 40):
+        for boom, old in (("A", "a"), ("B", "b")):
+            names[f"speed_{h}m_{old}"] = f"Spd_{h}m{boom}_Avg"
+            names[f"speed_{h}m_{old}_std"] = f"Spd_{h}m{boom}_SD"
+    for h in (78, 58, 38):
+        names[f"direction_{h}m"] = f"Dir_{h}m_Avg"
+    return year[list(names)].rename(columns=names), year
+
+
+def test_the_file_names_the_columns_booms_location_and_utc_offset(tmp_path):
+    mast = read_wra_file(task43_file(tmp_path))
+    assert mast.latitude == 53.3 and mast.longitude == -1.9 and mast.utc_offset_hours == 1.0
+    assert mast.booms == {"b135": 135.0, "b315": 315.0}
+    names = dict(zip(mast.columns["column"], mast.columns["name"]))
+    assert names["Spd_80mA_Avg"] == "speed_80m_b135" and names["Spd_40mB_SD"] == "speed_40m_b315_std"
+    assert names["Dir_38m_Avg"] == "direction_38m" and "Spd_80mA_Max" not in names
+    assert mast.vane_dead_bands == {78.0: 135.0, 58.0: 135.0, 38.0: 135.0}
+
+
+def test_fit_site_with_the_file_equals_fit_site_with_its_arguments(tmp_path):
+    records, year = logger_records()
+    with_file = fit_site(records, 80.0, on_misfit="drop", roughness_length=0.05,
+                         metadata=task43_file(tmp_path))
+    by_hand = fit_site(year, 80.0, on_misfit="drop", roughness_length=0.05, latitude=53.3,
+                       booms={"a": 135.0, "b": 315.0})
+    np.testing.assert_array_equal(with_file.wind_speeds, by_hand.wind_speeds)
+    np.testing.assert_array_equal(with_file.turbulence_intensities, by_hand.turbulence_intensities)
+    assert with_file.metadata.utc_offset_hours == 1.0
+
+
+def test_a_file_that_contradicts_the_records_or_the_call_is_refused_naming_both(tmp_path):
+    records, _ = logger_records(48)
+    path = task43_file(tmp_path, heights=(80, 60, 40, 20))
+    with pytest.raises(ValueError, match=r"names column 'Spd_20mA_Avg' \(measurement point "
+                                         r"'Spd_20mA' at 20 m\) that the records do not hold"):
+        fit_site(records, 80.0, metadata=path, roughness_length=0.05)
+    path = task43_file(tmp_path)
+    with pytest.raises(ValueError, match=r"latitude=52.0 contradicts the mast's metadata file "
+                                         r".*at 53.3 deg"):
+        fit_site(records, 80.0, metadata=path, latitude=52.0, roughness_length=0.05)
+    with pytest.raises(ValueError, match=r"booms=\{'a': 135.0\} contradicts .* booms are "
+                                         r"\{'b135': 135.0, 'b315': 315.0\}"):
+        fit_site(records, 80.0, metadata=path, booms={"a": 135.0}, roughness_length=0.05)
+    broken = tmp_path / "broken.json"
+    broken.write_text("{not json")
+    with pytest.raises(ValueError, match=r"no readable IEA Task 43 WRA data model JSON file"):
+        fit_site(records, 80.0, metadata=broken, roughness_length=0.05)
