@@ -10,11 +10,18 @@ time (docs/coupling.md#wakes-deep-in-an-array):
     added turbulence  "max": the largest upstream wake's (FLORIS's combination, the package's
                       former ``local_turbulence``); "quadrature": every upstream wake's, their
                       variances summed (``array_turbulence``); "none": the paper's ambient k_w;
+    overlap           the part of a rotor a wake's added turbulence is weighted with: "velocity",
+                      where the wake's velocity exceeds 0.05 m/s (FLORIS's count), or "radius",
+                      inside the wake radius 2 sigma (Niayifar & Porte-Agel 2016);
+    Crespo-Hernandez  the added turbulence's constants: "FLORIS" (FLORIS 4.7's defaults: 0.9
+                      a^0.8 I0^0.1 (x/D)^-0.32) or "1996" (Crespo & Hernandez's published
+                      0.73 a^0.8325 I0^0.0325 (x/D)^-0.32, as PyWake's Niayifar and Zong models
+                      take them; "1996-" with the exponent -0.0325 of the paper's scans);
     deficit scale     "free stream" (FLORIS's gauss) or "incoming" (Niayifar & Porte-Agel 2016);
     superposition     "sosfs" (squares summed) or "fls" (summed).
 
 Prints the RMSE (bias) of the direction-averaged P_i/P_1 over the waked positions (Horns Rev,
-Lillgrund) and of Horns Rev's farm efficiency against the LES. Takes about 3 minutes.
+Lillgrund) and of Horns Rev's farm efficiency against the LES. Takes about 5 minutes.
 """
 
 from __future__ import annotations
@@ -26,26 +33,43 @@ from floris_ekman_veer.studies.validation import metrics, models  # noqa: E402
 from floris_ekman_veer.studies.validation.cases import HORNS_REV, LILLGRUND  # noqa: E402
 
 EXPANSION = {"max": "local_turbulence", "quadrature": "array_turbulence", "none": "ambient"}
+OVERLAP = {"velocity": "wake_velocity", "radius": "wake_radius"}
+CRESPO_HERNANDEZ = {
+    "FLORIS": None,
+    "1996": {"constant": 0.73, "ai": 0.8325, "initial": 0.0325, "downstream": -0.32},
+    "1996-": {"constant": 0.73, "ai": 0.8325, "initial": -0.0325, "downstream": -0.32},
+}
 SCALE = {"free stream": "free_stream", "incoming": "incoming"}
-#: (added turbulence, deficit scale, superposition); the first is FLORIS's gauss coupling, the
-#: last but one the package's default.
+#: (added turbulence, overlap, Crespo-Hernandez, deficit scale, superposition); the first is
+#: FLORIS's gauss coupling, "quadrature, radius, FLORIS, incoming, fls" the package's default.
 COUPLINGS = (
-    ("max", "free stream", "sosfs"),
-    ("max", "free stream", "fls"),
-    ("max", "incoming", "fls"),
-    ("quadrature", "free stream", "sosfs"),
-    ("quadrature", "incoming", "fls"),
-    ("none", "incoming", "fls"),
+    ("max", "velocity", "FLORIS", "free stream", "sosfs"),
+    ("max", "velocity", "FLORIS", "free stream", "fls"),
+    ("max", "velocity", "FLORIS", "incoming", "fls"),
+    ("quadrature", "velocity", "FLORIS", "free stream", "sosfs"),
+    ("quadrature", "velocity", "FLORIS", "incoming", "fls"),
+    ("none", "velocity", "FLORIS", "incoming", "fls"),
+    ("max", "velocity", "1996", "incoming", "fls"),
+    ("quadrature", "velocity", "1996", "incoming", "fls"),
+    ("quadrature", "velocity", "1996-", "incoming", "fls"),
+    ("max", "radius", "FLORIS", "incoming", "fls"),
+    ("max", "radius", "1996", "incoming", "fls"),
+    ("max", "radius", "1996-", "incoming", "fls"),
+    ("quadrature", "radius", "1996", "incoming", "fls"),
+    ("quadrature", "radius", "1996-", "incoming", "fls"),
+    ("quadrature", "radius", "FLORIS", "incoming", "fls"),
 )
 
 
-def setup(turbulence: str, scale: str, superposition: str):
+def setup(turbulence: str, overlap: str, constants: str, scale: str, superposition: str):
     """A (name, set-up) pair of M-1 with this coupling (validation.models.WAKE_MODELS' form)."""
     strings, gch, parameters = models.WAKE_MODELS["M-1"]
-    velocity = {"wake_expansion": EXPANSION[turbulence], "deficit_velocity": SCALE[scale]}
-    return (f"{turbulence}, {scale}, {superposition}",
+    velocity = {"wake_expansion": EXPANSION[turbulence], "deficit_velocity": SCALE[scale],
+                "turbulence_overlap": OVERLAP[overlap]}
+    return (f"{turbulence}, {overlap}, {constants}, {scale}, {superposition}",
             ({**strings, "combination_model": superposition}, gch,
-             {**parameters, "velocity": velocity}))
+             {**parameters, "velocity": velocity,
+              "turbulence": {"crespo_hernandez": CRESPO_HERNANDEZ[constants]}}))
 
 
 def _cell(errors, kind="averaged") -> str:
@@ -54,9 +78,9 @@ def _cell(errors, kind="averaged") -> str:
 
 
 def main() -> None:
-    print("| added turbulence | deficit scale | superposition | Horns Rev rows | "
-          "Horns Rev efficiency | Lillgrund rows |")
-    print("|---|---|---|---|---|---|")
+    print("| added turbulence | overlap | Crespo-Hernandez | deficit scale | superposition | "
+          "Horns Rev rows | Horns Rev efficiency | Lillgrund rows |")
+    print("|---|---|---|---|---|---|---|---|")
     for coupling in COUPLINGS:
         model = setup(*coupling)
         horns_rev = metrics.row_errors(models.row_ratios(HORNS_REV, [model]))

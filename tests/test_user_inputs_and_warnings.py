@@ -383,6 +383,10 @@ def test_coincident_turbines_are_still_refused():
 
 
 @pytest.mark.filterwarnings("ignore::floris_ekman_veer.ShallowBoundaryLayerWarning")  # SBL-6 at 9 m/s: h 125 m < rotor top, not tested here
+# The optimiser packs the two turbines 1.6 D apart: the downstream rotor stands in the near wake's
+# super-Gaussian (docs/wake_model.md#near-wake), deeper across it, at speeds where the NREL 5 MW's
+# C_T passes the momentum limit: that warning is right and not what this test is about.
+@pytest.mark.filterwarnings("ignore::floris_ekman_veer.ThrustLimitWarning")
 def test_floris_layout_optimiser_and_turbine_plane_run_without_placement_warnings():
     from floris.flow_visualization import calculate_horizontal_plane_with_turbines
     from floris.optimization.layout_optimization.layout_optimization_scipy import (

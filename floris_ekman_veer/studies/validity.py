@@ -20,7 +20,10 @@ Farms add physics the paper's single wakes do not test: where a rotor stands in 
 the package's farm coupling (the upstream wakes' added turbulence in k_w, the wakes scaled with
 their rotors' incoming speed and summed, docs/coupling.md#wakes-deep-in-an-array) is beyond the
 paper's validation, which the report's ``farm_coupling_beyond_paper`` column says (it leaves
-``inside_envelope``, a property of the atmosphere, unchanged).
+``inside_envelope``, a property of the atmosphere, unchanged). Likewise the near wake: where a
+rotor may stand inside another's potential core, the super-Gaussian profile there
+(``near_wake: super_gaussian``, docs/wake_model.md#near-wake) is beyond the paper, which the
+``near_wake_beyond_paper`` column says per condition.
 
 Outside it the wake model is extrapolated (a shallow night, h below the rotor top, sees the
 geostrophic wind above h: docs/atmosphere.md#shallow-boundary-layer): its numbers, and any gain
@@ -34,6 +37,7 @@ import pandas as pd
 
 from floris_ekman_veer._validation import real_array, require_floris_model
 from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, solve
+from floris_ekman_veer.wake.deficit import initial_radius, potential_core_length
 
 #: The paper's Table 1 stability parameter of SBL-6, the most stable validated case.
 MU_SBL6_TABLE1 = 148.49
@@ -163,7 +167,7 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three), and
     ``at_rest`` (a calm condition: no boundary layer, its columns NaN), and
     ``farm_coupling_beyond_paper`` (:func:`farm_coupling_beyond_paper`: the same for every
-    condition).
+    condition) and ``near_wake_beyond_paper`` (:func:`near_wake_beyond_paper`).
 
     Raises:
         ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
@@ -226,7 +230,44 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         "rossby_in_range": in_range,
         "inside_envelope": validated & deep & in_range,
         "farm_coupling_beyond_paper": farm_coupling_beyond_paper(core),
+        "near_wake_beyond_paper": near_wake_beyond_paper(core),
     }), rest)
+
+
+def near_wake_beyond_paper(core) -> np.ndarray:
+    """Per condition, whether a rotor may stand inside another rotor's potential core with the
+    super-Gaussian near wake on (``near_wake: super_gaussian`` of the ekman_veer velocity model,
+    docs/wake_model.md#near-wake): downstream of it, along the condition's wind direction, by
+    less than the longest core its rotor can have (Eq. x0_transition with k_w at its floor and
+    the turbine's C_T at the condition's wind speed, 0.75 where its table has none) and
+    laterally within the two rotors' radii plus the stream tube's."""
+    velocity = getattr(core.wake, "velocity_model", None)
+    farm, flow_field = core.farm, core.flow_field
+    directions = np.asarray(flow_field.wind_directions, dtype=float).reshape(-1)
+    if farm.n_turbines < 2 or getattr(velocity, "near_wake", None) != "super_gaussian":
+        return np.zeros(directions.shape, dtype=bool)
+    radii = 0.5 * np.asarray(farm.rotor_diameters, dtype=float).reshape(-1, farm.n_turbines)[0]
+    speeds = np.asarray(flow_field.wind_speeds, dtype=float).reshape(-1)
+    thrust = np.empty((speeds.size, farm.n_turbines))
+    for k, definition in enumerate(farm.turbine_definitions):
+        table = definition.get("power_thrust_table", {})
+        if "thrust_coefficient" in table and "wind_speed" in table:
+            thrust[:, k] = np.interp(speeds, table["wind_speed"], table["thrust_coefficient"])
+        else:
+            thrust[:, k] = 0.75
+    thrust = np.clip(thrust, 0.0, velocity.max_thrust_coefficient)
+    core_length = potential_core_length(velocity.k_w_floor, radii, thrust, 0.0)
+    tube = initial_radius(radii, thrust, 0.0)
+    # FLORIS's frame: the wind from 270 degrees blows along +x.
+    angle = np.radians(270.0 - directions)[:, None]
+    x, y = np.asarray(farm.layout_x, dtype=float), np.asarray(farm.layout_y, dtype=float)
+    along = x * np.cos(angle) + y * np.sin(angle)
+    across = -x * np.sin(angle) + y * np.cos(angle)
+    dx = along[:, None, :] - along[:, :, None]  # [condition, upstream i, downstream j]
+    dy = np.abs(across[:, None, :] - across[:, :, None])
+    reach = radii[None, :, None] + radii[None, None, :] + tube[:, :, None]
+    inside = (dx > 0.0) & (dx < core_length[:, :, None]) & (dy < reach)
+    return inside.any(axis=(1, 2))
 
 
 def farm_coupling_beyond_paper(core) -> bool:

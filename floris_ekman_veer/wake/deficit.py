@@ -297,6 +297,7 @@ def normalised_deficit(
     local_speed=None,
     curl=True,
     polar_dy=None,
+    shape=None,
 ):
     """Normalised velocity deficit Delta u / U_h of one wake, Eq. (du_model).
 
@@ -314,6 +315,10 @@ def normalised_deficit(
         measures theta from the full centre (default, ``polar_dy=None``); the authors' published
         code measures it from the yaw-only centre while centring the Gaussian on the full one
         (docs/wake_model.md#polar-angle): pass y - y_c,yaw to reproduce that.
+    shape : None (the paper's Gaussian), or (n, m) of wake/near_wake.py's ``near_wake_shape``:
+        the profile exp(-(rho^2 / (2 (m sigma)^2))^(n/2)), the super-Gaussian that carries the
+        rotor's thrust inside the potential core (docs/wake_model.md#near-wake; beyond the
+        paper); where n = 2 the Gaussian itself (bit for bit), and the centre deficit is C(x).
 
     sigma(theta, x) > 0 for x >= 0 (xi0 > 0 and xi_hat > 0 for alpha < 48/38), so the Gaussian is
     always defined.
@@ -337,4 +342,8 @@ def normalised_deficit(
         xi = xi * curl_shape(t_hat, cos2, cos3, cos4)
     sigma = wake_width(x_wake, k_w, xi)
     gaussian = np.exp(-(dy**2 + dz**2) / (2.0 * sigma**2))
+    if shape is not None:
+        order, factor = shape
+        shaped = np.exp(-((dy**2 + dz**2) / (2.0 * (factor * sigma) ** 2)) ** (0.5 * order))
+        gaussian = np.where(order == 2.0, gaussian, shaped)
     return np.where(x > 0.0, max_deficit(x_wake, k_w, radius, ct, yaw) * gaussian, 0.0)

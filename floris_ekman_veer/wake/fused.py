@@ -117,11 +117,11 @@ def centre_offsets(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
 
 
 @numba.njit(**JIT)
-def _deficits(dy, dz, amplitude, kx, xi0, sin2b, q):
+def _deficits(dy, dz, amplitude, kx, xi0, sin2b, q, shape):
     out = np.empty(dy.size)
     for k in range(dy.size):
         out[k] = point_deficit(dy[k], dz[k], dy[k], amplitude[k], kx[k], xi0[k], sin2b[k],
-                               q[k, 0], q[k, 1], q[k, 2], q[k, 3], q[k, 4], GAUSSIAN_SHAPE)
+                               q[k, 0], q[k, 1], q[k, 2], q[k, 3], q[k, 4], shape[k])
     return out
 
 
@@ -133,9 +133,13 @@ def _curl_polynomials(t_hat, alpha):
     return q
 
 
-def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True):
+def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
+                            shape=None):
     """The per-wake factors of Eq. (du_model) (see :func:`rows_deficit_parameters`), evaluated
-    once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor."""
+    once per wake: C(x), k_w x, xi0 / |cos beta|'s numerator, sin^2 beta and t_hat's prefactor;
+    with ``shape`` = (n, m) of the near wake (wake/near_wake.py) also the radial shape exponent
+    n ("shape") and the width factor m scaling k_w x and xi0 (sigma is linear in both; where
+    n = 2, m = 1 and they stay bit for bit)."""
     r_tube = initial_radius(radius, ct, yaw)
     parameters = {
         "amplitude": max_deficit(x, k_w, radius, ct, yaw),
@@ -143,6 +147,11 @@ def wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
         "xi0": WIDTH_FACTOR * r_tube * np.abs(np.cos(yaw)),
         "sin2b": np.sin(yaw) ** 2,
     }
+    if shape is not None:
+        order, factor = shape
+        parameters["kx"] = parameters["kx"] * factor
+        parameters["xi0"] = parameters["xi0"] * factor
+        parameters["shape"] = order
     if curl:
         parameters["strength"] = time_like_strength(friction_velocity, hub_speed, ct, yaw)
     return parameters
@@ -166,16 +175,17 @@ def rows_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_spee
     q = _curl_polynomials(np.ravel(t_hat).astype(float), CURL_ALPHA).T.reshape(
         (5, *np.shape(t_hat)))
     return {**{k: wake[k] for k in ("amplitude", "kx", "xi0", "sin2b")},
-            **{f"q{k}": q[k] for k in range(5)}}
+            "shape": wake.get("shape", GAUSSIAN_SHAPE), **{f"q{k}": q[k] for k in range(5)}}
 
 
 def deficit_on_rows(dy, dz, parameters):
     """Delta u / U_h of Eq. (du_model) at points (dy, dz) from the factors of
     :func:`rows_deficit_parameters` (:func:`point_deficit` at every point of the broadcast
-    arrays)."""
+    arrays; the radial shape exponent "shape", 2 if absent)."""
     names = ("amplitude", "kx", "xi0", "sin2b", "q0", "q1", "q2", "q3", "q4")
+    shape = parameters.get("shape", GAUSSIAN_SHAPE)
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (
-        dy, dz, *(parameters[k] for k in names))))
+        dy, dz, *(parameters[k] for k in names), shape)))
     flat = [np.ascontiguousarray(a).ravel() for a in arrays]
-    q = np.stack(flat[6:], axis=1)
-    return _deficits(*flat[:6], q).reshape(arrays[0].shape)
+    q = np.stack(flat[6:11], axis=1)
+    return _deficits(*flat[:6], q, flat[11]).reshape(arrays[0].shape)

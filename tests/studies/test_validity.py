@@ -167,3 +167,26 @@ def test_farm_coupling_is_flagged_beyond_the_paper():
     paper = FlorisModel(config)
     paper.set(**conditions)
     assert not floris_ekman_veer.validity_report(paper).farm_coupling_beyond_paper.any()
+
+
+def test_rotors_inside_a_potential_core_are_flagged_with_the_near_wake():
+    """near_wake_beyond_paper: a row 3 D apart along the wind puts the second rotor inside the
+    first's potential core (x0 up to ~5 D at the k_w floor), flagged with the default
+    super-Gaussian near wake and not with the paper's potential core; the same row across the
+    wind (0 deg), or 8 D apart, is not flagged."""
+    config = load_yaml(floris_ekman_veer.example_input("farm_night"))
+    d = 126.0  # the NREL 5 MW of the farm inputs
+    for spacing, directions, expected in ((3.0, [270.0, 0.0, 90.0], [True, False, True]),
+                                          (8.0, [270.0], [False])):
+        farm = FlorisModel(config)
+        farm.set(layout_x=[0.0, spacing * d], layout_y=[0.0, 0.0],
+                 wind_directions=directions, wind_speeds=[10.0] * len(directions),
+                 turbulence_intensities=[0.06] * len(directions))
+        report = floris_ekman_veer.validity_report(farm)
+        assert report.near_wake_beyond_paper.tolist() == expected
+        assert report.inside_envelope.all()
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["near_wake"] = "potential_core"
+    paper = FlorisModel(config)
+    paper.set(layout_x=[0.0, 3.0 * d], layout_y=[0.0, 0.0], wind_directions=[270.0],
+              wind_speeds=[10.0], turbulence_intensities=[0.06])
+    assert not floris_ekman_veer.validity_report(paper).near_wake_beyond_paper.any()

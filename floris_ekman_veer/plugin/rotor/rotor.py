@@ -24,6 +24,7 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     WAKE_COLUMNS,
     integrate_wake,
 )
+from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 
@@ -45,6 +46,12 @@ NEGLIGIBLE_DEFICIT = 1e-5
 #: combines it; all of them, their variances summed), tracked here on a turbine grid.
 WAKE_EXPANSIONS = ("ambient", "local_turbulence", "array_turbulence")
 ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
+
+#: The velocity models' ``turbulence_overlap`` choices: the part of a rotor a wake's added
+#: turbulence is weighted with, the area where its velocity exceeds WAKE_OVERLAP_VELOCITY
+#: (FLORIS's count) or where the rotor lies inside the wake radius 2 sigma (Niayifar &
+#: Porte-Agel 2016, docs/coupling.md#wakes-deep-in-an-array).
+TURBULENCE_OVERLAPS = ("wake_velocity", "wake_radius")
 
 #: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
 DEFICIT_VELOCITIES = ("incoming", "free_stream")
@@ -191,7 +198,14 @@ def rotor_cell_deficit(
     per_pair["velocity_scale"] = per_pair["hub_speed"] * per_pair["speed_fraction"]
     per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0],
                     radius_j=rotor.radius[f, j], hub_height=hub_height_i[f, 0, 0, 0],
-                    moment=moment, reach_squared=reach_squared)
+                    moment=moment, reach_squared=reach_squared,
+                    overlap_edge=WAKE_OVERLAP_VELOCITY)
+    if track and model.turbulence_overlap == "wake_radius":
+        # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
+        # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
+        per_pair["overlap_edge"] = np.exp(-2.0) * model.centre_deficit(
+            x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
+        ) * per_pair["hub_speed"] * per_pair["speed_fraction"]
     columns = lambda table, names: np.stack(  # noqa: E731
         [np.broadcast_to(table[k], f.shape) for k in names], axis=1)
     removed, overlap, reached, centre = integrate_wake(

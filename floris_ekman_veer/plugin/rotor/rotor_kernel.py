@@ -6,7 +6,8 @@ the wake reaches (plugin/rotor/rotor.py chooses them), in one pass over the row'
 deficit of Eq. (du_model) (wake/fused.py ``point_deficit``, the per-height factors of
 ``curl_polynomial`` once per row), its superposition on the wakes so far by FLORIS's rule and
 the moment it removes (plugin/rotor/rotor_wakes.py ``superposed``, ``removed_moment``), the sums over
-the rotor cells and FLORIS's overlap as the area of the disk. The rotors run in parallel
+the rotor cells and the wake's overlap as the area of the disk (FLORIS's count, or the part
+inside the wake radius). The rotors run in parallel
 (numba's ``prange``, on numba's threads: NUMBA_NUM_THREADS, all cores by default); each rotor's
 sums run in the same order on any thread, so the results are the same bit for bit with 1 or N
 threads. Compiled once per installation (``cache=True``, wake/fused.py ``JIT``).
@@ -20,11 +21,7 @@ import threading
 import numba
 import numpy as np
 
-from floris_ekman_veer.plugin.rotor.rotor_wakes import (
-    WAKE_OVERLAP_VELOCITY,
-    removed_moment,
-    superposed,
-)
+from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
 from floris_ekman_veer.wake.fused import JIT, centre_offset, curl_polynomial, point_deficit
 
@@ -37,7 +34,7 @@ from floris_ekman_veer.wake.fused import JIT, centre_offset, curl_polynomial, po
 WAKE_COLUMNS = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape")
 CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 PAIR_COLUMNS = ("x", "velocity_scale", "cos", "sin", "friction_velocity", "radius",
-                "offset", "radius_j", "hub_height", "moment", "reach_squared")
+                "offset", "radius_j", "hub_height", "moment", "reach_squared", "overlap_edge")
 
 #: numba's threading layer where the user has not chosen one: one that survives a fork
 #: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
@@ -56,7 +53,7 @@ def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind
     for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b, strength, polar_veer, shape = wake[k]
         (x, scale, cos_a, sin_a, u_star, radius, offset, radius_j, hub_height, moment,
-         reach_squared) = pair[k]
+         reach_squared, overlap_edge) = pair[k]
         strength_c, r_tube, image_height, veer, ground_image = centre_table[k]
         f, kk = condition[k], kind[k]
         reach = 4.0 * radius
@@ -96,9 +93,10 @@ def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind
                                                          moment)
                 if rule:
                     combined[index, s] = new
-                # FLORIS's overlap: wake velocity above 0.05 m/s within 2 D of the wake's
-                # rotor laterally, as the area of the disk where it holds.
-                if track and du > WAKE_OVERLAP_VELOCITY and abs(dy + centre[k, r]) < reach:
+                # The overlap: wake velocity above ``overlap_edge`` (FLORIS's 0.05 m/s, or the
+                # wake's velocity at its radius 2 sigma: plugin/rotor/rotor.py) within 2 D of
+                # the wake's rotor laterally, as the area of the disk where it holds.
+                if track and du > overlap_edge and abs(dy + centre[k, r]) < reach:
                     area += weight[r, s]
         overlap[k] = area
 
@@ -106,7 +104,8 @@ def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind
 def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, track):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
-    fraction of the disk where FLORIS counts the wake; 0 unless ``track``), (pairs,) whether
+    fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
+    unless ``track``), (pairs,) whether
     the wake reached a row of the rotor, and (pairs, rows) the wake's centre at the rows.
 
     ``wake``, ``pair`` and ``centre_table`` (pairs, WAKE_COLUMNS, PAIR_COLUMNS, CENTRE_COLUMNS):

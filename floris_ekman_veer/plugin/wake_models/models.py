@@ -54,6 +54,7 @@ from floris_ekman_veer.plugin.wake_models.names import GAUSSIAN_2014_NAME, VELOC
 from floris_ekman_veer.plugin.rotor.rotor import (
     DEFICIT_VELOCITIES,
     ROTOR_PLANE_MARGIN,
+    TURBULENCE_OVERLAPS,
     WAKE_EXPANSIONS,
     WAKE_MODELS,
     RotorWakes,
@@ -81,6 +82,7 @@ from floris_ekman_veer.wake.deficit import (
 from floris_ekman_veer.wake.deflection import veer_deflection
 from floris_ekman_veer.wake.fused import GAUSSIAN_SHAPE, wake_deficit_parameters
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit, bastankhah2014_wake
+from floris_ekman_veer.wake.near_wake import NEAR_WAKES, near_wake_shape
 
 __all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "EkmanWakeModel",
            "Gaussian2014VelocityDeficit"]
@@ -113,6 +115,11 @@ class EkmanWakeModel(BaseModel):
     #: (FLORIS's combination ``fls``); "free_stream" the ambient U_h, as FLORIS's gauss
     #: (docs/coupling.md#wakes-deep-in-an-array). An unwaked rotor's wake is the paper's with each.
     deficit_velocity: str = choice_field("incoming", DEFICIT_VELOCITIES)
+    #: The part of a rotor a wake's added turbulence is weighted with (turbine grid):
+    #: "wake_radius" (the default), the area inside the wake radius 2 sigma (Niayifar &
+    #: Porte-Agel 2016), or "wake_velocity", the area where the wake's velocity exceeds 0.05 m/s
+    #: (FLORIS's count) (docs/coupling.md#wakes-deep-in-an-array).
+    turbulence_overlap: str = choice_field("wake_radius", TURBULENCE_OVERLAPS)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/inflow/shallow.py).
@@ -267,6 +274,10 @@ class EkmanWakeModel(BaseModel):
         """The largest deficit Delta u / U_h of the wake at x: C(x), Eq. (Cx)."""
         return max_deficit(x, k_w, radius, ct, yaw)
 
+    def centre_deficit(self, x, k_w, radius, ct, yaw):
+        """Delta u / U_h at the wake's centre at x: C(x), Eq. (Cx)."""
+        return max_deficit(x, k_w, radius, ct, yaw)
+
     def width_bound(self, x, k_w, radius, ct, yaw):
         """An upper bound of the wake width sigma(theta, x) over all polar angles [m]."""
         r_tube = radius * np.sqrt(stream_tube_area_ratio(ct, yaw))
@@ -327,14 +338,36 @@ class EkmanVeerVelocityDeficit(EkmanWakeModel):
 
     curl: bool = boolean_field(True)
     polar_angle_centre: str = choice_field("wake_centre", ("wake_centre", "yaw_centre"))
+    #: Inside the potential core (x < x0): "super_gaussian" (the default), the profile that
+    #: carries the rotor's thrust with the paper's centre deficit 2a and width (Blondel &
+    #: Cathelain 2020's super-Gaussian, wake/near_wake.py, beyond the paper); "potential_core",
+    #: the paper's Gaussian there. From x0 on both are the paper's wake
+    #: (docs/wake_model.md#near-wake).
+    near_wake: str = choice_field("super_gaussian", NEAR_WAKES)
+
+    def near_wake_shape(self, x, k_w, radius, ct, yaw):
+        """(n, m) of the wake (wake/near_wake.py), or None for the paper's Gaussian."""
+        if self.near_wake != "super_gaussian":
+            return None
+        return near_wake_shape(x, k_w, radius, ct, yaw)
+
+    def width_bound(self, x, k_w, radius, ct, yaw):
+        bound = super().width_bound(x, k_w, radius, ct, yaw)
+        shape = self.near_wake_shape(x, k_w, radius, ct, yaw)
+        # The super-Gaussian of order n > 2 and width m sigma falls below the Gaussian of width
+        # m sigma beyond it: m sigma bounds its reach.
+        return bound if shape is None else bound * shape[1]
 
     def kernel_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
         # The same Eq. (du_model), fused (wake/fused.py): shared factors per wake and height.
+        # Inside a potential core the near wake's super-Gaussian: its order n is the shape
+        # column, its width factor m scales k_w x and xi0 (wake/fused.py).
         table = wake_deficit_parameters(x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
-                                        curl=self.curl)
+                                        curl=self.curl,
+                                        shape=self.near_wake_shape(x, k_w, radius, ct, yaw))
         table.setdefault("strength", 0.0)  # (t_hat = 0: xi_hat = 1)
+        table.setdefault("shape", GAUSSIAN_SHAPE)
         table["polar_veer"] = float(self.polar_angle_centre == "yaw_centre")
-        table["shape"] = GAUSSIAN_SHAPE
         return table
 
     def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
@@ -349,6 +382,7 @@ class EkmanVeerVelocityDeficit(EkmanWakeModel):
             wake.dx, wake.dy, wake.dz, k_w=wake.k_w, radius=wake.radius, ct=wake.ct,
             yaw=wake.yaw, friction_velocity=wake.friction_velocity, hub_speed=wake.hub_speed,
             local_speed=safe_u, curl=self.curl, polar_dy=polar_dy,
+            shape=self.near_wake_shape(wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw),
         )
 
 
@@ -382,6 +416,10 @@ class Gaussian2014VelocityDeficit(EkmanWakeModel):
 
     def amplitude_bound(self, x, k_w, radius, ct, yaw):
         return 1.0  # C <= 2a < 1
+
+    def centre_deficit(self, x, k_w, radius, ct, yaw):
+        k_star = k_w if self.k_star is None else self.k_star
+        return bastankhah2014_deficit(x, 0.0, 0.0, ct=ct, diameter=2.0 * radius, k_star=k_star)
 
     def width_bound(self, x, k_w, radius, ct, yaw):
         k_star = k_w if self.k_star is None else self.k_star

@@ -56,18 +56,21 @@ def _builtin(name):
 
 #: Wake set-ups: model strings (FLORIS's combination ``sosfs`` unless given), the GCH switches,
 #: parameters for the package's models. The package's models take their defaults
-#: (``wake_expansion: array_turbulence``, ``deficit_velocity: incoming``, deficits summed:
-#: docs/coupling.md#wakes-deep-in-an-array); for an isolated wake that is the paper's model
-#: exactly. "M-1, ambient k_w" is the paper's k_w for every turbine; "M-1, FLORIS-style" the
-#: farm coupling FLORIS's gauss has (the largest upstream wake's added turbulence, deficits
-#: scaled with the free stream, their squares summed), for comparison.
+#: (``wake_expansion: array_turbulence``, ``turbulence_overlap: wake_radius``,
+#: ``deficit_velocity: incoming``, deficits summed: docs/coupling.md#wakes-deep-in-an-array; the
+#: super-Gaussian near wake inside a potential core, docs/wake_model.md#near-wake); for an
+#: isolated wake beyond x0 that is the paper's model exactly. "M-1, ambient k_w" is the paper's
+#: k_w for every turbine; "M-1, FLORIS-style" the farm coupling FLORIS's gauss has (the largest
+#: upstream wake's added turbulence with FLORIS's overlap count, deficits scaled with the free
+#: stream, their squares summed), for comparison.
 WAKE_MODELS = {
     "M-1": _ekman(),
     "M-1, ambient k_w": _ekman(wake_expansion="ambient"),
     "M-1, FLORIS-style": (
         {**_ekman()[0], "combination_model": "sosfs"}, False,
         {**_ekman()[2], "velocity": {"wake_expansion": "local_turbulence",
-                                     "deficit_velocity": "free_stream"}}),
+                                     "deficit_velocity": "free_stream",
+                                     "turbulence_overlap": "wake_velocity"}}),
     "M-2": _ekman(veer=False),
     "M-3": _ekman(veer=False, velocity="bastankhah2014"),
     "gauss": _builtin("gauss"),
@@ -195,7 +198,8 @@ def floris_input(case, reading: str, model) -> dict:
             "wake_deflection_parameters": {"ekman_veer": parameters.get("deflection", {}),
                                            "gauss": None, "empirical_gauss": None},
             "wake_velocity_parameters": velocity_parameters,
-            "wake_turbulence_parameters": {"crespo_hernandez": None, "wake_induced_mixing": None},
+            "wake_turbulence_parameters": {"crespo_hernandez": None, "wake_induced_mixing": None,
+                                           **parameters.get("turbulence", {})},
         },
     }
 

@@ -102,13 +102,15 @@ def farm_config(atmosphere: str = "SBL-6", turbine: str = "nrel_5MW", layout=((0
                 wind_speed: float = 9.0) -> dict:
     """The farm input (M-1, crespo_hernandez, 3 x 3 rotor cells) with the coupling FLORIS's
     point-wise solver expresses (free-stream wakes, sosfs, the largest upstream wake's added
-    turbulence: ``local_turbulence``), ``atmosphere``'s block, ``turbine`` (FLORIS's library) and
+    turbulence: ``local_turbulence``, counted where the wake's velocity exceeds 0.05 m/s:
+    ``turbulence_overlap: wake_velocity``), ``atmosphere``'s block, ``turbine`` (FLORIS's library) and
     ``layout`` (x, y) in rotor diameters; the reference wind height is the turbine's hub
     height."""
     config = load_yaml(INPUTS / "farm_sbl6.yaml")
     config["wake"]["model_strings"]["combination_model"] = "sosfs"
     config["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
-        wake_expansion="local_turbulence", deficit_velocity="free_stream")
+        wake_expansion="local_turbulence", deficit_velocity="free_stream",
+        turbulence_overlap="wake_velocity")
     block = load_yaml(INPUTS / ATMOSPHERES[atmosphere])["wake"]["wake_velocity_parameters"]
     config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
         block["ekman_veer"]["atmosphere"])

@@ -29,7 +29,13 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import grid_offsets, rotor_cells
 from floris_ekman_veer.wake.deficit import normalised_deficit
 from floris_ekman_veer.wake.deficit import initial_radius, time_like_strength
 from floris_ekman_veer.wake.deflection import wake_centre_offset
-from floris_ekman_veer.wake.fused import centre_offsets, deficit_on_rows, rows_deficit_parameters
+from floris_ekman_veer.wake.fused import (
+    centre_offsets,
+    deficit_on_rows,
+    rows_deficit_parameters,
+    wake_deficit_parameters,
+)
+from floris_ekman_veer.wake.near_wake import near_wake_shape
 from tests.plugin.rotor.multiwake_reference import disk_quadrature
 
 INPUTS = Path(__file__).resolve().parents[3] / "inputs"
@@ -191,6 +197,35 @@ def test_compiled_centre_equals_eq_yc_xz():
                 lateral_speed=np.where(flowing, v, 0.0), veer=veer, ground_image=image), 0.0)
             np.testing.assert_allclose(compiled, readable, rtol=1e-12, atol=1e-12)
             assert np.abs(readable).max() > 20.0 and np.all(compiled[0, :2] == 0.0)
+
+
+def test_fused_near_wake_equals_the_readable_super_gaussian():
+    """Inside the potential core (wake/near_wake.py) the compiled kernel's super-Gaussian equals
+    Eq. (du_model) with the near wake's shape; beyond x0 its Gaussian bit for bit."""
+    rng = np.random.default_rng(11)
+    pairs = 40
+    x = rng.uniform(1.0, 700.0, (pairs, 1, 1))  # x0 is 200-450 m here: both sides of it
+    yaw = rng.uniform(-0.5, 0.5, (pairs, 1, 1))
+    ct = rng.uniform(0.2, 0.9, (pairs, 1, 1))
+    speed = rng.uniform(3.0, 12.0, (pairs, 5, 1))
+    dy = rng.normal(0.0, 90.0, (pairs, 5, 6))
+    dz = rng.normal(0.0, 50.0, (pairs, 5, 1))
+    shape = near_wake_shape(x, 0.025, 60.0, ct, yaw)
+    assert np.any(shape[0] > 2.0) and np.any(shape[0] == 2.0)
+    for curl in (True, False):
+        wake = wake_deficit_parameters(x, 0.025, 60.0, ct, yaw, 0.35, 9.0, curl, shape=shape)
+        parameters = rows_deficit_parameters(x, 0.025, 60.0, ct, yaw, 0.35, 9.0, speed, curl,
+                                             wake=wake)
+        fused = deficit_on_rows(dy, dz, parameters)
+        readable = normalised_deficit(x, dy, dz, k_w=0.025, radius=60.0, ct=ct, yaw=yaw,
+                                      friction_velocity=0.35, hub_speed=9.0, local_speed=speed,
+                                      curl=curl, shape=shape)
+        np.testing.assert_allclose(fused, readable, rtol=1e-12, atol=1e-15)
+        gaussian = deficit_on_rows(dy, dz, rows_deficit_parameters(
+            x, 0.025, 60.0, ct, yaw, 0.35, 9.0, speed, curl))
+        far = np.broadcast_to(shape[0] == 2.0, fused.shape)
+        np.testing.assert_array_equal(fused[far], gaussian[far])
+        assert np.any(fused[~far] != gaussian[~far])
 
 
 # -------------------------------------------------------------------------------- 4. guard

@@ -639,10 +639,11 @@ def farm(layout, wind_directions=WIND_DIRECTIONS, wind_speeds=WIND_SPEEDS, yaw=N
                  wind_speeds=list(wind_speeds),
                  turbulence_intensities=[0.06] * len(wind_speeds))
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = list(layout[0]), list(layout[1])
-    # The baselines pin the paper's k_w with FLORIS's free-stream sum of squares (the farm
-    # input's array coupling is pinned by test_array_coupling_*).
+    # The baselines pin the paper's model: its k_w and its Gaussian inside the potential core,
+    # with FLORIS's free-stream sum of squares (the farm input's array coupling is pinned by
+    # test_array_coupling_*, the near wake by tests/physics/test_near_wake.py).
     cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
-        wake_expansion="ambient", deficit_velocity="free_stream")
+        wake_expansion="ambient", deficit_velocity="free_stream", near_wake="potential_core")
     cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
     fmodel = FlorisModel(cfg)
     if yaw is not None:
@@ -926,3 +927,30 @@ def test_summed_wakes_are_asked_for_with_incoming_deficits():
             assert f"combination_model = '{combination}'" in messages[0]
             assert "deficit_velocity = 'incoming'" in messages[0]
 
+
+
+@pytest.mark.parametrize("lateral, same", [(0.0, True), (1.4, False)])
+def test_turbulence_overlap_counts_the_rotor_inside_the_wake_radius(lateral, same):
+    """``turbulence_overlap``: a wake's added turbulence is weighted with the part of the rotor
+    inside the wake radius 2 sigma (wake_radius, Niayifar & Porte-Agel 2016) or where its
+    velocity exceeds 0.05 m/s (wake_velocity, FLORIS's count). A rotor on the wake's axis lies
+    inside 2 sigma whole at 5 D: both count all of it and every power is the same. One 1.4 D
+    aside lies mostly beyond 2 sigma but in the 0.05 m/s tail: it gets less added turbulence
+    with wake_radius, so its own power is unchanged (turbulence acts on its wake) and its wake,
+    expanding more slowly, leaves less power to the rotor behind it."""
+    powers = {}
+    for overlap in ("wake_radius", "wake_velocity"):
+        cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+        diameter = 126.0  # the NREL 5 MW of the farm input
+        cfg["farm"]["layout_x"] = [0.0, 5.0 * diameter, 10.0 * diameter]
+        cfg["farm"]["layout_y"] = [0.0, lateral * diameter, lateral * diameter]
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["turbulence_overlap"] = overlap
+        fmodel = FlorisModel(cfg)
+        fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+        fmodel.run()
+        powers[overlap] = fmodel.get_turbine_powers()[0]
+    np.testing.assert_array_equal(powers["wake_radius"][:2], powers["wake_velocity"][:2])
+    if same:
+        np.testing.assert_array_equal(powers["wake_radius"], powers["wake_velocity"])
+    else:
+        assert powers["wake_radius"][2] < powers["wake_velocity"][2] * (1.0 - 1e-4)

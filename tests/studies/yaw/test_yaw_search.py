@@ -286,8 +286,10 @@ def test_both_signs_costs_at_most_twice_floris_serial_refine():
 def test_without_bounds_both_signs_are_searched():
     """optimize_yaw without bounds searches -25..25 deg (FLORIS's default, 0..25 deg, one sign):
     on the L = 100 m night's 3-turbine row at 4.5 D, 7 m/s, 263 deg the gain is on the negative
-    side, [-25, -25, ...] at about 2,594 kW where FLORIS's bounds gave [0, 0, 0] at 2,331.2 kW
-    (+11.3 %); bounds given stay the caller's."""
+    side, [-23, -25, ...] at about 2,557 kW where FLORIS's bounds gave [0, 0, 0] at 2,317.0 kW
+    (+10.4 %; with the paper's Gaussian inside the potential core, before the near wake of
+    docs/wake_model.md#near-wake: [-25, -25] at 2,594 kW, +11.3 %, the second rotor 4.5 D behind
+    stands inside x0); bounds given stay the caller's."""
     fmodel = row(4.5, "farm_night", 263.0, 7.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ShallowBoundaryLayerWarning)
@@ -295,8 +297,8 @@ def test_without_bounds_both_signs_are_searched():
         one_sign = optimize_yaw(fmodel, YawOptimizationSR, minimum_yaw_angle=0.0,
                                 maximum_yaw_angle=25.0)
     yaw = free["yaw_angles_opt"].iloc[0]
-    assert yaw[0] <= -24.0 and yaw[1] <= -24.0
-    assert free["farm_power_opt"].iloc[0] == pytest.approx(2.5939e6, rel=2e-3)
+    assert yaw[0] <= -23.0 and yaw[1] <= -24.0
+    assert free["farm_power_opt"].iloc[0] == pytest.approx(2.5568e6, rel=2e-3)
     assert free["farm_power_opt"].iloc[0] > 1.10 * free["farm_power_baseline"].iloc[0]
     assert np.all(one_sign["yaw_angles_opt"].iloc[0] >= 0.0)
     assert one_sign["farm_power_opt"].iloc[0] < 0.92 * free["farm_power_opt"].iloc[0]

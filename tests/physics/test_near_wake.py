@@ -1,0 +1,89 @@
+"""The near wake inside the potential core (wake/near_wake.py, docs/wake_model.md#near-wake):
+the super-Gaussian of Blondel & Cathelain (2020) with the paper's centre deficit 2a and width,
+its order the root of the momentum integral."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from floris_ekman_veer.wake import deficit as wd
+from floris_ekman_veer.wake.near_wake import near_wake_shape, super_gaussian_order
+
+RADIUS = 50.0
+K_W = 0.0216
+
+
+def _deficit(x, r, ct, shape, yaw=0.0):
+    return wd.normalised_deficit(x, r, np.zeros_like(r), k_w=K_W, radius=RADIUS, ct=ct, yaw=yaw,
+                                 curl=False, shape=shape)
+
+
+@pytest.mark.parametrize("ct", [0.5, 0.75, 0.87])
+def test_near_wake_is_the_paper_from_x0_on(ct):
+    x0 = float(wd.potential_core_length(K_W, RADIUS, ct, 0.0))
+    x = np.array([x0, x0 * 1.01, 2.0 * x0, 20.0 * RADIUS])
+    order, factor = near_wake_shape(x, K_W, RADIUS, ct, 0.0)
+    np.testing.assert_array_equal(order, 2.0)
+    np.testing.assert_array_equal(factor, 1.0)
+    r = np.linspace(0.0, 4.0 * RADIUS, 41)
+    for xk in x:
+        shape = near_wake_shape(xk, K_W, RADIUS, ct, 0.0)
+        np.testing.assert_array_equal(_deficit(xk, r, ct, shape), _deficit(xk, r, ct, None))
+    # Continuous at x0: the order and the width factor tend to the Gaussian's from inside.
+    below = near_wake_shape(x0 * (1.0 - 1e-6), K_W, RADIUS, ct, 0.0)
+    assert 2.0 < below[0] < 2.0 + 1e-4
+    assert abs(below[1] - 1.0) < 1e-4
+
+
+@pytest.mark.parametrize("ct, yaw", [(0.5, 0.0), (0.8, 0.0), (0.87, 0.0), (0.8, 0.35)])
+@pytest.mark.parametrize("fraction", [0.0, 0.3, 0.7])
+def test_near_wake_carries_the_thrust(ct, yaw, fraction):
+    """Inside the core the profile's momentum deficit, integrated here on a fine radial grid,
+    is the rotor's thrust C_T cos^3 beta pi R^2 / 2 (per rho U^2), with the centre at 2a."""
+    x0 = float(wd.potential_core_length(K_W, RADIUS, ct, yaw))
+    x = max(fraction * x0, 1e-3)
+    order, factor = near_wake_shape(x, K_W, RADIUS, ct, yaw)
+    assert order > 2.0
+    # The un-curled, yawed width is elliptical; the momentum closure takes the paper's
+    # sigma_tilde, the geometric mean of the two axes: integrate the round profile of that width.
+    sigma = math.sqrt(float(wd.sigma_tilde_squared(x, K_W, RADIUS, ct, yaw)))
+    centre = 2.0 * float(wd.axial_induction(ct, yaw))
+    r = np.linspace(0.0, 12.0 * sigma, 200_001)
+    profile = centre * np.exp(-(r**2 / (2.0 * (factor * sigma) ** 2)) ** (0.5 * order))
+    momentum = np.trapezoid(profile * (1.0 - profile) * 2.0 * np.pi * r, r)
+    thrust = ct * math.cos(yaw) ** 3 * math.pi * RADIUS**2 / 2.0
+    assert momentum == pytest.approx(thrust, rel=1e-6)
+    # The centre is the paper's potential-core deficit.
+    assert float(_deficit(x, np.zeros(1), ct, (order, factor), yaw)[0]) == pytest.approx(centre)
+
+
+def test_order_is_blondel_and_cathelains_closure_by_hand():
+    """At the solved order, Blondel & Cathelain's printed C(n, sigma_tilde) is 2a."""
+    ct, x = 0.8, 100.0
+    width_squared = float(wd.sigma_tilde_squared(x, K_W, RADIUS, ct, 0.0)) / (2 * RADIUS) ** 2
+    a = float(wd.axial_induction(ct, 0.0))
+    n = float(super_gaussian_order(2.0 * a, ct, width_squared))
+    printed = 2 ** (2 / n - 1) - math.sqrt(
+        2 ** (4 / n - 2) - n * ct / (16.0 * math.gamma(2 / n) * width_squared ** (2 / n)))
+    assert printed == pytest.approx(2.0 * a, rel=1e-12)
+    # At n = 2 the same formula is Bastankhah & Porte-Agel's (2014) C, Eq. (Cx) beyond x0.
+    x_far = 3.0 * float(wd.potential_core_length(K_W, RADIUS, ct, 0.0))
+    s2 = float(wd.sigma_tilde_squared(x_far, K_W, RADIUS, ct, 0.0)) / (2 * RADIUS) ** 2
+    gaussian = 1.0 - math.sqrt(1.0 - 2 * ct / (16.0 * math.gamma(1.0) * s2))
+    assert gaussian == pytest.approx(float(wd.max_deficit(x_far, K_W, RADIUS, ct, 0.0)), rel=1e-12)
+
+
+def test_near_wake_is_flatter_and_deeper_across_the_rotor():
+    """Towards the rotor the order rises and the profile flattens: at the rotor's edge the wake
+    is deeper than the paper's Gaussian, at the centre the same (2a)."""
+    ct = 0.8
+    x = np.array([1.0, 100.0, 200.0, 300.0, 400.0])
+    order, factor = near_wake_shape(x, K_W, RADIUS, ct, 0.0)
+    assert np.all(np.diff(order) < 0.0) and np.all(np.diff(factor) < 0.0)
+    assert 3.0 < order[0] < 5.5  # Blondel & Cathelain's calibrated n(0): 5.5
+    edge = np.array([RADIUS])
+    for k, xk in enumerate(x):
+        assert _deficit(xk, edge, ct, (order[k], factor[k]))[0] > _deficit(xk, edge, ct, None)[0]
