@@ -88,8 +88,10 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
             ``{sector centre deg: z0 m}`` (each record takes the sector nearest its direction).
         metadata: the path of the mast's IEA Wind Task 43 WRA data model file (JSON; wra_file.py,
             docs/measurements.md#the-masts-own-metadata): its logger columns are read as the
-            records' columns, its booms as ``booms`` and its location as ``latitude``; given
-            ``booms`` or ``latitude`` that contradict it, or a column it names that the records
+            records' columns (temperatures and pressures too), its booms as ``booms``, its
+            location as ``latitude`` and ``longitude`` and its logger's offset from UTC as
+            ``time_zone`` (where not given); given ``booms``, ``latitude`` or ``longitude``
+            that contradict it, or a column it names that the records
             lack, are refused naming both.
         site_type: ``"onshore"`` (no convective state while the sun is below the horizon, the
             heat flux by day at most half the clear-sky irradiance: needs ``latitude``,
@@ -128,6 +130,14 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                              f"{str(metadata)!r}, whose location is at {mast.latitude:g} deg; "
                              "give one of them")
         fit_options_and_inputs = {**fit_options_and_inputs, "latitude": mast.latitude}
+        # The file's location and logger clock give the sun's position (site_type="onshore")
+        # as the hand-given longitude and time_zone would; given ones must agree with it.
+        if longitude is not None and not np.isclose(longitude, mast.longitude, atol=1e-6):
+            raise ValueError(f"fit_site: longitude={longitude!r} contradicts the mast's metadata "
+                             f"file {str(metadata)!r}, whose location is at {mast.longitude:g} "
+                             "deg; give one of them")
+        longitude = mast.longitude
+        time_zone = time_zone if time_zone is not None else mast.time_zone
     checked_site_type(site_type, longitude, time_zone, fit_options_and_inputs)
     columns = mast_columns(records, booms)
     if time_column is not None and time_column not in records.columns:
