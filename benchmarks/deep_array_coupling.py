@@ -62,7 +62,7 @@ def main() -> None:
         horns_rev = metrics.row_errors(models.row_ratios(HORNS_REV, [model]))
         efficiency = metrics.efficiency_errors(models.farm_efficiency(HORNS_REV, [model]))
         lillgrund = metrics.row_errors(models.row_ratios(LILLGRUND, [model]))
-        print(f"| {' | '.join(coupling)} | {_cell(horns_rev)} | {_cell(efficiency)} | "
+        print(f"| {' | '.join(coupling)} | {_cell(horns_rev)} | {_cell(efficiency, "raw")} | "
               f"{_cell(lillgrund)} |", flush=True)
 
 

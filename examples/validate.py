@@ -204,7 +204,7 @@ def rows_table(rows, case, reading, kind="averaged"):
 
 
 def efficiency_table(effs):
-    errors = efficiency_errors(effs)
+    errors = efficiency_errors(effs[effs["kind"] == "raw"])
     readings = list(dict.fromkeys(errors["reading"]))
     table = []
     for model in dict.fromkeys(errors["model"]):
@@ -358,7 +358,7 @@ def efficiency_figure(effs, output, dpi=100):
     les = HORNS_REV.efficiency
     fig, ax = plt.subplots(figsize=(10, 3.6))
     ax.plot(les.directions, les.efficiency, "ko-", ms=3, lw=1.0, label=les.source)
-    matched = effs[effs["reading"] == "matched"]
+    matched = effs[(effs["reading"] == "matched") & (effs["kind"] == "raw")]
     for model in dict.fromkeys(matched["model"]):
         line = matched[matched["model"] == model]
         ax.plot(line["wind_direction"], line["efficiency"], label=model, **STYLE[model])

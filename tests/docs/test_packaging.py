@@ -31,7 +31,8 @@ from floris import FlorisModel
 fmodel = FlorisModel(f.example_input("sbl6"))  # with its !include turbines/...
 fmodel.run()
 assert (fmodel.get_turbine_powers() > 0).all()
-from floris_ekman_veer.studies.validation.cases import DATA, HORNS_REV  # the validation data ship
+from floris_ekman_veer.studies.validation.cases import HORNS_REV
+from floris_ekman_veer.studies.validation.reference_data import DATA  # the validation data ship
 assert "site-packages" in str(DATA) and (DATA / "PyWake-LICENSE.txt").is_file(), DATA
 assert HORNS_REV.layout[0].size == 80 and len(list(DATA.glob("*.dat"))) == 60  # Lillgrund too
 assert (DATA / "Lillgrund_layout.csv").is_file() and (DATA / "SWT-2.3-93_power_ct.csv").is_file()

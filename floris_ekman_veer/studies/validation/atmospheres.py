@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
+from floris_ekman_veer._validation import number
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.wake.deficit import potential_core_length
 
@@ -37,6 +38,29 @@ ATMOSPHERES = ("site", "matched")
 GIVEN = "given"
 #: Search range of the matched roughness length [m].
 ROUGHNESS_RANGE = (1.0e-6, 5.0)
+#: Roughness lengths of the "site" atmospheres [m]: open sea and open farmland.
+SEA_ROUGHNESS = 2.0e-4
+LAND_ROUGHNESS = 0.03
+#: Total over streamwise turbulence intensity, sqrt((s_u^2 + s_v^2 + s_w^2)/3) / s_u, with the
+#: neutral surface layer's s_u : s_v : s_w = 2.39 : 1.92 : 1.25 (Panofsky & Dutton 1984): 0.80,
+#: the reading PyWake's validation gives its single-wake cases' TI
+#: (docs/validation.md#turbulence-intensity).
+TOTAL_OVER_STREAMWISE = 0.8
+
+
+def streamwise_turbulence(total_turbulence: float) -> float:
+    """The hub-height streamwise I_u of a published total turbulence intensity (of the
+    turbulent kinetic energy, sqrt(2k/3)/U): I_u = TI_total / :data:`TOTAL_OVER_STREAMWISE`
+    (docs/validation.md#turbulence-intensity). A cup anemometer's TI (of the horizontal speed)
+    is already I_u to within a few per cent and needs no conversion."""
+    total = number(total_turbulence, "streamwise_turbulence: total_turbulence", "in (0, 0.8)",
+                   lambda ti: 0.0 < ti < TOTAL_OVER_STREAMWISE)
+    return total / TOTAL_OVER_STREAMWISE
+
+
+def site_roughness_length(offshore: bool) -> float:
+    """z0 [m] of the "site" reading: open sea offshore, open farmland onshore."""
+    return SEA_ROUGHNESS if offshore else LAND_ROUGHNESS
 
 
 def _abl(case, roughness_length: float) -> EkmanABL:
@@ -62,6 +86,13 @@ def wake_scales(case, roughness_length: float, thrust_coefficient: float) -> tup
     return k_w, float(potential_core_length(k_w, radius, thrust_coefficient, 0.0)) / case.rotor_diameter
 
 
+def matched_turbulence_range(case) -> tuple[float, float]:
+    """The I_u(z_h) the "matched" reading can reach: those of :data:`ROUGHNESS_RANGE`'s ends
+    (I_u grows monotonically with z0)."""
+    low, high = (hub_turbulence(case, z) for z in ROUGHNESS_RANGE)
+    return low, high
+
+
 def matched_roughness(case) -> float:
     """z0 [m] of the neutral ABL whose I_u(z_h) is the case's measured streamwise TI.
 
@@ -74,8 +105,8 @@ def matched_roughness(case) -> float:
         return hub_turbulence(case, float(np.exp(log_z0))) - target
 
     if mismatch(low) > 0 or mismatch(high) < 0:
-        raise ValueError(f"{case.name}: no neutral roughness length in {ROUGHNESS_RANGE} m gives "
-                         f"I_u(z_h) = {target:.4g}")
+        raise ValueError(f"{case.name}: turbulence: no neutral roughness length in "
+                         f"{ROUGHNESS_RANGE} m gives I_u(z_h) = {target:.4g}")
     return float(np.exp(brentq(mismatch, low, high, xtol=1e-12, rtol=1e-12)))
 
 
@@ -88,5 +119,8 @@ def atmosphere(case, reading: str) -> dict:
         return dict(case.atmosphere)
     if reading not in ATMOSPHERES:
         raise ValueError(f"reading must be one of {ATMOSPHERES + (GIVEN,)}, got {reading!r}")
+    if reading == "matched" and case.streamwise_turbulence is None:
+        raise ValueError(f"{case.name}: reading 'matched' needs the case's turbulence (the "
+                         f"measured I_u); this case gives an atmosphere block: use reading {GIVEN!r}")
     z0 = case.site_roughness if reading == "site" else matched_roughness(case)
     return {"latitude": float(case.latitude), "roughness_length": float(z0)}

@@ -74,8 +74,8 @@ def _errors(group, value, reference, spread=None) -> pd.Series:
     rmse, bias = rmse_bias(chosen[value], chosen[reference])
     result = {"n": int(inside.sum()), "rmse": rmse, "bias": bias}
     if spread is not None:
-        # The measured means' own standard error, as an RMS over the same points: an RMSE near
-        # it is within what the measurements can tell apart.
+        # The reference's own standard error, as an RMS over the same points: an RMSE near it
+        # is within what the measurements can tell apart.
         result["standard_error"] = float(np.sqrt(np.mean(chosen[spread] ** 2)))
     return pd.Series(result)
 
@@ -99,11 +99,18 @@ def reference_row_errors(ratios: pd.DataFrame, by=("case", "kind")) -> pd.DataFr
     return row_errors(first.assign(ratio=first["rans"]), by=by)
 
 
-def efficiency_errors(efficiency: pd.DataFrame, by=("case", "reading", "model")) -> pd.DataFrame:
-    """RMSE and bias of the farm efficiency (``models.farm_efficiency``) against its reference
-    at the reference's directions, per group ``by``."""
+def efficiency_errors(efficiency: pd.DataFrame, by=None) -> pd.DataFrame:
+    """RMSE, bias and the reference's standard error (RMS over the same points; NaN where the
+    reference gives none) of the farm efficiency (``models.farm_efficiency``) against its
+    reference at the reference's directions, per group ``by`` (default: case, reading, model
+    and kind, those of them the table has, so that a table built elsewhere without "kind" or
+    "standard_error" columns is scored as well)."""
+    if by is None:
+        by = [c for c in ("case", "reading", "model", "kind") if c in efficiency]
+    spread = "standard_error" if "standard_error" in efficiency else None
     return (efficiency.groupby(list(by), sort=False)
-            .apply(_errors, "efficiency", "reference", include_groups=False).reset_index())
+            .apply(_errors, "efficiency", "reference", spread, include_groups=False)
+            .reset_index())
 
 
 def markdown(header: list[str], rows: list[list]) -> str:

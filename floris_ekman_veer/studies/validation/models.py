@@ -13,11 +13,18 @@ FLORIS's default parameters; a user adds a set-up to the dictionary or passes on
 * :func:`arc_profiles`: U/U0 at hub height on the arcs of a single-wake case;
 * :func:`row_ratios`: P_i/P_1 along a farm case's reference rows, as computed and averaged over
   the wind-direction uncertainty with FLORIS's ``UncertainFlorisModel``, as a tidy table;
-* :func:`farm_efficiency`: the farm efficiency against wind direction.
+* :func:`farm_efficiency`: the farm efficiency against wind direction, as computed and averaged
+  over the wind-direction uncertainty, with the farm's and its no-wake power.
+
+Every table carries the model's name and its :func:`model_label`: the name with the settings
+the model ran with (docs/validation.md#model-labels).
 """
 
 from __future__ import annotations
 
+import re
+
+import attrs
 import numpy as np
 import pandas as pd
 from floris import FlorisModel, UncertainFlorisModel
@@ -30,7 +37,9 @@ from floris_ekman_veer.studies.comparison import (
     fair_builtin_set_kwargs,
 )
 from floris_ekman_veer.studies.validation.atmospheres import atmosphere, hub_turbulence
-from floris_ekman_veer.studies.validation.cases import ARC_HALF_WIDTH
+from floris_ekman_veer.studies.validation.checks import array, scalar
+from floris_ekman_veer.studies.validation.farm_case import MAX_DIRECTION_OFFSET
+from floris_ekman_veer.studies.validation.reference_data import ARC_HALF_WIDTH
 
 
 def _ekman(veer=True, velocity="ekman_veer", **velocity_parameters):
@@ -80,8 +89,75 @@ def _setup(model):
             raise ValueError(f"model must be one of {list(WAKE_MODELS)} or a (name, set-up) pair, "
                              f"got {model!r}")
         return model, WAKE_MODELS[model]
+    if not (isinstance(model, (tuple, list)) and len(model) == 2 and isinstance(model[0], str)
+            and isinstance(model[1], (tuple, list)) and len(model[1]) == 3):
+        raise TypeError("model must be a name of WAKE_MODELS or a (name, (model strings, GCH "
+                        f"switch, parameters)) pair; got {model!r}")
     name, setup = model
     return name, setup
+
+
+def _models(models) -> list:
+    if isinstance(models, (str, bytes)) or not isinstance(models, (tuple, list)) or not models:
+        raise TypeError(f"models must be a non-empty list of model names or (name, set-up) "
+                        f"pairs; got {models!r}")
+    return [(_setup(m)[0], m) for m in models]
+
+
+def _readings(readings) -> tuple:
+    if isinstance(readings, str) or not isinstance(readings, (tuple, list)) or not readings:
+        raise TypeError(f"readings must be a non-empty list of atmosphere readings; got "
+                        f"{readings!r}")
+    return tuple(readings)
+
+
+def _sample_step(sample_step) -> float:
+    return scalar(sample_step, "sample_step", "in (0, 10] deg",
+                  lambda step: np.isfinite(step) and 0.0 < step <= 10.0)
+
+
+#: Fields of a wake model that are not model settings: the inflow, the shallow-ABL policy.
+_NOT_SETTINGS = ("atmosphere", "shallow_boundary_layer")
+
+
+def _shown(component) -> list[str]:
+    # Every choice (string or boolean) of a wake component, and its numbers: all of them for
+    # the package's own models (whose defaults a release may change), those set away from
+    # FLORIS's defaults for FLORIS's (FLORIS's version is pinned).
+    own = type(component).__module__.startswith("floris_ekman_veer.")
+    items = []
+    for item in attrs.fields(type(component)):
+        if not item.init or item.name in _NOT_SETTINGS:
+            continue
+        value = getattr(component, item.name)
+        if isinstance(value, (str, bool, np.bool_)):
+            items.append(f"{item.name}={value}")
+        elif isinstance(value, (int, float)) and (own or value != item.default):
+            items.append(f"{item.name}={value:g}")
+    return items
+
+
+#: FLORIS's secondary-effect switches, named in a label when on.
+_SWITCHES = {"enable_secondary_steering": "secondary_steering",
+             "enable_yaw_added_recovery": "yaw_added_recovery",
+             "enable_transverse_velocities": "transverse_velocities"}
+
+
+def model_label(name: str, fmodel) -> str:
+    """A label that carries the settings a built model runs with, and makes a good key (no
+    commas, no spaces): the name, then in brackets FLORIS's model strings, the GCH switches
+    that are on, every choice of the velocity, deflection and turbulence models (the
+    package's ``wake_expansion``, ``deficit_velocity``, ``veer`` ...) with their defaults
+    resolved, every number of the package's models and each number of FLORIS's set away from
+    its default. Two runs with one label ran one model (docs/validation.md#model-labels)."""
+    wake = fmodel.core.wake
+    items = [f"{kind}={wake.model_strings[f'{kind}_model']}"
+             for kind in ("velocity", "deflection", "turbulence", "combination")]
+    items += [short for switch, short in _SWITCHES.items() if getattr(wake, switch)]
+    items += _shown(wake.velocity_model)
+    items += [f"{kind}.{item}" for kind in ("deflection", "turbulence")
+              for item in _shown(getattr(wake, f"{kind}_model"))]
+    return f"{re.sub(r'[^A-Za-z0-9.-]+', '_', name)}[{';'.join(items)}]"
 
 
 def floris_input(case, reading: str, model) -> dict:
@@ -173,13 +249,21 @@ def _gaussian_weights(sigma, offsets):
 
 def turbine_powers(case, reading: str, model, directions, sample_step: float = 1.0):
     """Turbine powers [W] at each wind direction, raw and averaged over the direction
-    uncertainty, as ``{"raw": (n_directions, n_turbines), "averaged": ...}``.
+    uncertainty, as ``{"raw": (n_directions, n_turbines), "averaged": ...}`` (the model built
+    by :func:`build_model`; see :func:`uncertain_powers`)."""
+    fmodel = build_model(case, reading, model)
+    return uncertain_powers(fmodel, case, _directions(directions, "directions"), sample_step)
+
+
+def uncertain_powers(fmodel, case, directions, sample_step: float = 1.0):
+    """Turbine powers [W] of a built model at each wind direction, raw and averaged over the
+    direction uncertainty, as ``{"raw": (n_directions, n_turbines), "averaged": ...}``.
 
     One ``UncertainFlorisModel`` runs the directions perturbed by ``sample_step``-spaced offsets
     out to 3 sigma_max; FLORIS's ``map_turbine_values_uncertain`` then weights the expanded
     model's turbine powers with each turbine's own Gaussian (``case.direction_sigma()``) and,
     for "raw", with all weight on the zero offset."""
-    fmodel = build_model(case, reading, model)
+    sample_step = _sample_step(sample_step)
     directions = np.asarray(directions, dtype=float)
     _conditions(fmodel, case, directions)
     sigma = case.direction_sigma()
@@ -203,6 +287,10 @@ def turbine_powers(case, reading: str, model, directions, sample_step: float = 1
     return {"raw": weighted((offsets == 0.0).astype(float)), "averaged": averaged}
 
 
+def _directions(directions, name: str) -> np.ndarray:
+    return array(directions, name, 1, "finite, in [0, 360] deg", lambda d: (d >= 0) & (d <= 360))
+
+
 def _ratios(per_turbine, row):
     # Mean over the row's parallel rows at each position, relative to position 1; gaps NaN.
     powers = per_turbine[np.where(row.turbines < 0, 0, row.turbines)].mean(axis=1)
@@ -220,15 +308,21 @@ def row_ratios(case, models, readings=("matched",), sample_step: float = 1.0,
     The model runs, per row direction, the directions ``direction + offsets`` (default
     ``case.direction_offsets``, the measurements' bin; e.g. (0,) for speed) through
     :func:`turbine_powers`; all rows of a case go in one run per model and reading.
-    ``models``: names of :data:`WAKE_MODELS` or (name, set-up) pairs."""
-    offsets = np.asarray(case.direction_offsets if offsets is None else offsets, dtype=float)
+    ``models``: names of :data:`WAKE_MODELS` or (name, set-up) pairs; the "label" column is
+    each one's :func:`model_label`."""
+    offsets = array(case.direction_offsets if offsets is None else offsets, "offsets", 1,
+                    f"finite, within +-{MAX_DIRECTION_OFFSET:g} deg",
+                    lambda o: np.abs(o) <= MAX_DIRECTION_OFFSET)
+    if not case.rows:
+        raise ValueError(f"{case.name}: row_ratios needs the case's rows (RowReference); it has none")
     row_directions = sorted({row.wind_direction for row in case.rows})
     directions = np.concatenate([d + offsets for d in row_directions])
     frames = []
-    for reading in readings:
-        for model in models:
-            name = _setup(model)[0]
-            powers = turbine_powers(case, reading, model, directions, sample_step)
+    for reading in _readings(readings):
+        for name, model in _models(models):
+            fmodel = build_model(case, reading, model)
+            label = model_label(name, fmodel)
+            powers = uncertain_powers(fmodel, case, directions, sample_step)
             for row in case.rows:
                 k = row_directions.index(row.wind_direction)
                 chosen = slice(k * offsets.size, (k + 1) * offsets.size)
@@ -236,7 +330,8 @@ def row_ratios(case, models, readings=("matched",), sample_step: float = 1.0,
                     rans = (row.rans[:, 2 if kind == "averaged" else 1] if row.rans is not None
                             else np.full(len(row.turbines), np.nan))
                     frames.append(pd.DataFrame({
-                        "case": case.name, "reading": reading, "model": name, "row": row.label,
+                        "case": case.name, "reading": reading, "model": name, "label": label,
+                        "row": row.label,
                         "wind_direction": row.wind_direction,
                         "position": row.measured[:, 0].astype(int), "kind": kind,
                         "ratio": _ratios(powers[kind][chosen].mean(axis=0), row),
@@ -246,32 +341,47 @@ def row_ratios(case, models, readings=("matched",), sample_step: float = 1.0,
     return pd.concat(frames, ignore_index=True)
 
 
-def farm_efficiency(case, models, readings=("matched",), directions=None) -> pd.DataFrame:
-    """Farm power over n unwaked turbines' power at each wind direction [deg] (default: the
-    case's efficiency reference's), no averaging: a tidy table case, reading, model,
-    wind_direction, efficiency, reference (NaN where the case has none at that direction)."""
+def farm_efficiency(case, models, readings=("matched",), directions=None,
+                    sample_step: float = 1.0) -> pd.DataFrame:
+    """Farm power over the farm's no-wake power at each wind direction [deg] (default: the
+    case's efficiency reference's), a tidy table: case, reading, model, label, wind_direction,
+    kind ("raw": at the direction; "averaged": each turbine's power averaged over the direction
+    uncertainty as in :func:`row_ratios`, for a case with one), efficiency, farm_power and no_wake_power [W],
+    reference and standard_error (the efficiency reference's at that direction; NaN where the
+    case has none)."""
     reference = case.efficiency
     if directions is None:
         if reference is None:
             raise ValueError(f"{case.name}: give directions (the case has no efficiency reference)")
-        directions, measured = reference.directions, reference.efficiency
+        directions = reference.directions
+        measured, error = reference.efficiency, reference.standard_errors
     else:
-        directions = np.asarray(directions, dtype=float)
-        measured = np.full(directions.size, np.nan)
+        directions = _directions(directions, "directions")
+        measured, error = np.full(directions.size, np.nan), np.full(directions.size, np.nan)
         if reference is not None:  # the reference's first value at each direction it has
             match = np.isclose(directions[:, None], reference.directions[None, :])
             found = match.any(axis=1)
             measured[found] = reference.efficiency[match.argmax(axis=1)[found]]
+            error[found] = reference.standard_errors[match.argmax(axis=1)[found]]
     frames = []
-    for reading in readings:
-        for model in models:
+    for reading in _readings(readings):
+        for name, model in _models(models):
             fmodel = build_model(case, reading, model)
-            _conditions(fmodel, case, directions)
+            label = model_label(name, fmodel)
+            kinds = {}
+            if case.direction_uncertainty is not None:
+                powers = uncertain_powers(fmodel, case, directions, sample_step)
+                kinds["averaged"] = powers["averaged"].sum(axis=1)
+            else:
+                _conditions(fmodel, case, directions)
             fmodel.run()
-            farm = fmodel.get_farm_power()
+            kinds = {"raw": fmodel.get_farm_power(), **kinds}
             fmodel.run_no_wake()
-            frames.append(pd.DataFrame({
-                "case": case.name, "reading": reading, "model": _setup(model)[0],
-                "wind_direction": directions, "efficiency": farm / fmodel.get_farm_power(),
-                "reference": measured}))
+            no_wake = fmodel.get_farm_power()
+            for kind, power in kinds.items():
+                frames.append(pd.DataFrame({
+                    "case": case.name, "reading": reading, "model": name, "label": label,
+                    "wind_direction": directions, "kind": kind, "efficiency": power / no_wake,
+                    "farm_power": power, "no_wake_power": no_wake, "reference": measured,
+                    "standard_error": error}))
     return pd.concat(frames, ignore_index=True)
