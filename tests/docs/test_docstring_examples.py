@@ -10,7 +10,7 @@ import pytest
 import floris_ekman_veer
 
 #: The objects whose docstrings carry a usage example, by their public name.
-DOCUMENTED = ["EkmanABL", "optimize_yaw"]
+DOCUMENTED = ["EkmanABL", "optimize_yaw", "fit_site"]
 
 
 def examples(name):

@@ -29,6 +29,9 @@ LENGTH_SCALE = 100.0
 #: The relative slack a fitted state keeps inside the physical domain's bounds
 #: (`DomainCheck.margin`): far above the round-off of the ABL re-solved from its G.
 _DOMAIN_MARGIN = 1e-9
+#: The largest coefficient of mu_N z f/u* in the profile's surface layer (wind_profile.py:
+#: 0.3; 1 for margin): a state where it is no finite number is refused.
+_SURFACE_TERM = 1.0
 
 
 class ProfileModel:
@@ -112,6 +115,13 @@ class ProfileModel:
                 & (self.template.matching_fraction * h > 1.001 * z0)
                 # a layer as deep as the ABL class accepts (light winds: u* -> 0, h -> 0)
                 & (h >= 1.001 * self.min_depth)
+                # the profile is written in units of u* (u = u* F(z f/u*, ...)): a state whose
+                # u* has run to underflow (a calm reached by a long trial step, u* ~ 1e-309 with
+                # G ~ 0.2 m/s) has its surface terms (mu_N z f/u*: the free atmosphere's
+                # stratification over u*) beyond any number, no state of the model
+                & np.isfinite(_SURFACE_TERM * p["mu_n"] * np.abs(p["f"])
+                              * np.nanmax(np.where(self.ms[index], self.z[index], 0.0), axis=1)
+                              / u_star)
             )
             if self.fit_mixed_layer:
                 # z_i an input the ABL class accepts, whatever the sign the state takes

@@ -82,6 +82,13 @@ def misfit_reason(heights, speeds, directions, speed_noise, direction_noise, hem
                       + looks)
 
 
+#: The fraction of a fitted top within which a measurement height counts as at the top, not
+#: below it: far above the fit's convergence onto a height (measured: a top 2.6e-7 of it above
+#: the 30 m cup, tests/studies/site/test_site_year.py's 2025-08-26 12:00), far below any real
+#: layer's distance from a cup (3 mm at 30 m).
+TOP_RESOLUTION = 1e-4
+
+
 def _top_changes(heights, speeds, directions, depth):
     """Per record: the speed and direction changes from the lowest height to the lowest one at
     or above ``depth`` (across the layer) and from there to the highest (above it), the largest
@@ -97,7 +104,11 @@ def _top_changes(heights, speeds, directions, depth):
         "speed_below": s[rows, cross] - s[rows, low],
         "speed_above": s[rows, high] - s[rows, cross],
         "peak": np.nanmax(s, axis=1) - s[rows, high],
-        "below": z[rows, low] < depth,
+        # A measurement at the top itself (the fit's top converged onto a measurement height,
+        # the misfit's kink where that height leaves the layer) reads the top's own wind: the
+        # model's deficit below the top vanishes there, so only a height below the top by more
+        # than TOP_RESOLUTION of it lies inside the layer and can show it.
+        "below": z[rows, low] < depth * (1.0 - TOP_RESOLUTION),
     }
     if directions is not None:
         # (the vanes' own heights: a vane need not stand at a cup's height)

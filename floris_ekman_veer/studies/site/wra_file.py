@@ -3,7 +3,8 @@ data model file (JSON, schema v1.x; docs/measurements.md#the-masts-own-metadata)
 
 What the file says that the fit uses: the location (``latitude_ddeg``, ``longitude_ddeg``), the
 logger's offset from UTC (``logger_main_config[].offset_from_utc_hrs``), and per measurement
-point of type ``wind_speed`` or ``wind_direction`` its ``height_m``, its boom
+point of type ``wind_speed``, ``wind_direction``, ``air_temperature`` or ``air_pressure`` its
+``height_m``, its boom
 (``mounting_arrangement[].boom_orientation_deg``; a vane's ``vane_dead_band_orientation_deg``)
 and the logger's columns with their statistics (``logger_measurement_config[].column_name[]``:
 ``column_name`` and ``statistic_type_id``, ``avg`` the mean, ``sd`` the standard deviation).
@@ -22,8 +23,11 @@ import attrs
 import numpy as np
 import pandas as pd
 
-#: The file's measurement types the fit reads, as the columns' quantities.
-QUANTITIES = {"wind_speed": "speed", "wind_direction": "direction"}
+#: The file's measurement types the fit reads, as the columns' quantities (temperatures and
+#: pressures are stability data, stability.py: a file that names them gives them to the fit as
+#: the records' ``temperature_<h>m`` / ``pressure_<h>m`` columns would).
+QUANTITIES = {"wind_speed": "speed", "wind_direction": "direction",
+              "air_temperature": "temperature", "air_pressure": "pressure"}
 #: The file's statistics the fit reads, as the columns' suffixes ("" the mean).
 STATISTICS = {"avg": "", "sd": "_std"}
 
@@ -47,6 +51,15 @@ class MastMetadata:
     columns: pd.DataFrame
     booms: dict
     vane_dead_bands: dict
+
+    @property
+    def time_zone(self) -> str | None:
+        """The logger's offset from UTC as ``fit_site``'s ``time_zone`` ("+01:00"), or None."""
+        if self.utc_offset_hours is None:
+            return None
+        minutes = int(round(abs(self.utc_offset_hours) * 60.0))
+        sign = "+" if self.utc_offset_hours >= 0 else "-"
+        return f"{sign}{minutes // 60:02d}:{minutes % 60:02d}"
 
     def named_records(self, records: pd.DataFrame) -> pd.DataFrame:
         """``records`` with the file's logger columns named as columns.py reads them; ValueError
