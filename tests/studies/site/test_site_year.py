@@ -79,11 +79,16 @@ def test_one_call_fits_every_fittable_record_and_names_the_others(records, site)
     assert (stable == "fitted").sum() >= stable.size - 3
     bound = excluded[excluded["kind"] == "physical bound"]["reason"]
     assert bound.str.contains(r"on the bound of the sensible heat flux (?:-300|800) W/m\^2").all()
-    # The rare kinds are recognised as what they are; the convective hours are kept, convective.
+    # The rare kinds are recognised as what they are; the convective hours are kept, convective,
+    # where their fit lies inside the physical domain. A fit on a bound is never kept
+    # (docs/measurements.md#reading-stability): the convective afternoons whose best fit, under
+    # the weak prior on 1/L, still lies on the 800 W/m^2 bound are named "physical bound"
+    # (measured: 222 of the 360 kept convective, 81 on the bound, 50 with no top in the mast).
     assert (kind[records["true_kind"] == "backing"] == "backing").sum() >= 36
     convective = records["true_kind"] == "convective"
     classes = pd.Series(site.profile_fit.stability_class, index=kind.index[kind == "fitted"])
-    assert (classes.reindex(kind.index[convective]) == "convective").sum() >= 310
+    assert (classes.reindex(kind.index[convective]) == "convective").sum() >= 215
+    assert (kind[convective] == "physical bound").sum() <= 90
     # The reasons a person reads: the column of a zero reading, the backing in degrees.
     zero = excluded[excluded["kind"] == "zero reading"]["reason"]
     assert zero.str.contains(r"zero speed reading \(0 m/s\) in speed_\d+m").all()
