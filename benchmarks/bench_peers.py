@@ -180,6 +180,10 @@ def main(argv=None) -> None:
         numexpr.set_num_threads(args.threads)
         numba.set_num_threads(args.threads)
     contenders = [c.strip() for c in args.contenders.split(",")]
+    unknown = [c for c in contenders if c not in FLORIS_CONTENDERS + PYWAKE_CONTENDERS]
+    if unknown:
+        parser.error(f"--contenders: unknown {unknown}; choose from "
+                     f"{', '.join(FLORIS_CONTENDERS + PYWAKE_CONTENDERS)}")
     try:
         import py_wake
         pywake = f"PyWake {py_wake.__version__}"
