@@ -140,17 +140,20 @@ class EkmanWakeModel(BaseModel):
         ``floris_turbulence`` its ambient TI_0. Both keep the paper's ambient I_u(z_h) and add
         the wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0), so an unwaked turbine gets the
         paper's k_w exactly, whatever TI_0 FLORIS was given
-        (docs/coupling.md#wake-expansion-in-farms).
+        (docs/coupling.md#wake-expansion-in-farms). The ambient I_u(z_h) is scaled by the
+        atmosphere's ``turbulence_factor`` where it has one (a site's measured turbulence,
+        docs/atmosphere.md#ambient-turbulence).
         """
         if self.wake_expansion == "ambient":
             return wake_expansion_rate(
                 abl.friction_velocity, abl.boundary_layer_height, hub_height, hub_speed,
                 A1=self.A1, B1=self.B1, alpha_prime=self.alpha_prime, floor=self.k_w_floor,
                 n=self.k_w_exponent, convective=abl.convective_variance,
+                turbulence_factor=abl.turbulence_factor,
             )
         ambient = streamwise_turbulence_intensity(
             hub_height, abl.friction_velocity, abl.boundary_layer_height, hub_speed, self.A1,
-            self.B1, abl.convective_variance,
+            self.B1, abl.convective_variance, abl.turbulence_factor,
         )
         added_squared = np.maximum(
             np.asarray(turbulence_intensity, dtype=float) ** 2 - floris_turbulence**2, 0.0
