@@ -307,7 +307,7 @@ class EkmanABL(WindProfile, EkmanSolver):
     - ``reference_potential_temperature`` Theta0 [K], default the paper's 265 K.
     - ``turbulence_factor`` (beyond the paper; default None, the paper's I_u): the site's
       ambient streamwise turbulence as a factor on the model's I_u(z) of Eq. (Iu_model), > 0 and
-      <= 5; it scales `turbulence_intensity` and hence the wake expansion rate k_w of
+      <= 10; it scales `turbulence_intensity` and hence the wake expansion rate k_w of
       Eq. (kw_CNBL_SBL_model), not the mean wind. A measured hub-height TI over the model's I_u
       there (terrain, upwind roughness: docs/atmosphere.md#ambient-turbulence).
     - Model constants: ``von_karman`` 0.41, ``c_g`` 1.43, ``stress_decay`` (Gamma) 0.83,

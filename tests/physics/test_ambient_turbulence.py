@@ -75,7 +75,7 @@ def test_the_factor_scales_i_u_at_every_height_and_leaves_the_mean_wind():
 
 @pytest.mark.parametrize("bad", [0.0, -1.2, 120.0, np.nan, np.inf])
 def test_a_bad_factor_is_refused_naming_it_its_value_and_range(bad):
-    with pytest.raises(ValueError, match=r"turbulence_factor.*> 0 and <= 5"):
+    with pytest.raises(ValueError, match=r"turbulence_factor.*> 0 and <= 10"):
         EkmanABL.from_reference_wind(8.0, 90.0, turbulence_factor=bad, **NIGHT)
     with pytest.raises(ValueError, match=r"got .* at condition 1"):
         EkmanABL.from_reference_wind(8.0, 90.0, turbulence_factor=[1.2, bad], **NIGHT)
@@ -84,7 +84,7 @@ def test_a_bad_factor_is_refused_naming_it_its_value_and_range(bad):
     config = make_config("ekman_veer", {**NIGHT, "turbulence_factor": [1.1, bad]},
                          wind_speeds=(8.0, 9.0), wind_directions=(270.0, 270.0))
     with pytest.raises(ValueError, match=r"wake\.wake_velocity_parameters\.ekman_veer\.atmosphere"
-                                         r"\.turbulence_factor.*> 0 and <= 5"):
+                                         r"\.turbulence_factor.*> 0 and <= 10"):
         FlorisModel(config)
 
 

@@ -53,10 +53,12 @@ MAX_GEOSTROPHIC_WIND = 75.0
 #: (Ekman 1905) bounds the turning of a layer mixed at least as strongly; convective layers turn
 #: the wind less than neutral ones (docs/atmosphere.md#physical-domain).
 MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE = 45.0
-#: The largest ambient turbulence factor accepted (docs/atmosphere.md#ambient-turbulence): the
-#: streamwise turbulence of real sites lies within about half to twice the model's I_u (terrain,
-#: upwind roughness, meandering); 5 is far beyond, and catches a factor given in percent (120).
-MAX_TURBULENCE_FACTOR = 5.0
+#: The largest ambient turbulence factor accepted (docs/atmosphere.md#ambient-turbulence): a
+#: site's streamwise turbulence is typically 0.8-1.5 times the model's neutral I_u (terrain,
+#: upwind roughness), and on weak-wind stable nights the meandering of submeso motions can make
+#: it several times the model's (Mahrt 2014); 10 is beyond both and catches a factor given in
+#: percent (120).
+MAX_TURBULENCE_FACTOR = 10.0
 #: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#input-ranges
 #: state it. Every input is a real number or an array of them (strings and booleans are refused).
 VALID_RANGES = {
