@@ -3,8 +3,8 @@ the reference height (docs/measurements.md#from-the-fit-to-floris): the wind spe
 of the fitted profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model) or the
 cups' measured one, and the atmosphere block with one entry per record (with the measured
 turbulence as its ``turbulence_factor``, the wake's ambient turbulence). Driven by those wind
-speeds, the block gives back the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere` carries them to FLORIS (a
-``TimeSeries``, :meth:`~SiteAtmosphere.apply`, annual energy), and
+speeds, the block gives back the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere`
+carries them to FLORIS (a ``TimeSeries``, :meth:`~SiteAtmosphere.apply`, annual energy), and
 :meth:`SiteAtmosphere.summary` reports the site (:class:`SiteSummary`).
 """
 

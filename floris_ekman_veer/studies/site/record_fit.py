@@ -55,9 +55,10 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
     first record that cannot be fitted and why; ``"drop"``: such records are left out and
     named in ``excluded``. The cups' measured turbulence intensity (nearest the reference
     height) enters the fit as its departure from the site's neutral turbulence in its sector
-    (the ``baseline``'s terrain excess, stage 3) unless a ``turbulence_intensity`` is given; the fit takes the weak prior on 1/L, an onshore
-    site's sun bound, and the temperatures' and a sonic's stability where ``records`` hold
-    them (stability.py, docs/measurements.md#reading-stability)."""
+    (the ``baseline``'s terrain excess, stage 3) unless a ``turbulence_intensity`` is given;
+    the fit takes the weak prior on 1/L, an onshore site's sun bound, and the temperatures'
+    and a sonic's stability where ``records`` hold them (stability.py,
+    docs/measurements.md#reading-stability)."""
     heights, speeds, directions, speed_columns = fit_heights(instruments, columns)
     excluded = screen_records(speed_columns, labels, heights, speeds, directions,
                               3 if fit_options_and_inputs.get("fit_roughness") else 2)
