@@ -13,7 +13,9 @@ IEC 61400-12-1 Annex B), per direction sector:
   upwind roughness changes steepen it): it is the roughness that makes the model's neutral
   profile the site's own. Its uncertainty is the ratio's standard error (of the median, from the
   MAD) carried through that inversion, given as a factor (z0 times or divided by it), and beside
-  it the systematic factor of the cups' calibration (:data:`CUP_CALIBRATION`);
+  it the systematic factor of the cups' calibration (their certificates' uncertainty where
+  applied, readings.py's :func:`~.readings.calibrated_cups`, else the generic transfer
+  function's :data:`~.readings.CUP_CALIBRATION_GENERIC`);
 * the neutral turbulence intensity: the median of the cups' sigma_u / U at that cup, with its
   standard error, beside the model's neutral I_u there (Eq. Iu_model) at the sector's z0; their
   ratio is the terrain's excess turbulence (Wieringa 1993; Panofsky & Dutton 1984, ch. 7).
@@ -36,7 +38,7 @@ import pandas as pd
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
-from floris_ekman_veer.studies.site.readings import Instruments
+from floris_ekman_veer.studies.site.readings import CUP_CALIBRATION_GENERIC, Instruments
 from floris_ekman_veer.studies.site.vanes import (OFFSET_MIN_SPEED, direction_near,
                                                   median_and_error, reference_index,
                                                   wrapped_angle)
@@ -49,10 +51,6 @@ BASELINE_MIN_RECORDS = 20
 #: city centre (Wieringa 1993's table).
 ROUGHNESS_RANGE = (1e-5, 2.0)
 _GRID = np.geomspace(*ROUGHNESS_RANGE, 61)
-#: A cup's calibration uncertainty, relative (IEC 61400-12-1 Annex E: about 1 % for a class-1
-#: cup): it does not average out over records, and a 1 % error of the shear ratio moves z0 by a
-#: factor of about 1.5 between 40 and 80 m; given as its own factor beside the statistical one.
-CUP_CALIBRATION = 0.01
 
 
 @attrs.frozen(eq=False)
@@ -123,12 +121,16 @@ def checked_roughness(roughness_length, reference_height: float):
 
 def neutral_baseline(instruments: Instruments, reference_height: float,
                      fit_options_and_inputs: dict, roughness_length="estimate", *,
-                     cups_per_height=None) -> NeutralBaseline:
+                     cups_per_height=None, calibration_uncertainty=None) -> NeutralBaseline:
     """The site's neutral baseline from the records (module docstring). ``roughness_length``:
     "estimate", or a number or ``{sector centre: z0}`` given (then only the turbulence is
     estimated, and each record takes the given roughness of the sector nearest its direction).
     ValueError when "estimate" finds fewer than :data:`BASELINE_MIN_RECORDS` strong-wind
-    records (give the roughness length)."""
+    records (give the roughness length). ``calibration_uncertainty``: per cup height the
+    relative calibration uncertainty of its speed (the cups' certificates', readings.py); by
+    default the generic transfer function's over the height's ``cups_per_height`` cups. It does
+    not average out over records (a 1 % error of the shear ratio moves z0 by a factor of about
+    1.5 between 40 and 80 m) and is given as its own factor beside the statistical one."""
     n = instruments.speeds.shape[0]
     cups = instruments.cup_heights
     # The turbulence's cup is the one nearest the reference height; the shear is read between
@@ -182,7 +184,10 @@ def neutral_baseline(instruments: Instruments, reference_height: float,
         table["roughness_factor_calibration"] = np.nan
         table["source"] = "given"
     else:
-        calibration = CUP_CALIBRATION * np.sqrt(1.0 / counts[lower] + 1.0 / counts[upper])
+        per_height = (np.asarray(calibration_uncertainty, float)
+                      if calibration_uncertainty is not None
+                      else CUP_CALIBRATION_GENERIC / np.sqrt(np.asarray(counts, float)))
+        calibration = float(np.hypot(per_height[lower], per_height[upper]))
         z0, factor, inside, systematic = _inverted(table, heights, fixed, calibration)
         table["roughness_length"], table["roughness_factor"] = z0, factor
         table["roughness_factor_calibration"] = systematic
