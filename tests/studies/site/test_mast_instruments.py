@@ -148,6 +148,37 @@ def test_vane_offsets_are_found_within_their_uncertainty(year, instruments, site
         fit_site(mast_year(periods=48), 80.0, booms=BOOMS, direction_offsets={40: 1.0}, **SITE)
 
 
+def test_an_offset_known_by_construction_is_found_against_the_surface_layers_turning():
+    """Strong-wind records whose wind does not turn between the vanes (the constant-stress
+    surface layer's neutral turning, the reference chosen: docs/measurements.md#vane-offsets),
+    speeds of the neutral log law, vanes offset by -3.0 and +1.5 deg with 0.7 deg noise: each
+    offset found within three of its statistical errors, and the systematic part (the other
+    published forms' departure) reported beside it."""
+    rng = np.random.default_rng(7)
+    n, z0, kappa = 300, 0.05, 0.41
+    speed = rng.uniform(12.0, 18.0, n)
+    u_star = kappa * speed / np.log(80.0 / z0)
+    direction = rng.uniform(0.0, 360.0, n)
+    offsets = {38.0: -3.0, 58.0: 1.5, 78.0: 0.0}
+    records = {f"speed_{h:g}m": np.round(u_star / kappa * np.log(h / z0)
+                                          * (1.0 + rng.normal(0.0, 0.005, n)), 2)
+               for h in (40.0, 60.0, 80.0)}
+    for h, offset in offsets.items():
+        records[f"direction_{h:g}m"] = np.mod(direction + offset + rng.normal(0.0, 0.7, n), 360.0)
+    records = pd.DataFrame(records)
+    columns = mast_columns(records)
+    found = estimate_vane_offsets(read_instruments(records, columns), records, columns, 80.0,
+                                  FIT_INPUTS).offsets
+    for h, offset in offsets.items():
+        row = found.loc[h]
+        if not offset:
+            assert row["source"] == "reference"
+            continue
+        assert row["records"] >= 200 and 0.0 < row["uncertainty_deg"] < 0.1
+        assert row["offset_deg"] == pytest.approx(offset, abs=3.0 * row["uncertainty_deg"])
+        assert row["systematic_deg"] > 2.0 * row["uncertainty_deg"]
+
+
 def test_cup_pairs_agree_within_their_calibration(instruments):
     pairs = instruments.cup_pairs
     assert list(pairs["height"]) == list(CUP_HEIGHTS)
