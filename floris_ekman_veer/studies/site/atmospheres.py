@@ -43,7 +43,8 @@ class SiteSummary:
         class_by_hour: fitted records per hour of day (rows 0-23) and class (None when the
             records' names are no time stamps).
         offsets: the vane offsets applied [deg] (reading minus true direction, relative to the
-            reference vane), their standard errors, the records they come from, and the source.
+            reference vane), their standard errors (statistical) and the reference turning's
+            systematic uncertainty (offsets.py), the records they come from, and the source.
         cup_pairs: each redundant cup pair's median ratio where neither is in the mast's wake,
             its standard error and whether the pair disagrees.
         flags: the instruments' values removed, per kind and column: the count, the first time
