@@ -192,8 +192,8 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     instruments = read_instruments(records, columns, booms=booms,
                                    direction_offsets=direction_offsets,
                                    shadow_half_width=shadow_half_width, labels=labels)
-    # 3. the neutral baseline and the vane offsets (whose reference turning is the model's
-    # neutral one at the site's roughness)
+    # 3. the neutral baseline and the vane offsets (whose reference turning is the neutral
+    # surface layer's, the model's state at the site's roughness giving its depth: offsets.py)
     # (a height's speed is its cups' mean: its calibration uncertainty, relative, is theirs
     # combined over their number)
     per_height = calibrations.groupby("height")["uncertainty"].agg(
