@@ -24,9 +24,9 @@ turbine yawed uniformly in [-20, 20] deg). Contenders:
                      (3 x 3 points), partial wakes at the rotor points, numpy engine (one
                      process); foxes centre: the same at the rotor centre ("centre").
 
-The FLORIS models run on the SBL-6 Ekman inflow of ``inputs/farm_sbl6.yaml`` on a 3 x 3 turbine
-grid; PyWake and foxes on a uniform site at the same hub-height wind (their cost does not depend on
-the profile). PyWake's power and thrust curves are FLORIS's NREL 5 MW table; foxes's its own
+The FLORIS models run on the SBL-6 Ekman inflow of ``inputs/farm_sbl6.yaml``, FLORIS's own on its
+3 x 3 turbine grid, M-1 on the input's rotor cells (the shipped 3 x 3); PyWake and foxes on a
+uniform site at the same hub-height wind (their cost does not depend on the profile). PyWake's power and thrust curves are FLORIS's NREL 5 MW table; foxes's its own
 NREL 5 MW table ("NREL5MW").
 
 Timed: one run of each contender (``FlorisModel.run()``; PyWake's call with ``time=True`` and
