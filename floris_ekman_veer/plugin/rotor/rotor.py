@@ -26,6 +26,7 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
+from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
@@ -52,6 +53,12 @@ ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
 #: (FLORIS's count) or where the rotor lies inside the wake radius 2 sigma (Niayifar &
 #: Porte-Agel 2016, docs/coupling.md#wakes-deep-in-an-array).
 TURBULENCE_OVERLAPS = ("wake_velocity", "wake_radius")
+
+#: The velocity models' ``wake_turbulence`` choices: the form of a wake's added turbulence,
+#: FLORIS's turbulence model (Crespo & Hernandez 1996 as FLORIS has it) weighted with the
+#: overlap, or Ishihara & Qian (2018, wake/added_turbulence.py) averaged over the rotor's
+#: sub-points, its radial profile being its own overlap (docs/coupling.md#wakes-deep-in-an-array).
+WAKE_TURBULENCES = ("crespo_hernandez", "ishihara_qian")
 
 #: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
 DEFICIT_VELOCITIES = ("incoming", "free_stream")
@@ -220,7 +227,15 @@ def rotor_cell_deficit(
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell,
         moment[reached][:, None])
-    if track:
+    if track and model.wake_turbulence == "ishihara_qian":
+        added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
+                               rotor, f[reached], j[reached], kind[reached],
+                               hub_height_i[f[reached], 0, 0, 0],
+                               ambient.floris_turbulence, x_i.shape[0])
+        wakes.add_turbulence(f[reached], j[reached], added, np.broadcast_to(
+            ambient.floris_turbulence, (x_i.shape[0], 1, 1, 1))[f[reached], 0, 0, 0],
+            added_rule)
+    elif track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
                         axial_induction_i, overlap[reached], ambient, added_rule)
     return result.reshape(u_initial.shape)
@@ -239,6 +254,28 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
         x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
+
+
+def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
+                   ambient_turbulence, n_findex):
+    """Ishihara & Qian's (2018) added turbulence of turbine i's wake at rotors (f, j), the mean
+    over each rotor's sub-points (the wake's centre at the rows, ``centre``: (pairs, rows)),
+    not below 0 (the ground term lowers it below the hub), within 15 D downstream as FLORIS has
+    Crespo-Hernandez (docs/coupling.md#wakes-deep-in-an-array)."""
+    cells = rotor.cells
+    radius_j = rotor.radius[f, j][:, None, None]
+    lateral = (per_pair["offset"][reached][:, None] - centre)[:, :, None] \
+        + radius_j * cells.sub_y
+    heights = rotor.kind_heights[kind][:, :, None]
+    r = np.hypot(lateral, heights - hub_height[:, None, None])
+    diameter = 2.0 * per_pair["radius"][reached]
+    ambient = np.broadcast_to(ambient_turbulence, (n_findex, 1, 1, 1))[f, 0, 0, 0]
+    column = lambda a: a[:, None, None]  # noqa: E731
+    added = ishihara_qian_added_turbulence(
+        column(x), r, np.broadcast_to(heights, r.shape), column(per_pair["ct"][reached]),
+        column(ambient), column(diameter), column(hub_height))
+    mean = np.einsum("prs,rs->p", added, cells.weight)
+    return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 
 def _check_resolution(x, per_pair, reached, centre, radius_j, cells, warned):

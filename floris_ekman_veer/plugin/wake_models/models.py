@@ -56,6 +56,7 @@ from floris_ekman_veer.plugin.rotor.rotor import (
     ROTOR_PLANE_MARGIN,
     TURBULENCE_OVERLAPS,
     WAKE_EXPANSIONS,
+    WAKE_TURBULENCES,
     WAKE_MODELS,
     RotorWakes,
     TurbineWake,
@@ -120,6 +121,11 @@ class EkmanWakeModel(BaseModel):
     #: Porte-Agel 2016), or "wake_velocity", the area where the wake's velocity exceeds 0.05 m/s
     #: (FLORIS's count) (docs/coupling.md#wakes-deep-in-an-array).
     turbulence_overlap: str = choice_field("wake_radius", TURBULENCE_OVERLAPS)
+    #: The form of a wake's added turbulence (turbine grid): "crespo_hernandez" (the default),
+    #: FLORIS's turbulence model weighted with ``turbulence_overlap``; "ishihara_qian", Ishihara
+    #: & Qian (2018, wake/added_turbulence.py) averaged over the rotor, its ring-shaped profile
+    #: its own overlap (docs/coupling.md#wakes-deep-in-an-array).
+    wake_turbulence: str = choice_field("crespo_hernandez", WAKE_TURBULENCES)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/inflow/shallow.py).

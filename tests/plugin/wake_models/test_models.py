@@ -954,3 +954,46 @@ def test_turbulence_overlap_counts_the_rotor_inside_the_wake_radius(lateral, sam
         np.testing.assert_array_equal(powers["wake_radius"], powers["wake_velocity"])
     else:
         assert powers["wake_radius"][2] < powers["wake_velocity"][2] * (1.0 - 1e-4)
+
+
+def test_ishihara_qian_turbulence_is_its_rotor_average(monkeypatch):
+    """``wake_turbulence: ishihara_qian``: the added turbulence a wake hands a rotor is Ishihara
+    & Qian's (2018) Delta I averaged over the rotor (the cells' sub-points), equal to an
+    independent polar quadrature of the published form computed here; 15 D on, none (FLORIS's
+    cut-off). A single wake is unchanged (turbulence acts on the wake of the rotor it reaches)."""
+    from floris_ekman_veer.plugin.rotor import rotor_wakes
+    from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
+
+    diameter, hub = 126.0, 90.0  # the NREL 5 MW of the farm input
+    added, powers = [], {}
+    original = rotor_wakes.RotorWakes.add_turbulence
+
+    def spy(self, f, j, values, ambient, rule="max"):
+        added.append(dict(zip(j.tolist(), np.asarray(values).tolist())))
+        return original(self, f, j, values, ambient, rule)
+
+    monkeypatch.setattr(rotor_wakes.RotorWakes, "add_turbulence", spy)
+    for form in ("ishihara_qian", "crespo_hernandez"):
+        added.clear()
+        cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+        cfg["farm"]["layout_x"] = [0.0, 5.0 * diameter, 15.0 * diameter]
+        cfg["farm"]["layout_y"] = [0.0, 0.0, 0.0]
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_turbulence"] = form
+        fmodel = FlorisModel(cfg)
+        fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+        fmodel.run()
+        powers[form] = fmodel.get_turbine_powers()[0]
+        if form == "ishihara_qian":
+            ct = fmodel.get_turbine_thrust_coefficients()[0, 0]
+            first = added[0]
+    n = 400
+    r = (np.arange(n) + 0.5) / n * 0.5 * diameter
+    theta = (np.arange(n) + 0.5) * 2.0 * np.pi / n
+    r, theta = np.meshgrid(r, theta)
+    z = hub + r * np.sin(theta)
+    point = ishihara_qian_added_turbulence(5.0 * diameter, r, z, ct, 0.06, diameter, hub)
+    assert first[1] == pytest.approx(np.sum(point * r) / np.sum(r), rel=2e-3)
+    assert first[1] > 0.05
+    assert first[2] == 0.0
+    np.testing.assert_array_equal(powers["ishihara_qian"][:2], powers["crespo_hernandez"][:2])
+    assert powers["ishihara_qian"][2] != powers["crespo_hernandez"][2]
