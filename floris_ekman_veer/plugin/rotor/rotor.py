@@ -16,6 +16,7 @@ import warnings
 import attrs
 import numpy as np
 
+from floris_ekman_veer.plugin.rotor.convection import removed_moments
 from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
@@ -213,6 +214,16 @@ def rotor_cell_deficit(
         per_pair["overlap_edge"] = np.exp(-2.0) * model.centre_deficit(
             x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
         ) * per_pair["hub_speed"] * per_pair["speed_fraction"]
+    convecting = wakes.convection is not None
+    if convecting:
+        # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
+        # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
+        centre_speed = model.centre_deficit(
+            x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
+        ) * per_pair["velocity_scale"]
+        wake_convection = per_pair["velocity_scale"] - 0.5 * centre_speed
+        per_pair["velocity_scale"] = per_pair["velocity_scale"] * wake_convection
+        per_pair["overlap_edge"] = per_pair["overlap_edge"] * wake_convection
     columns = lambda table, names: np.stack(  # noqa: E731
         [np.broadcast_to(table[k], f.shape) for k in names], axis=1)
     removed, overlap, reached, centre = integrate_wake(
@@ -221,6 +232,11 @@ def rotor_cell_deficit(
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape)
+    if convecting:
+        removed = _momentum_conserving(
+            wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
+            np.broadcast_to(table["kx"] + table["xi0"], f.shape), centre_speed,
+            wake_convection)
     _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
                       rotor.radius[f, j][reached, None], cells, rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
@@ -254,6 +270,49 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
         x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
+
+
+#: A wake joins a rotor's combined convection velocity where its deficit on the rotor exceeds
+#: this fraction of U_0 (PyWake's WeightedSum: weaker wakes add linearly); Zong & Porte-Agel's
+#: U_c is that of the wakes that overlap there.
+CONVECTION_THRESHOLD = 0.01
+
+
+def _momentum_conserving(wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair,
+                         y_i, hub_height_i, width, centre_speed, wake_convection):
+    """The cells' removed moment (pairs, n^2), as the kernel returns it, of the rotors reached by
+    turbine i's wake after Zong & Porte-Agel's superposition (plugin/rotor/convection.py): the
+    wake's Gaussian equivalent (centre deficit, width k_w x + xi0 of the kernel's table, centre
+    at the rows' mean) joins the rotor's where its deficit on the rotor exceeds
+    CONVECTION_THRESHOLD U_0, U_c is updated and the whole rotor's moment recomputed, less what
+    the cells already removed."""
+    pick = lambda a: np.broadcast_to(a, flat.shape)[reached]  # noqa: E731
+    pairs = flat[reached]
+    f, j, kind = f[reached], j[reached], kind[reached]
+    hub_speed, width = pick(per_pair["hub_speed"]), pick(width)
+    centre_speed, wake_convection = pick(centre_speed), pick(wake_convection)
+    centre_y = y_i[f, 0, 0, 0] + centre[reached].mean(axis=1)
+    centre_z = hub_height_i[f, 0, 0, 0]
+    # The rotor's nearest sub-point row to the wake's centre line (veer shears it row by row).
+    radius_j = rotor.radius[f, j][:, None]
+    lateral = np.maximum(np.abs(pick(per_pair["offset"])[:, None] - centre[reached])
+                         - radius_j * wakes.cells.row_chord, 0.0)
+    gap_squared = np.min(lateral**2 + (rotor.kind_heights[kind] - centre_z[:, None]) ** 2,
+                         axis=1)
+    joins = (centre_speed * np.exp(-gap_squared / (2.0 * width**2))
+             > CONVECTION_THRESHOLD * hub_speed)
+    state = wakes.convection
+    state.add(pairs[joins], (wake_convection * centre_speed)[joins], width[joins] ** 2,
+              centre_y[joins], centre_z[joins], hub_speed[joins])
+    # A rotor no wake has joined yet: its wakes add linearly (weight 1 for this one).
+    convection = np.where(state.count[pairs] > 0, state.velocity[pairs], wake_convection)
+    u, v = rotor.kind_u[f, kind], rotor.kind_v[f, kind]
+    flowing = u * pick(per_pair["cos"])[:, None] + v * pick(per_pair["sin"])[:, None] > 0.0
+    total = removed_moments(wakes.cells, wakes.combined, pairs, convection,
+                            np.where(flowing, u, 0.0), moment[reached])
+    removed = np.zeros((flat.size, wakes.cells.n**2))
+    removed[reached] = total - wakes.removed[pairs] / wakes.cells.n**2
+    return removed
 
 
 def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,

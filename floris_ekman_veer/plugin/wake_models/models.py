@@ -63,6 +63,7 @@ from floris_ekman_veer.plugin.rotor.rotor import (
     rotor_cell_deficit,
 )
 from floris_ekman_veer.plugin.inflow.shallow import POLICIES as SHALLOW_POLICIES
+from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_SUPERPOSITIONS
 from floris_ekman_veer.plugin.rotor.turbine_states import handed as handed_turbine_states
 from floris_ekman_veer.plugin.wake_models.wake_inputs import (
     GLAUERT_THRUST_COEFFICIENT,
@@ -126,6 +127,11 @@ class EkmanWakeModel(BaseModel):
     #: & Qian (2018, wake/added_turbulence.py) averaged over the rotor, its ring-shaped profile
     #: its own overlap (docs/coupling.md#wakes-deep-in-an-array).
     wake_turbulence: str = choice_field("crespo_hernandez", WAKE_TURBULENCES)
+    #: How the wakes superpose at the rotor cells' sub-points (turbine grid):
+    #: "combination_model" (the default), FLORIS's combination model point-wise;
+    #: "momentum_conserving", Zong & Porte-Agel (2020, plugin/rotor/convection.py), with
+    #: FLORIS's combination ``fls`` (docs/coupling.md#wakes-deep-in-an-array).
+    wake_superposition: str = choice_field("combination_model", WAKE_SUPERPOSITIONS)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/inflow/shallow.py).
@@ -176,7 +182,7 @@ class EkmanWakeModel(BaseModel):
             if wake_models is not None and wake_models.velocity_model is not self:
                 wake_models = None
             wakes = RotorWakes.start(ambient.rotor.cells, *ambient.rotor.x.shape, wake_models,
-                                     ambient.floris_turbulence)
+                                     ambient.floris_turbulence, self.wake_superposition)
         return {
             "x": grid.x_sorted,
             "y": grid.y_sorted,

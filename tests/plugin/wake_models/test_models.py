@@ -997,3 +997,32 @@ def test_ishihara_qian_turbulence_is_its_rotor_average(monkeypatch):
     assert first[2] == 0.0
     np.testing.assert_array_equal(powers["ishihara_qian"][:2], powers["crespo_hernandez"][:2])
     assert powers["ishihara_qian"][2] != powers["crespo_hernandez"][2]
+
+
+def test_momentum_conserving_superposition_on_the_rotor_cells():
+    """``wake_superposition: momentum_conserving`` (Zong & Porte-Agel 2020): one wake behind an
+    unwaked rotor has weight 1, so the second turbine's power is the summed wakes' (to the
+    single-precision sub-point sum, 1e-7); behind two aligned wakes the second, shed by a waked
+    rotor (incoming speed about 0.7 U_0), convects slower than the combined wake, weighs less
+    than 1 and dominates at the third turbine, which gets more than the plain sum gives;
+    FLORIS's sosfs cannot carry it (ValueError naming fls)."""
+    diameter = 126.0
+    powers = {}
+    for superposition in ("combination_model", "momentum_conserving"):
+        cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+        cfg["farm"]["layout_x"] = [0.0, 5.0 * diameter, 10.0 * diameter]
+        cfg["farm"]["layout_y"] = [0.0, 0.0, 0.0]
+        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_superposition"] = superposition
+        fmodel = FlorisModel(cfg)
+        fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+        fmodel.run()
+        powers[superposition] = fmodel.get_turbine_powers()[0]
+    summed, conserving = powers["combination_model"], powers["momentum_conserving"]
+    assert conserving[0] == summed[0]
+    assert conserving[1] == pytest.approx(summed[1], rel=1e-7)
+    assert conserving[2] > summed[2] * (1.0 + 0.02)
+    cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["deficit_velocity"] = "free_stream"
+    fmodel = FlorisModel(cfg)
+    with pytest.raises(ValueError, match="combination_model: fls"):
+        fmodel.run()
