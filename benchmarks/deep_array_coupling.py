@@ -21,9 +21,10 @@ time (docs/coupling.md#wakes-deep-in-an-array):
                       2018, ``wake_turbulence: ishihara_qian``), its ring-shaped profile
                       averaged over the rotor (its own overlap: the overlap column is "-");
     deficit scale     "free stream" (FLORIS's gauss) or "incoming" (Niayifar & Porte-Agel 2016);
-    superposition     "sosfs" (squares summed), "fls" (summed) or "zong" (Zong & Porte-Agel's
+    superposition     "sosfs" (squares summed), "fls" (summed), "zong" (Zong & Porte-Agel's
                       2020 momentum-conserving weights on the sum, ``wake_superposition:
-                      momentum_conserving``).
+                      momentum_conserving``) or "cumulative" (Bastankhah et al.'s 2021
+                      cumulative wake, summed: ``wake_superposition: cumulative``).
 
 Prints the RMSE (bias) of the direction-averaged P_i/P_1 over the waked positions (Horns Rev,
 Lillgrund) and of Horns Rev's farm efficiency against the LES. Takes about 5 minutes.
@@ -70,6 +71,12 @@ COUPLINGS = (
     ("quadrature", "velocity", "1996-", "incoming", "zong"),
     ("quadrature", "-", "Ishihara-Qian", "incoming", "zong"),
     ("max", "radius", "FLORIS", "incoming", "zong"),
+    ("max", "radius", "1996-", "incoming", "zong"),
+    ("max", "velocity", "FLORIS", "incoming", "zong"),
+    ("quadrature", "radius", "FLORIS", "incoming", "cumulative"),
+    ("max", "radius", "FLORIS", "incoming", "cumulative"),
+    ("quadrature", "radius", "1996-", "incoming", "cumulative"),
+    ("quadrature", "-", "Ishihara-Qian", "incoming", "cumulative"),
 )
 
 
@@ -83,10 +90,12 @@ def setup(turbulence: str, overlap: str, constants: str, scale: str, superpositi
     else:
         velocity["turbulence_overlap"] = OVERLAP[overlap]
         crespo_hernandez = CRESPO_HERNANDEZ[constants]
-    if superposition == "zong":
-        velocity["wake_superposition"] = "momentum_conserving"
+    if superposition in ("zong", "cumulative"):
+        velocity["wake_superposition"] = ("momentum_conserving" if superposition == "zong"
+                                          else superposition)
+    summed = superposition in ("zong", "cumulative")
     return (f"{turbulence}, {overlap}, {constants}, {scale}, {superposition}",
-            ({**strings, "combination_model": "fls" if superposition == "zong" else superposition},
+            ({**strings, "combination_model": "fls" if summed else superposition},
              gch,
              {**parameters, "velocity": velocity,
               "turbulence": {"crespo_hernandez": crespo_hernandez}}))

@@ -1,6 +1,6 @@
-"""The momentum-conserving superposition of wakes of Zong & Porte-Agel (2020): the farm coupling's
-alternative to summing the deficits (docs/coupling.md#wakes-deep-in-an-array). Beyond the paper,
-which models one wake.
+"""Two published alternatives to summing the wakes' deficits in a farm: the momentum-conserving
+superposition of Zong & Porte-Agel (2020) and the cumulative wake of Bastankhah et al. (2021)
+(docs/coupling.md#wakes-deep-in-an-array). Beyond the paper, which models one wake.
 
 Zong & Porte-Agel (2020, J. Fluid Mech. 889, A8, "A momentum-conserving wake superposition method
 for wind farm power prediction", their Section 2) weight each wake's deficit u_i with the
@@ -19,7 +19,20 @@ int g^2 dA / int g dA = 1/2). For the combined wake the plane integrals of the G
 G_ij = int g_i g_j dA (:func:`gaussian_product_integral`), a quadratic whose root near U_0,
 (U_0 + sqrt(U_0^2 - 4 Q)) / 2, is the fixed point Zong & Porte-Agel iterate to
 (:func:`convection_velocity`). One wake behind an unwaked rotor (U_in = U_0) gets U_c = U_c,1:
-weight 1, the wake unchanged. Pure numpy.
+weight 1, the wake unchanged.
+
+Bastankhah, Welch, Martinez-Tossas, King & Fleming (2021, J. Fluid Mech. 911, A53, "Analytical
+solution for the cumulative wake of wind turbines in wind farms", their Eqs. 4.9-4.10) instead
+give each wake n the centre deficit that carries its rotor's thrust through the wakes already
+there: with the upstream wakes' centre deficits C_i at the same x,
+
+    C_n = a - sqrt(a^2 - C_T U_n^2 D^2 / (8 sigma_n^2)),   a = U_0 - sum_i lambda_ni C_i,
+    lambda_ni = 2 sigma_i^2 / (sigma_n^2 + sigma_i^2) exp(-d_ni^2 / (2 (sigma_n^2 + sigma_i^2))),
+
+U_n the rotor's incoming speed, the deficits then summed (:func:`cumulative_deficit`; the factor
+2 of Eq. 4.9 as PyWake's CumulativeWakeSum takes it, FLORIS's cc uses 1). The model's own
+single-wake momentum term K = C_T D^2 / (8 sigma^2) is taken from its C(x) (K = 1 - (1 - C)^2), so
+that without upstream wakes and U_n = U_0 the wake is the model's. Pure numpy.
 """
 
 from __future__ import annotations
@@ -48,3 +61,22 @@ def convection_velocity(ambient_speed, momentum_ratio):
     (4 Q > U_0^2, wakes that stop the flow) U_c = U_0 / 2, the root's limit."""
     return 0.5 * (ambient_speed
                   + np.sqrt(np.maximum(ambient_speed**2 - 4.0 * momentum_ratio, 0.0)))
+
+
+def overlap_weight(sigma_squared_new, sigma_squared_old, distance_squared):
+    """lambda_ni of Bastankhah et al. (2021, Eq. 4.9, the module docstring): the share of an
+    upstream wake i's centre deficit that wake n's momentum balance meets."""
+    total = sigma_squared_new + sigma_squared_old
+    return 2.0 * sigma_squared_old / total * np.exp(-distance_squared / (2.0 * total))
+
+
+def cumulative_deficit(single_deficit, ambient_speed, incoming_speed, upstream, core_deficit):
+    """C_n [m/s] of Bastankhah et al. (2021, Eq. 4.10, the module docstring): ``single_deficit``
+    the model's C(x) / U_h of the wake alone, ``ambient_speed`` U_0, ``incoming_speed`` U_n,
+    ``upstream`` sum_i lambda_ni C_i [m/s]; where the root is not real, or beyond it, the
+    potential core's ``core_deficit`` [m/s] (2a U_n), as PyWake's CumulativeWakeSum bounds it."""
+    momentum = 1.0 - (1.0 - single_deficit) ** 2
+    a = ambient_speed - upstream
+    root = a**2 - momentum * incoming_speed**2
+    deficit = a - np.sqrt(np.maximum(root, 0.0))
+    return np.where((root > 0.0) & (deficit <= core_deficit), deficit, core_deficit)

@@ -70,3 +70,21 @@ def test_convection_velocity_is_its_definition():
                   for incoming, c, sigma, centre in wakes)
     by_definition = np.sum((8.0 - deficit) * deficit) / np.sum(deficit)
     assert u_c == pytest.approx(by_definition, rel=1e-10)
+
+
+def test_cumulative_wake_by_hand():
+    """Bastankhah et al. (2021, Eqs. 4.9-4.10) with the model's momentum term K = 1 - (1 - C)^2:
+    alone (no upstream wake, U_n = U_0) the wake is the model's, C_n = U_0 C; behind a
+    co-located upstream wake of the same width (lambda = 2 sigma^2 / (2 sigma^2) = 1) with
+    C_1 = 2.4 m/s, U_0 = 8, U_n = 6, C = 0.3: a = 5.6, K = 0.51,
+    C_2 = 5.6 - sqrt(31.36 - 18.36) = 1.9945 m/s; no real root gives the core's 2a U_n."""
+    from floris_ekman_veer.wake.superposition import cumulative_deficit, overlap_weight
+
+    assert cumulative_deficit(0.3, 8.0, 8.0, 0.0, 5.0) == pytest.approx(2.4, rel=1e-14)
+    assert overlap_weight(2500.0, 2500.0, 0.0) == 1.0
+    assert overlap_weight(2500.0, 900.0, 40.0**2) == pytest.approx(
+        2 * 900.0 / 3400.0 * math.exp(-1600.0 / 6800.0), rel=1e-15)
+    assert cumulative_deficit(0.3, 8.0, 6.0, 2.4, 5.0) == pytest.approx(
+        5.6 - math.sqrt(13.0), rel=1e-14)
+    assert cumulative_deficit(0.3, 8.0, 6.0, 6.0, 2.9) == 2.9  # a^2 < K U_n^2
+    assert cumulative_deficit(0.6, 8.0, 8.0, 0.0, 4.0) == 4.0  # beyond the core's 2a U_n

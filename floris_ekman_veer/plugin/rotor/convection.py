@@ -1,6 +1,9 @@
-"""The wakes' convection velocities at each rotor during one solve, for the momentum-conserving
-superposition of Zong & Porte-Agel (2020) on the rotor cells (``wake_superposition:
-momentum_conserving``, wake/superposition.py, docs/coupling.md#wakes-deep-in-an-array).
+"""The wakes kept at each rotor during one solve, for the momentum-conserving superposition of
+Zong & Porte-Agel (2020) and the cumulative wake of Bastankhah et al. (2021) on the rotor cells
+(``wake_superposition: momentum_conserving`` or ``cumulative``, wake/superposition.py,
+docs/coupling.md#wakes-deep-in-an-array). For the cumulative wake each rotor keeps the upstream
+wakes' centre deficits C_i, widths and centres at its plane, and a new wake's C_n follows from
+their overlap with it (``upstream``); its deficits are then summed (FLORIS's ``fls``).
 
 The rotor cells superpose wakes point-wise at their sub-points (plugin/rotor/rotor_wakes.py);
 Zong & Porte-Agel's weights U_c,i / U_c need the combined wake's convection velocity U_c, a
@@ -21,6 +24,7 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells
 from floris_ekman_veer.wake.superposition import (
     convection_velocity,
     gaussian_product_integral,
+    overlap_weight,
 )
 
 
@@ -57,14 +61,28 @@ class WakeConvection:
         self.momentum[pair] += strength * (
             strength * np.pi * width_squared + 2.0 * np.sum(cross, axis=1))
         self.deficit[pair] += strength * 2.0 * np.pi * width_squared
+        self.keep(pair, strength, width_squared, centre_y, centre_z)
+        self.velocity[pair] = convection_velocity(
+            ambient_speed, self.momentum[pair] / self.deficit[pair])
+        return self.velocity[pair]
+
+    def upstream(self, pair, width_squared, centre_y, centre_z):
+        """sum_i lambda_ni C_i [m/s] at rotors ``pair`` of a new wake (sigma_n^2, centre) over the
+        wakes kept there (Bastankhah et al. 2021; ``strength`` holds their C_i)."""
+        old = np.arange(self.strength.shape[1]) < self.count[pair][:, None]
+        distance_squared = ((self.centre_y[pair] - centre_y[:, None]) ** 2
+                            + (self.centre_z[pair] - centre_z[:, None]) ** 2)
+        weight = overlap_weight(width_squared[:, None], self.width_squared[pair],
+                                distance_squared)
+        return np.sum(np.where(old, weight * self.strength[pair], 0.0), axis=1)
+
+    def keep(self, pair, strength, width_squared, centre_y, centre_z):
+        """Keep one wake (its C_i or s_i, sigma^2, centre) at rotors ``pair`` (each once)."""
         slot = self.count[pair]
         for table, value in ((self.strength, strength), (self.width_squared, width_squared),
                              (self.centre_y, centre_y), (self.centre_z, centre_z)):
             table[pair, slot] = value
         self.count[pair] += 1
-        self.velocity[pair] = convection_velocity(
-            ambient_speed, self.momentum[pair] / self.deficit[pair])
-        return self.velocity[pair]
 
 
 def removed_moments(cells: RotorCells, combined, pair, convection, ambient_u, moment):

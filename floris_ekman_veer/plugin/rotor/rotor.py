@@ -28,7 +28,8 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
-from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
+from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -123,7 +124,10 @@ def rotor_cell_deficit(
     added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
     track = (added_rule is not None and wakes.rule is not None
              and wakes.turbulence_model is not None)
-    incoming = model.deficit_velocity == "incoming" and wakes.rule is not None
+    cumulative = wakes.superposition == "cumulative"
+    # The cumulative wake's thrust needs turbine i's incoming speed whatever the deficit's scale.
+    incoming = ((model.deficit_velocity == "incoming" or cumulative)
+                and wakes.rule is not None)
     if track or incoming:
         # Turbine i among the rotors, per condition.
         source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
@@ -214,7 +218,24 @@ def rotor_cell_deficit(
         per_pair["overlap_edge"] = np.exp(-2.0) * model.centre_deficit(
             x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
         ) * per_pair["hub_speed"] * per_pair["speed_fraction"]
-    convecting = wakes.convection is not None
+    convecting = wakes.superposition == "momentum_conserving"
+    if cumulative:
+        # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
+        # wakes kept at each rotor (plugin/rotor/convection.py); the kernel's deficit is the
+        # model's shape scaled to it, and the wakes are summed.
+        single = model.centre_deficit(x_pair,
+                                      *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
+        width_squared = np.broadcast_to(table["kx"] + table["xi0"], f.shape) ** 2
+        centre_y = y_i[f, 0, 0, 0] + np.mean(deflection_field_i[f, j], axis=(1, 2))
+        centre_z = hub_height_i[f, 0, 0, 0]
+        incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
+        deficit = cumulative_deficit(
+            single, per_pair["hub_speed"], incoming_speed,
+            wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
+            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
+        per_pair["velocity_scale"] = deficit / np.where(single > 0.0, single, 1.0)
+        if track and model.turbulence_overlap == "wake_radius":
+            per_pair["overlap_edge"] = np.exp(-2.0) * deficit
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
@@ -232,6 +253,9 @@ def rotor_cell_deficit(
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape)
+    if cumulative:
+        wakes.convection.keep(flat[reached], deficit[reached], width_squared[reached],
+                              centre_y[reached], centre_z[reached])
     if convecting:
         removed = _momentum_conserving(
             wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,

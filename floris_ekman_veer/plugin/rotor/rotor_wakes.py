@@ -53,8 +53,9 @@ RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3, "momentum_conserving": 4}
 
 #: The velocity models' ``wake_superposition`` choices: FLORIS's combination model point-wise
 #: at the sub-points, or Zong & Porte-Agel's (2020) momentum-conserving weights, on FLORIS's
-#: ``fls`` (plugin/rotor/convection.py, docs/coupling.md#wakes-deep-in-an-array).
-WAKE_SUPERPOSITIONS = ("combination_model", "momentum_conserving")
+#: ``fls``, or Bastankhah et al.'s (2021) cumulative wake, summed by ``fls``
+#: (plugin/rotor/convection.py, docs/coupling.md#wakes-deep-in-an-array).
+WAKE_SUPERPOSITIONS = ("combination_model", "momentum_conserving", "cumulative")
 
 #: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
 #: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
@@ -132,8 +133,9 @@ class RotorWakes:
         turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
             ambient one.
         turbulence_model: FLORIS's wake-added turbulence model, or None.
-        convection: the wakes' convection velocities at each rotor (rule
-            "momentum_conserving"), or None.
+        convection: the wakes kept at each rotor (``superposition`` "momentum_conserving"
+            or "cumulative"), or None.
+        superposition: the velocity model's ``wake_superposition``.
     """
 
     cells: RotorCells
@@ -144,6 +146,7 @@ class RotorWakes:
     turbulence: np.ndarray
     turbulence_model: object = None
     convection: WakeConvection | None = None
+    superposition: str = "combination_model"
 
     @classmethod
     def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,
@@ -157,13 +160,14 @@ class RotorWakes:
             turbulence_model = wake_models.turbulence_model
         pairs = n_findex * n_turbines
         convection = None
-        if superposition == "momentum_conserving" and rule is not None:
+        if superposition != "combination_model" and rule is not None:
             if rule != "fls":
                 raise ValueError(
-                    "wake_superposition: momentum_conserving returns the rotors' wakes as "
+                    f"wake_superposition: {superposition} returns the rotors' wakes as "
                     "increments of a sum: it needs wake.model_strings.combination_model: fls, "
                     f"got {rule!r} (docs/coupling.md#wakes-deep-in-an-array)")
-            rule = "momentum_conserving"
+            if superposition == "momentum_conserving":
+                rule = "momentum_conserving"
             convection = WakeConvection.start(pairs, n_turbines)
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
@@ -172,7 +176,8 @@ class RotorWakes:
         turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
                                      (n_findex, n_turbines)).copy()
         return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
-                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model, convection)
+                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model, convection,
+                   superposition if convection is not None else "combination_model")
 
     @property
     def rule_code(self) -> int:
