@@ -31,9 +31,10 @@ from floris_ekman_veer.wake.superposition import (
 @attrs.define(eq=False)
 class WakeConvection:
     """Per rotor (flat index condition * n_turbines + turbine): the wakes that reached it,
-    (pairs, n_turbines) s_i = U_c,i u_c,i [m^2/s^2], sigma_i^2 [m^2] and centre (y, z) [m] at
-    the rotor's plane, their count, the sums sum_ij s_i s_j G_ij and sum_i s_i 2 pi sigma_i^2,
-    and U_c [m/s] (wake/superposition.py)."""
+    (pairs, n_turbines, points) their s_i = U_c,i u_c,i [m^2/s^2] (Zong & Porte-Agel, one point)
+    or C_i [m/s] (Bastankhah et al., at each of the rotor's grid points), sigma_i^2 [m^2] and
+    centre (y, z) [m] at the rotor's plane, their count, and for Zong & Porte-Agel the sums
+    sum_ij s_i s_j G_ij and sum_i s_i 2 pi sigma_i^2 and U_c [m/s] (wake/superposition.py)."""
 
     strength: np.ndarray
     width_squared: np.ndarray
@@ -45,8 +46,8 @@ class WakeConvection:
     velocity: np.ndarray
 
     @classmethod
-    def start(cls, pairs: int, n_turbines: int) -> WakeConvection:
-        table = lambda: np.zeros((pairs, n_turbines))  # noqa: E731
+    def start(cls, pairs: int, n_turbines: int, points: int = 1) -> WakeConvection:
+        table = lambda: np.zeros((pairs, n_turbines, points))  # noqa: E731
         return cls(table(), table(), table(), table(), np.zeros(pairs, dtype=int),
                    np.zeros(pairs), np.zeros(pairs), np.zeros(pairs))
 
@@ -54,22 +55,24 @@ class WakeConvection:
         """One wake at rotors ``pair`` (flat indices, each once): its s = U_c,i u_c,i,
         sigma^2 and centre; ``ambient_speed`` U_0. Returns (pairs,) the combined wake's U_c."""
         old = np.arange(self.strength.shape[1]) < self.count[pair][:, None]
-        distance_squared = ((self.centre_y[pair] - centre_y[:, None]) ** 2
-                            + (self.centre_z[pair] - centre_z[:, None]) ** 2)
-        cross = np.where(old, self.strength[pair] * gaussian_product_integral(
-            self.width_squared[pair], width_squared[:, None], distance_squared), 0.0)
+        distance_squared = ((self.centre_y[pair, :, 0] - centre_y[:, None]) ** 2
+                            + (self.centre_z[pair, :, 0] - centre_z[:, None]) ** 2)
+        cross = np.where(old, self.strength[pair, :, 0] * gaussian_product_integral(
+            self.width_squared[pair, :, 0], width_squared[:, None], distance_squared), 0.0)
         self.momentum[pair] += strength * (
             strength * np.pi * width_squared + 2.0 * np.sum(cross, axis=1))
         self.deficit[pair] += strength * 2.0 * np.pi * width_squared
-        self.keep(pair, strength, width_squared, centre_y, centre_z)
+        self.keep(pair, *(np.asarray(v)[:, None]
+                          for v in (strength, width_squared, centre_y, centre_z)))
         self.velocity[pair] = convection_velocity(
             ambient_speed, self.momentum[pair] / self.deficit[pair])
         return self.velocity[pair]
 
     def upstream(self, pair, width_squared, centre_y, centre_z):
-        """sum_i lambda_ni C_i [m/s] at rotors ``pair`` of a new wake (sigma_n^2, centre) over the
-        wakes kept there (Bastankhah et al. 2021; ``strength`` holds their C_i)."""
-        old = np.arange(self.strength.shape[1]) < self.count[pair][:, None]
+        """sum_i lambda_ni C_i [m/s] at rotors ``pair`` of a new wake (sigma_n^2 and centre,
+        (pairs, points)) over the wakes kept there, at each point (Bastankhah et al. 2021;
+        ``strength`` holds their C_i)."""
+        old = (np.arange(self.strength.shape[1]) < self.count[pair][:, None])[:, :, None]
         distance_squared = ((self.centre_y[pair] - centre_y[:, None]) ** 2
                             + (self.centre_z[pair] - centre_z[:, None]) ** 2)
         weight = overlap_weight(width_squared[:, None], self.width_squared[pair],
@@ -77,7 +80,8 @@ class WakeConvection:
         return np.sum(np.where(old, weight * self.strength[pair], 0.0), axis=1)
 
     def keep(self, pair, strength, width_squared, centre_y, centre_z):
-        """Keep one wake (its C_i or s_i, sigma^2, centre) at rotors ``pair`` (each once)."""
+        """Keep one wake (its C_i or s_i, sigma^2, centre; (pairs, points)) at rotors
+        ``pair`` (each once)."""
         slot = self.count[pair]
         for table, value in ((self.strength, strength), (self.width_squared, width_squared),
                              (self.centre_y, centre_y), (self.centre_z, centre_z)):

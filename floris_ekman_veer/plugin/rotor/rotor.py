@@ -221,21 +221,22 @@ def rotor_cell_deficit(
     convecting = wakes.superposition == "momentum_conserving"
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
-        # wakes kept at each rotor (plugin/rotor/convection.py); the kernel's deficit is the
-        # model's shape scaled to it, and the wakes are summed.
+        # wakes kept at each rotor (plugin/rotor/convection.py), at each of its grid points (the
+        # veer-sheared centres differ with height, as on FLORIS's other grids); the kernel's
+        # deficit is the model's shape scaled to the rotor's mean C_n, and the wakes are summed.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
-        width_squared = np.broadcast_to(table["kx"] + table["xi0"], f.shape) ** 2
-        centre_y = y_i[f, 0, 0, 0] + np.mean(deflection_field_i[f, j], axis=(1, 2))
-        centre_z = hub_height_i[f, 0, 0, 0]
-        incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
+        width_squared = np.broadcast_to(table["kx"] + table["xi0"], f.shape)[:, None] ** 2
+        centre_y = y_i[f, 0, 0, 0][:, None] + deflection_field_i[f, j].reshape(f.size, -1)
+        centre_z = np.broadcast_to(hub_height_i[f, 0, 0, 0][:, None], centre_y.shape)
+        incoming_speed = (per_pair["hub_speed"] * per_pair["speed_fraction"])[:, None]
         deficit = cumulative_deficit(
-            single, per_pair["hub_speed"], incoming_speed,
+            single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
             wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
-            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
-        per_pair["velocity_scale"] = deficit / np.where(single > 0.0, single, 1.0)
+            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
+        per_pair["velocity_scale"] = deficit.mean(axis=1) / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
-            per_pair["overlap_edge"] = np.exp(-2.0) * deficit
+            per_pair["overlap_edge"] = np.exp(-2.0) * deficit.mean(axis=1)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
@@ -254,7 +255,8 @@ def rotor_cell_deficit(
     if reached.size == 0:
         return result.reshape(u_initial.shape)
     if cumulative:
-        wakes.convection.keep(flat[reached], deficit[reached], width_squared[reached],
+        wakes.convection.keep(flat[reached], deficit[reached],
+                              np.broadcast_to(width_squared, deficit.shape)[reached],
                               centre_y[reached], centre_z[reached])
     if convecting:
         removed = _momentum_conserving(

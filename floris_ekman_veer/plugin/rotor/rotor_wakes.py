@@ -160,15 +160,19 @@ class RotorWakes:
             turbulence_model = wake_models.turbulence_model
         pairs = n_findex * n_turbines
         convection = None
-        if superposition != "combination_model" and rule is not None:
-            if rule != "fls":
-                raise ValueError(
-                    f"wake_superposition: {superposition} returns the rotors' wakes as "
-                    "increments of a sum: it needs wake.model_strings.combination_model: fls, "
-                    f"got {rule!r} (docs/coupling.md#wakes-deep-in-an-array)")
+        if superposition == "momentum_conserving" and rule not in (None, "fls"):
+            raise ValueError(
+                "wake_superposition: momentum_conserving returns the rotors' wakes as "
+                "increments of a sum: it needs wake.model_strings.combination_model: fls, "
+                f"got {rule!r} (docs/coupling.md#wakes-deep-in-an-array)")
+        if superposition != "combination_model" and rule == "fls":
+            # (The cumulative wake is summed; with another combination, each wake is combined
+            # by it alone, as input_checks.warn_deficit_superposition says.)
             if superposition == "momentum_conserving":
                 rule = "momentum_conserving"
-            convection = WakeConvection.start(pairs, n_turbines)
+            # (the cumulative wake keeps its upstream wakes at each grid point of a rotor)
+            convection = WakeConvection.start(
+                pairs, n_turbines, cells.n**2 if superposition == "cumulative" else 1)
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
         combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),
