@@ -956,6 +956,19 @@ def test_turbulence_overlap_counts_the_rotor_inside_the_wake_radius(lateral, sam
         assert powers["wake_radius"][2] < powers["wake_velocity"][2] * (1.0 - 1e-4)
 
 
+def _neutral_row(spacings, **velocity_settings):
+    """farm_sbl6's NREL 5 MW along the wind at ``spacings`` [D] in a neutral ABL without veer,
+    at 8 m/s, with ``velocity_settings`` in the ekman_veer block; run."""
+    cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+    cfg["farm"]["layout_x"] = [126.0 * s for s in spacings]
+    cfg["farm"]["layout_y"] = [0.0] * len(spacings)
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(velocity_settings)
+    fmodel = FlorisModel(cfg)
+    fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+    fmodel.run()
+    return fmodel
+
+
 def test_ishihara_qian_turbulence_is_its_rotor_average(monkeypatch):
     """``wake_turbulence: ishihara_qian``: the added turbulence a wake hands a rotor is Ishihara
     & Qian's (2018) Delta I averaged over the rotor (the cells' sub-points), equal to an
@@ -975,13 +988,7 @@ def test_ishihara_qian_turbulence_is_its_rotor_average(monkeypatch):
     monkeypatch.setattr(rotor_wakes.RotorWakes, "add_turbulence", spy)
     for form in ("ishihara_qian", "crespo_hernandez"):
         added.clear()
-        cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
-        cfg["farm"]["layout_x"] = [0.0, 5.0 * diameter, 15.0 * diameter]
-        cfg["farm"]["layout_y"] = [0.0, 0.0, 0.0]
-        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_turbulence"] = form
-        fmodel = FlorisModel(cfg)
-        fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
-        fmodel.run()
+        fmodel = _neutral_row((0.0, 5.0, 15.0), wake_turbulence=form)
         powers[form] = fmodel.get_turbine_powers()[0]
         if form == "ishihara_qian":
             ct = fmodel.get_turbine_thrust_coefficients()[0, 0]
@@ -1013,23 +1020,19 @@ def test_published_superpositions_on_the_rotor_cells(superposition):
     C_2 = K U_n^2 / (a + sqrt(a^2 - K U_n^2)) is smaller and the third turbine gets more.
     FLORIS's sosfs cannot carry Zong & Porte-Agel's weights (ValueError naming fls); the
     cumulative wake (the sum of the deficits) then leaves each wake to sosfs alone."""
-    diameter = 126.0
     powers = {}
-    for superposition in ("combination_model", superposition):
-        cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
-        cfg["farm"]["layout_x"] = [0.0, 5.0 * diameter, 10.0 * diameter]
-        cfg["farm"]["layout_y"] = [0.0, 0.0, 0.0]
-        cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_superposition"] = superposition
-        fmodel = FlorisModel(cfg)
-        fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
-        fmodel.run()
-        powers[superposition] = fmodel.get_turbine_powers()[0]
+    for setting in ("combination_model", superposition):
+        fmodel = _neutral_row((0.0, 5.0, 10.0), wake_superposition=setting)
+        powers[setting] = fmodel.get_turbine_powers()[0]
     summed, other = powers["combination_model"], powers[superposition]
     assert other[0] == summed[0]
     assert other[1] == pytest.approx(summed[1], rel=1e-7)
     assert other[2] > summed[2] * (1.0 + 0.02)
+    cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+    cfg["farm"].update(layout_x=[0.0, 630.0, 1260.0], layout_y=[0.0, 0.0, 0.0])
     cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
-    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["deficit_velocity"] = "free_stream"
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        deficit_velocity="free_stream", wake_superposition=superposition)
     fmodel = FlorisModel(cfg)
     if superposition == "momentum_conserving":
         with pytest.raises(ValueError, match="combination_model: fls"):
