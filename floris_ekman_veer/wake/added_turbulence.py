@@ -4,7 +4,7 @@ Crespo-Hernandez form for the farm coupling's wake-added turbulence
 
 Ishihara & Qian (2018, J. Wind Eng. Ind. Aerodyn. 177, 275, "A new Gaussian-based analytical
 wake model for wind turbines considering ambient turbulence intensities and thrust coefficient
-effects", their Eqs. 18-22) fit the added streamwise turbulence intensity behind a rotor of
+effects", their added-turbulence model) fit the added streamwise turbulence intensity behind a rotor of
 diameter D and hub height H, at x downstream and r from the wake axis, to LES and wind-tunnel
 wakes (C_T 0.4-0.9, I_a 0.035-0.137):
 
@@ -28,7 +28,7 @@ import numpy as np
 
 def ishihara_qian_added_turbulence(x, r, z, thrust_coefficient, ambient_turbulence, diameter,
                                    hub_height):
-    """Delta I of Ishihara & Qian (2018, Eqs. 18-22, the module docstring) at x [m] downstream,
+    """Delta I of Ishihara & Qian (2018, the module docstring) at x [m] downstream,
     r [m] from the wake axis, height z [m], behind a rotor of ``diameter`` and ``hub_height``
     [m] with thrust coefficient C_T in an ambient streamwise turbulence intensity I_a
     (arrays broadcast)."""
