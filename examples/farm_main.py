@@ -4,8 +4,8 @@ Run it from anywhere (after ``pip install -e .`` in the repository, or from a ch
 
     python examples/farm_main.py [--output DIR]
 
-It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 stability: f_c =
-1e-4 1/s, z0 = 0.1 m, mu = 148.49, N = 6.1e-3 1/s) and compares, on the SAME Ekman inflow:
+It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 by its surface
+cooling rate: f_c = 1e-4 1/s, z0 = 0.1 m, C_r = -1 K/h, N = 6.1e-3 1/s) and compares, on the SAME Ekman inflow:
 
 * M-1    ``ekman_veer`` velocity + deflection (yaw and veer deflection: the wake is sheared),
 * M-2    the same with the veer deflection off (``wake_deflection_parameters.ekman_veer.veer``),
@@ -154,7 +154,7 @@ def print_abl(farm: Farm, speeds) -> dict:
     k_w = abl.wake_expansion_rate(z_h)
     print(f"Atmosphere (Ekman-surface-layer ABL of {FARM_INPUT.name}): f_c = "
           f"{farm.atmosphere['coriolis_parameter']:g} 1/s, z0 = {farm.atmosphere['roughness_length']:g} m, "
-          f"mu = {farm.atmosphere['stability_parameter']:g}, "
+          f"C_r = {farm.atmosphere['cooling_rate']:g} K/h, "
           f"N = {farm.atmosphere['brunt_vaisala_frequency']:g} 1/s")
     print(f"  rotor layer {z_h - radius:.0f}-{z_h + radius:.0f} m (NREL 5 MW, D = "
           f"{farm.diameter:.0f} m, z_h = {z_h:.0f} m)")

@@ -112,6 +112,11 @@ def yaw_wake_centre(abl, x, z, yaw_deg, ct, radius, hub_height, u_local):
 # Helpers
 
 
+#: The exclusive stability inputs of an atmosphere block (docs/atmosphere.md#input-ranges).
+STABILITY_INPUTS = {"stability_parameter", "cooling_rate", "surface_heat_flux", "sensible_heat_flux",
+                    "obukhov_length"}
+
+
 def config(case, *, veer=None, curl=None, atmosphere=None, **flow_field):
     """An input of inputs/<case>.yaml as a dict, with a few changes."""
     cfg = load_yaml(str(INPUTS / f"{case}.yaml"))
@@ -121,7 +126,11 @@ def config(case, *, veer=None, curl=None, atmosphere=None, **flow_field):
     if curl is not None:
         wake["wake_velocity_parameters"]["ekman_veer"]["curl"] = curl
     if atmosphere is not None:
-        wake["wake_velocity_parameters"]["ekman_veer"]["atmosphere"].update(atmosphere)
+        block = wake["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
+        if STABILITY_INPUTS & set(atmosphere):  # a stability given replaces the input's
+            for key in STABILITY_INPUTS:
+                block.pop(key, None)
+        block.update(atmosphere)
     cfg["flow_field"].update(flow_field)
     return cfg
 
