@@ -21,7 +21,7 @@ gives gauss the rotor-layer veer as FLORIS's ``wind_veer`` (as
 ``floris_ekman_veer.studies.comparison.builtin_inflow_settings`` suggests). It is off by default:
 FLORIS's gauss narrows its initial width by cos(wind_veer) and tilts its ellipse, and with this
 night's ~40 degrees and I_u ~ 0.02 its deficit saturates (u = 0 on part of the waked rotor at
-9 m/s, 81 kW instead of 401 kW for the turbine 7 D behind). It prints the ABL of each
+9 m/s, 107 kW instead of 495 kW for the turbine 7 D behind). It prints the ABL of each
 wind speed, per-turbine and farm powers at 270 deg, farm power over a small wind rose at 9 m/s
 and a yaw-optimisation demo (FLORIS's YawOptimizationSR over -25..25 deg: with veer the optimum
 is not symmetric in the sign of yaw), and writes figures to DIR (default ./output).
