@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from floris import FlorisModel, TimeSeries, WindRose
 from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
-from floris.utilities import load_yaml
 
 from floris_ekman_veer.studies.energy import condition_chunks, energy, energy_results
 from floris_ekman_veer.studies.comparison import builtin_inflow_settings, builtin_model
 from floris_ekman_veer.studies.energy.energy import annual_energy
 from floris_ekman_veer.plugin.inflow.inflow import atmosphere_of, set_atmosphere
+from tests.conftest import table1_sbl6
 
 FARM = Path(__file__).resolve().parents[3] / "inputs" / "farm_sbl6.yaml"
 YAW = dict(minimum_yaw_angle=-20.0, maximum_yaw_angle=20.0, Ny_passes=[5, 4])
@@ -32,11 +32,7 @@ def row():
     Table 1's SBL-6 state mu = 148.49 fixed (the input's stability until issue 39; it now gives
     SBL-6 by its cooling rate, whose layer is below the hub at 8-9 m/s): these tests pin the
     study's machinery and the steering skip on the paper's LES state."""
-    config = load_yaml(str(FARM))
-    atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
-    del atmosphere["cooling_rate"]
-    atmosphere["stability_parameter"] = 148.49
-    fmodel = FlorisModel(config)
+    fmodel = FlorisModel(table1_sbl6(FARM))
     fmodel.set(layout_x=[0.0, 882.0, 1764.0], layout_y=[0.0, 0.0, 0.0])
     return fmodel
 
