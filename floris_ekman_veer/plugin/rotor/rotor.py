@@ -19,14 +19,14 @@ import numpy as np
 from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
-    CENTRE_COLUMNS,
+    CONDITION_COLUMNS,
     PAIR_COLUMNS,
-    WAKE_COLUMNS,
     integrate_wake,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.fused import WAKE_TABLE
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -139,22 +139,22 @@ def rotor_cell_deficit(
         turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
     k_w = model.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                               ambient.floris_turbulence)
-    pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
-    per_pair = {
-        "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
-        "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
-        "speed_fraction": speed_fraction,
-    }
-    per_pair = {k: pick(v) for k, v in per_pair.items()}
+    # Turbine i's quantities, one per condition; the wake's factors per rotor downstream.
+    column = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[:, 0, 0, 0]  # noqa: E731
+    source_wake = {"k_w": k_w, "radius": radius_i, "ct": ct, "yaw": yaw,
+                   "friction_velocity": abl.friction_velocity, "hub_speed": hub_speed}
+    source_wake = {k: column(v) for k, v in source_wake.items()}
     x_pair = dx[f, j]
-    width = model.width_bound(x_pair, per_pair["k_w"], per_pair["radius"], per_pair["ct"],
-                             per_pair["yaw"])
+    # The velocity model's table (plugin/rotor/rotor_kernel.py): the deficit's factors that
+    # depend on the wake only, its width and amplitude bounds and its centre deficit.
+    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+    width = table[:, WAKE_TABLE.index("width_bound")]
     # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
     # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
-    amplitude = model.amplitude_bound(x_pair, per_pair["k_w"], per_pair["radius"],
-                                     per_pair["ct"], per_pair["yaw"])
+    amplitude = table[:, WAKE_TABLE.index("amplitude_bound")]
     reach_squared = 2.0 * width**2 * np.log(
         np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
+    offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
     centre_table = getattr(deflection_field_i, "kernel_table", None)
     if centre_table is not None and cells.n > 1:
         # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
@@ -165,17 +165,17 @@ def rotor_cell_deficit(
         # axis cost more than the comparisons)
         points = deflection_field_i[f, j, 0, :].T
         top, bottom = functools.reduce(np.maximum, points), functools.reduce(np.minimum, points)
-        margin = top - bottom + 0.25 * rotor.radius[f, j]
-        offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
+        radius_j = rotor.radius[f, j]
+        margin = top - bottom + 0.25 * radius_j
         lateral_gap = np.maximum(np.maximum(offset - top, bottom - offset)
-                                 - margin - rotor.radius[f, j], 0.0)
+                                 - margin - radius_j, 0.0)
         vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
-                                  - rotor.radius[f, j], 0.0)
-        near = lateral_gap**2 + vertical_gap**2 < reach_squared
-        f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
-        per_pair = {k: v[near] for k, v in per_pair.items()}
-        if f.size == 0:
+                                  - radius_j, 0.0)
+        near = np.flatnonzero(lateral_gap**2 + vertical_gap**2 < reach_squared)
+        if near.size == 0:
             return result.reshape(u_initial.shape)
+        f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
+        offset, table = offset[near], table[near]
     centre = None
     if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
@@ -186,36 +186,35 @@ def rotor_cell_deficit(
         centre_table = {"strength": 0.0, "r_tube": 1.0, "image_height": 0.0, "veer": 0.0,
                         "ground_image": 0.0}
     else:
-        centre_table = centre_table(f)
+        centre_table = centre_table()
     flat = f * n_turbines + j
     kind = rotor.kind[f, j]
     moment = rotor.moment[f, j]
-    # The kernel's tables (plugin/rotor/rotor_kernel.py): the deficit's and the centre's factors
-    # that depend on the wake only (the velocity and deflection models'), and the solver's,
-    # once per rotor within reach.
-    table = model.kernel_table(x_pair, *(per_pair[k] for k in (
-        "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
-    per_pair["velocity_scale"] = per_pair["hub_speed"] * per_pair["speed_fraction"]
-    per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0],
-                    radius_j=rotor.radius[f, j], hub_height=hub_height_i[f, 0, 0, 0],
-                    moment=moment, reach_squared=reach_squared,
-                    overlap_edge=WAKE_OVERLAP_VELOCITY)
+    # The solver's part of the kernel's tables: per condition (turbine i's) and per rotor.
+    speed_fraction = column(speed_fraction)
+    velocity_scale = source_wake["hub_speed"] * speed_fraction
+    per_condition = {"velocity_scale": velocity_scale, "cos": column(cos_a),
+                     "sin": column(sin_a), "friction_velocity": source_wake["friction_velocity"],
+                     "radius": source_wake["radius"], "hub_height": column(hub_height_i),
+                     **{f"centre_{k}": v for k, v in centre_table.items()}}
+    overlap_edge = WAKE_OVERLAP_VELOCITY
     if track and model.turbulence_overlap == "wake_radius":
         # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
         # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
-        per_pair["overlap_edge"] = np.exp(-2.0) * model.centre_deficit(
-            x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
-        ) * per_pair["hub_speed"] * per_pair["speed_fraction"]
-    columns = lambda table, names: np.stack(  # noqa: E731
-        [np.broadcast_to(table[k], f.shape) for k in names], axis=1)
+        overlap_edge = (np.exp(-2.0) * table[:, WAKE_TABLE.index("centre_deficit")]
+                        * source_wake["hub_speed"][f] * speed_fraction[f])
+    per_pair = {"x": x_pair, "offset": offset, "radius_j": rotor.radius[f, j],
+                "moment": moment, "reach_squared": reach_squared, "overlap_edge": overlap_edge}
     removed, overlap, reached, centre = integrate_wake(
-        columns(table, WAKE_COLUMNS), columns(per_pair, PAIR_COLUMNS),
-        columns(centre_table, CENTRE_COLUMNS), centre, flat, kind, rotor, wakes, track)
+        table, _columns(per_pair, PAIR_COLUMNS, f.shape),
+        _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat, kind, rotor,
+        wakes, track)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape)
-    _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
-                      rotor.radius[f, j][reached, None], cells, rotor.warned)
+    _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
+                      centre[reached], rotor.radius[f[reached], j[reached]], cells,
+                      rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell,
@@ -241,17 +240,25 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
 
 
-def _check_resolution(x, per_pair, reached, centre, radius_j, cells, warned):
+def _columns(values, names, shape):
+    """The kernel's table (shape..., names) of ``values`` (arrays or scalars by name)."""
+    table = np.empty((*shape, len(names)))
+    for k, name in enumerate(names):
+        table[..., k] = values[name]
+    return table
+
+
+def _check_resolution(x, source_wake, centre, radius_j, cells, warned):
     """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
     if "rows" in warned:
         return
-    k_w, radius, ct, yaw = (per_pair[k][reached] for k in ("k_w", "radius", "ct", "yaw"))
+    k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
     width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
         stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
-    height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
+    height = radius_j * (cells.row_z[-1] - cells.row_z[0])
     shear = np.abs(centre[:, -1] - centre[:, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)
-    spacing = 2.0 * radius_j[:, 0] / cells.rows
+    spacing = 2.0 * radius_j / cells.rows
     if np.any(thickness < MIN_BAND_PER_ROW * spacing):
         warned.add("rows")
         ratio = float(np.min(thickness / spacing))

@@ -23,18 +23,26 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
-from floris_ekman_veer.wake.fused import JIT, centre_offset, curl_polynomial, point_deficit
+from floris_ekman_veer.wake.fused import (
+    JIT,
+    WAKE_TABLE,
+    centre_offset,
+    curl_polynomial,
+    point_deficit,
+)
 
-#: The per-wake columns of the kernel's tables, one row per (wake, rotor within reach): the
-#: velocity model's (``kernel_table``: C(x), k_w x, 0.4 R sqrt(A*) |cos beta|, sin^2 beta, t_hat's
-#: prefactor (0: no curl), 1 if the polar angle is measured from the yaw-only centre, the
-#: radial shape exponent), the deflection model's (its ``kernel_table``: the centre's t_hat
-#: prefactor, R sqrt(A*), the image vortex's hub height, the veer and ground-image switches)
-#: and the solver's.
-WAKE_COLUMNS = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape")
+#: The kernel's tables. Per wake and rotor within reach: the velocity model's (its ``wake_table``,
+#: wake/fused.py WAKE_TABLE, of which the kernel reads the first seven: C(x), k_w x,
+#: 0.4 R sqrt(A*) |cos beta|, sin^2 beta, t_hat's prefactor (0: no curl), 1 if the polar angle
+#: is measured from the yaw-only centre, the radial shape exponent) and the solver's
+#: (PAIR_COLUMNS). Per condition (turbine i's, CONDITION_COLUMNS): the solver's and the
+#: deflection model's (its ``kernel_table``: the centre's t_hat prefactor, R sqrt(A*), the image
+#: vortex's hub height, the veer and ground-image switches).
+WAKE_COLUMNS = WAKE_TABLE[:7]
+PAIR_COLUMNS = ("x", "offset", "radius_j", "moment", "reach_squared", "overlap_edge")
 CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
-PAIR_COLUMNS = ("x", "velocity_scale", "cos", "sin", "friction_velocity", "radius",
-                "offset", "radius_j", "hub_height", "moment", "reach_squared", "overlap_edge")
+CONDITION_COLUMNS = ("velocity_scale", "cos", "sin", "friction_velocity", "radius",
+                     "hub_height", *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
 #: numba's threading layer where the user has not chosen one: one that survives a fork
 #: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
@@ -47,15 +55,16 @@ _LAUNCH = threading.Lock()
 
 
 @numba.njit(parallel=True, **JIT)
-def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind, kind_u,
+def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kind, kind_u,
                kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
                block, track, removed, overlap, reached):
     for k in numba.prange(wake.shape[0]):
-        amplitude, kx, xi0, sin2b, strength, polar_veer, shape = wake[k]
-        (x, scale, cos_a, sin_a, u_star, radius, offset, radius_j, hub_height, moment,
-         reach_squared, overlap_edge) = pair[k]
-        strength_c, r_tube, image_height, veer, ground_image = centre_table[k]
+        amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
+        strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
+        x, offset, radius_j, moment, reach_squared, overlap_edge = pair[k]
         f, kk = condition[k], kind[k]
+        (scale, cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
+         ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
         for r in range(row_chord.size):
@@ -101,17 +110,17 @@ def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind
         overlap[k] = area
 
 
-def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, track):
+def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
     unless ``track``), (pairs,) whether
     the wake reached a row of the rotor, and (pairs, rows) the wake's centre at the rows.
 
-    ``wake``, ``pair`` and ``centre_table`` (pairs, WAKE_COLUMNS, PAIR_COLUMNS, CENTRE_COLUMNS):
-    the tables, one row per rotor within reach; ``centre`` (pairs, rows) the wake's centre at
-    the rows, or None: the kernel evaluates it from ``centre_table`` (the ekman_veer
-    deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
+    ``wake`` (pairs, WAKE_TABLE) and ``pair`` (pairs, PAIR_COLUMNS): the tables, one row per
+    rotor within reach; ``per_condition`` (n_findex, CONDITION_COLUMNS); ``centre`` (pairs,
+    rows) the wake's centre at the rows, or None: the kernel evaluates it from the centre's
+    columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
     updated in place.
@@ -125,7 +134,7 @@ def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, t
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     with _LAUNCH:
         _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(centre_table), compute_centre, centre,
+                   np.ascontiguousarray(per_condition), compute_centre, centre,
                    flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
                    rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
                    cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,
