@@ -234,46 +234,62 @@ WAKE_TABLE = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shap
 
 
 @numba.njit(**JIT)
-def _momentum_excess(n, c, loading, width_squared):
-    # wake/near_wake.py's _momentum_excess at one point.
-    return (n * loading / (16.0 * math.gamma(2.0 / n) * width_squared ** (2.0 / n))
-            - c * (2.0 ** (2.0 / n) - c))
+def _digamma(x):
+    # psi(x), x > 0: the recurrence psi(x) = psi(x + 1) - 1/x up to x >= 6, then the asymptotic
+    # series (to ~1e-13: it sets only the Newton steps of super_gaussian_order, not the root).
+    result = 0.0
+    while x < 6.0:
+        result -= 1.0 / x
+        x += 1.0
+    inverse = 1.0 / x
+    inverse2 = inverse * inverse
+    return result + np.log(x) - 0.5 * inverse - inverse2 * (
+        1.0 / 12.0 - inverse2 * (1.0 / 120.0 - inverse2 * (1.0 / 252.0 - inverse2 * (
+            1.0 / 240.0 - inverse2 / 132.0))))
+
+
+@numba.njit(**JIT)
+def _momentum_excess(n, c, loading, log_width_squared):
+    # wake/near_wake.py's _momentum_excess at one point, n C_T' / (16 Gamma(2/n) s^(4/n)) -
+    # c (2^(2/n) - c), with s^(4/n) = exp((2/n) ln s^2), and its derivative in n (Newton).
+    t = 2.0 / n
+    carried = n * loading / (16.0 * math.gamma(t) * np.exp(t * log_width_squared))
+    power = np.exp(t * np.log(2.0))
+    slope = (carried * (1.0 / n + 0.5 * t * t * (_digamma(t) + log_width_squared))
+             + c * power * np.log(2.0) * 0.5 * t * t)
+    return carried - c * (power - c), slope
 
 
 @numba.njit(**JIT)
 def super_gaussian_order(centre_deficit, loading, width_squared):
     """wake/near_wake.py's ``super_gaussian_order`` at one point: the same root in the same
-    bracket, found by regula falsi with the Illinois modification (superlinear: a handful of
-    evaluations of the momentum integral where the bisection takes 60) down to the resolution
-    of float64, which is where the bisection ends too (tests/physics/test_near_wake.py)."""
+    bracket, by Newton's method kept inside the bracket (a bisection step where Newton would
+    leave it; a handful of evaluations of the momentum integral where the bisection takes 60),
+    down to the resolution of float64, where the bisection ends too
+    (tests/physics/test_near_wake.py)."""
+    log_width_squared = np.log(width_squared)
     lower = GAUSSIAN_ORDER
     upper = 2.0 / (1.0 + np.log2(centre_deficit)) if centre_deficit > 0.5 else 64.0
-    f_lower = _momentum_excess(lower, centre_deficit, loading, width_squared)
-    if not f_lower > 0.0:
+    excess, slope = _momentum_excess(lower, centre_deficit, loading, log_width_squared)
+    if not excess > 0.0:
         return GAUSSIAN_ORDER
-    f_upper = _momentum_excess(upper, centre_deficit, loading, width_squared)
-    side = 0
-    for _ in range(4 * BISECTION_STEPS):
-        middle = 0.5 * (lower + upper)
-        if not (middle > lower and middle < upper):
-            break  # the bracket is two adjacent floats
-        trial = upper - f_upper * (upper - lower) / (f_upper - f_lower)
+    order = lower
+    for _ in range(2 * BISECTION_STEPS):
+        step = excess / slope
+        trial = order - step
         if not (trial > lower and trial < upper):
-            trial = middle
-        f_trial = _momentum_excess(trial, centre_deficit, loading, width_squared)
-        if f_trial > 0.0:
-            lower, f_lower = trial, f_trial
-            if side == 1:
-                f_upper *= 0.5
-            side = 1
+            trial = 0.5 * (lower + upper)
+        if abs(trial - order) <= 2e-16 * order or not (lower < trial < upper):
+            break
+        order = trial
+        excess, slope = _momentum_excess(order, centre_deficit, loading, log_width_squared)
+        if excess > 0.0:
+            lower = order
+        elif excess < 0.0:
+            upper = order
         else:
-            upper, f_upper = trial, f_trial
-            if side == -1:
-                f_lower *= 0.5
-            side = -1
-            if f_trial == 0.0:
-                return trial
-    return 0.5 * (lower + upper)
+            break
+    return order
 
 
 @numba.njit(**JIT)
