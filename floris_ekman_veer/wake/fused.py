@@ -85,14 +85,55 @@ def centre_offset(x, z, local_u, local_v, strength, r_tube, hub_height, radius, 
     ``veer`` times x V(z)/U(z) (Eq. yc_veer); 0 where there is no flow (U(z) <= 0)."""
     if not local_u > 0.0:
         return 0.0
-    t_hat = strength * -np.expm1(-0.35 * (friction_velocity / local_u) * x / radius)
-    abs_t = abs(t_hat)
+    return grown_centre_offset(time_growth(x, local_u, radius, friction_velocity), x, z,
+                               local_u, local_v, strength, r_tube, hub_height, veer,
+                               ground_image)
+
+
+@numba.njit(**JIT)
+def time_growth(x, speed, radius, friction_velocity):
+    """1 - exp(-0.35 (u*/U) x/R), t_hat's growth of Eq. (that) at a height where the speed is
+    U = ``speed`` > 0 (the centre's and the curl's t_hat at a row share it)."""
+    return -np.expm1(-0.35 * (friction_velocity / speed) * x / radius)
+
+
+@numba.njit(**JIT)
+def _vortex_pair_offset(abs_t):
+    # |y_hat_c| of Eq. (yhatc) without the image, at |t_hat| = abs_t (increasing in abs_t).
     pm1 = np.pi - 1.0
     numerator = (pm1 * abs_t * abs_t * abs_t + 2.0 * np.sqrt(3.0) * np.pi**2 * abs_t * abs_t
                  + 48.0 * pm1**2 * abs_t)
     denominator = (2.0 * np.pi * pm1 * abs_t * abs_t + 4.0 * np.sqrt(3.0) * np.pi**2 * abs_t
                    + 96.0 * pm1**2)
-    y_hat = np.sign(t_hat) * numerator / denominator
+    return numerator / denominator
+
+
+@numba.njit(**JIT)
+def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
+                        friction_velocity, veer, ground_image):
+    """(drift, bound) with |:func:`centre_offset` - drift| <= bound, without its exponential
+    (U(z) > 0): the veer's x V/U exactly, and the vortex pair's offset (Eq. yhatc, increasing
+    in |t_hat|, and its ground image's, linear in it) at the bound
+    |t_hat| <= |strength| min(2a / (2 + a), 1) of Eq. (that) (1 - exp(-a) <= 2a / (2 + a) for
+    a = 0.35 (u*/U) x/R >= 0, exp's Pade bound); widened by a millionth and a micrometre for
+    the round-off. The rotor-cell kernel skips the exact centre of the rows that this bound
+    already puts out of a wake's reach."""
+    drift = veer * (x * local_v / local_u)
+    a = 0.35 * (friction_velocity / local_u) * x / radius
+    t_bound = abs(strength) * min(2.0 * a / (2.0 + a), 1.0)
+    offset = _vortex_pair_offset(t_bound)
+    if ground_image:
+        eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
+        offset += (2.0 / np.pi) * t_bound / (eta * eta - 1.0)
+    return drift, r_tube * offset * (1.0 + 1e-6) + 1e-6
+
+
+@numba.njit(**JIT)
+def grown_centre_offset(growth, x, z, local_u, local_v, strength, r_tube, hub_height, veer,
+                        ground_image):
+    """:func:`centre_offset` with t_hat's growth (:func:`time_growth`) given (U(z) > 0)."""
+    t_hat = strength * growth
+    y_hat = np.sign(t_hat) * _vortex_pair_offset(abs(t_hat))
     if ground_image:
         eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
         y_hat -= (2.0 / np.pi) * t_hat / (eta * eta - 1.0)

@@ -27,8 +27,11 @@ from floris_ekman_veer.wake.fused import (
     JIT,
     WAKE_TABLE,
     centre_offset,
+    centre_offset_bound,
     curl_polynomial,
+    grown_centre_offset,
     point_deficit,
+    time_growth,
 )
 
 #: The kernel's tables. Per wake and rotor within reach: the velocity model's (its ``wake_table``,
@@ -67,28 +70,48 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
          ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
+        # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
+        # only if the rotor is reached (the first and last rows', for the resolution check of
+        # plugin/rotor/rotor.py; the others are not used).
+        skipped_first = skipped_last = False
         for r in range(row_chord.size):
+            dz = kind_heights[kk, r] - hub_height
             u, v = kind_u[f, kk, r], kind_v[f, kk, r]
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
+            # No flow (at and below z0): no wake, no t_hat.
+            flowing = local_u > 0.0
+            speed = local_u if flowing else 1.0
+            growth = 0.0
             if compute_centre:
-                centre[k, r] = centre_offset(x, kind_heights[kk, r], local_u, local_v,
-                                             strength_c, r_tube, image_height, radius, u_star,
-                                             veer, ground_image)
+                if flowing:
+                    # Out of reach whatever the exact centre (wake/fused.py centre_offset_bound):
+                    # the row is skipped without the exponential.
+                    drift, bound = centre_offset_bound(
+                        x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        image_height, radius, u_star, veer, ground_image)
+                    nearest = max(abs(offset - drift) - bound - radius_j * row_chord[r], 0.0)
+                    if not nearest * nearest + dz * dz < reach_squared:
+                        skipped_first |= r == 0
+                        skipped_last |= r == row_chord.size - 1
+                        continue
+                    growth = time_growth(x, speed, radius, u_star)
+                    centre[k, r] = grown_centre_offset(
+                        growth, x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        image_height, veer, ground_image)
+                else:
+                    centre[k, r] = 0.0
             lateral = offset - centre[k, r]
-            dz = kind_heights[kk, r] - hub_height
             # Only the rows the wake reaches are integrated (plugin/rotor/rotor.py
             # NEGLIGIBLE_DEFICIT): the row's nearest point within reach.
             gap = max(abs(lateral) - radius_j * row_chord[r], 0.0) ** 2 + dz * dz
             if not gap < reach_squared:
                 continue
             reached[k] = True
-            # No flow (at and below z0): no wake.
-            flowing = local_u > 0.0
             ambient_u = u if flowing else 0.0
-            speed = local_u if flowing else 1.0
-            q0, q1, q2, q3, q4 = curl_polynomial(
-                strength * -np.expm1(-0.35 * (u_star / speed) * x / radius), CURL_ALPHA)
+            if not (compute_centre and flowing):
+                growth = time_growth(x, speed, radius, u_star)
+            q0, q1, q2, q3, q4 = curl_polynomial(strength * growth, CURL_ALPHA)
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
@@ -108,6 +131,14 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
                 if track and du > overlap_edge and abs(dy + centre[k, r]) < reach:
                     area += weight[r, s]
         overlap[k] = area
+        if reached[k] and (skipped_first or skipped_last):
+            for r in (0, row_chord.size - 1):
+                if (r == 0 and skipped_first) or (r > 0 and skipped_last):
+                    u, v = kind_u[f, kk, r], kind_v[f, kk, r]
+                    centre[k, r] = centre_offset(x, kind_heights[kk, r], u * cos_a + v * sin_a,
+                                                 v * cos_a - u * sin_a, strength_c, r_tube,
+                                                 image_height, radius, u_star, veer,
+                                                 ground_image)
 
 
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track):
