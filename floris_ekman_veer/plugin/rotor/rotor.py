@@ -10,7 +10,6 @@ the kernel): no FLORIS import.
 
 from __future__ import annotations
 
-import functools
 import warnings
 
 import attrs
@@ -20,8 +19,8 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_inter
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     CONDITION_COLUMNS,
-    PAIR_COLUMNS,
     integrate_wake,
+    near_pairs,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
@@ -84,8 +83,26 @@ def rotor_cell_deficit(
     model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
     turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
 ):
+    """:func:`reached_rotor_cell_deficit`'s d_k; the rotors the wake reached (a superset of
+    those where d_k is not 0) are left in ``wakes.reached`` for the solver
+    (plugin/floris_hooks/solver.py), which updates only those."""
+    result, wakes.reached = reached_rotor_cell_deficit(
+        model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+        turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes)
+    return result
+
+
+#: No rotor reached: (f, j) empty.
+_NONE = (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
+
+
+def reached_rotor_cell_deficit(
+    model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+    turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
+):
     """d_k of every rotor cell of the grid after turbine i's wake (the module docstring), for a
-    velocity model's call on a turbine grid (docs/coupling.md#rotor-average).
+    velocity model's call on a turbine grid (docs/coupling.md#rotor-average), and the rotors
+    (f, j) the wake reached.
 
     Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
     (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
@@ -109,7 +126,7 @@ def rotor_cell_deficit(
     dx = rotor.x - x_i[:, 0, 0]
     f, j = np.nonzero(dx > ROTOR_PLANE_MARGIN)
     if f.size == 0:
-        return result.reshape(u_initial.shape)
+        return result.reshape(u_initial.shape), _NONE
     abl = ambient.abl
     hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
     added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
@@ -148,34 +165,29 @@ def rotor_cell_deficit(
     # The velocity model's table (plugin/rotor/rotor_kernel.py): the deficit's factors that
     # depend on the wake only, its width and amplitude bounds and its centre deficit.
     table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
-    width = table[:, WAKE_TABLE.index("width_bound")]
-    # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
-    # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
-    amplitude = table[:, WAKE_TABLE.index("amplitude_bound")]
-    reach_squared = 2.0 * width**2 * np.log(
-        np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
-    offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
     centre_table = getattr(deflection_field_i, "kernel_table", None)
+    # The rotors the wake reaches, with the deficit C(x) exp(-gap^2 / (2 sigma^2)) below
+    # NEGLIGIBLE_DEFICIT beyond gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT) (sigma the widest
+    # width). With the ekman_veer deflection, also those out of reach by the centre at the
+    # grid's points (heights z_h, z_h +- R/2) widened by its spread plus R/4 on either side
+    # (the centre at the rows beyond +-R/2, twice the linear extrapolation, and between them)
+    # are not integrated and their rows not evaluated.
+    points = np.zeros((1, 1, 0))
     if centre_table is not None and cells.n > 1:
-        # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
-        # widened by its spread plus R/4 on either side (the centre at the rows beyond
-        # +-R/2, twice the linear extrapolation, and between them) are not integrated and
-        # their rows not evaluated.
-        # (the n point heights' extremes column by column: numpy's reductions along a short
-        # axis cost more than the comparisons)
-        points = deflection_field_i[f, j, 0, :].T
-        top, bottom = functools.reduce(np.maximum, points), functools.reduce(np.minimum, points)
-        radius_j = rotor.radius[f, j]
-        margin = top - bottom + 0.25 * radius_j
-        lateral_gap = np.maximum(np.maximum(offset - top, bottom - offset)
-                                 - margin - radius_j, 0.0)
-        vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
-                                  - radius_j, 0.0)
-        near = np.flatnonzero(lateral_gap**2 + vertical_gap**2 < reach_squared)
-        if near.size == 0:
-            return result.reshape(u_initial.shape)
-        f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
-        offset, table = offset[near], table[near]
+        points = np.asarray(deflection_field_i)[:, :, 0, :]
+    speed_fraction = column(speed_fraction)
+    edge_factor = 0.0
+    if track and model.turbulence_overlap == "wake_radius":
+        # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
+        # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
+        edge_factor = np.exp(-2.0)
+    near, pair = near_pairs(
+        f, j, x_pair, table, points, rotor, column(y_i), column(hub_height_i),
+        NEGLIGIBLE_DEFICIT, WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"],
+        speed_fraction)
+    if near.size == 0:
+        return result.reshape(u_initial.shape), _NONE
+    f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
     centre = None
     if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
@@ -189,40 +201,29 @@ def rotor_cell_deficit(
         centre_table = centre_table()
     flat = f * n_turbines + j
     kind = rotor.kind[f, j]
-    moment = rotor.moment[f, j]
-    # The solver's part of the kernel's tables: per condition (turbine i's) and per rotor.
-    speed_fraction = column(speed_fraction)
+    # The solver's part of the kernel's tables per condition (turbine i's).
     velocity_scale = source_wake["hub_speed"] * speed_fraction
     per_condition = {"velocity_scale": velocity_scale, "cos": column(cos_a),
                      "sin": column(sin_a), "friction_velocity": source_wake["friction_velocity"],
                      "radius": source_wake["radius"], "hub_height": column(hub_height_i),
                      **{f"centre_{k}": v for k, v in centre_table.items()}}
-    overlap_edge = WAKE_OVERLAP_VELOCITY
-    if track and model.turbulence_overlap == "wake_radius":
-        # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
-        # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
-        overlap_edge = (np.exp(-2.0) * table[:, WAKE_TABLE.index("centre_deficit")]
-                        * source_wake["hub_speed"][f] * speed_fraction[f])
-    per_pair = {"x": x_pair, "offset": offset, "radius_j": rotor.radius[f, j],
-                "moment": moment, "reach_squared": reach_squared, "overlap_edge": overlap_edge}
     removed, overlap, reached, centre = integrate_wake(
-        table, _columns(per_pair, PAIR_COLUMNS, f.shape),
-        _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat, kind, rotor,
-        wakes, track)
+        table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
+        kind, rotor, wakes, track)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
-        return result.reshape(u_initial.shape)
+        return result.reshape(u_initial.shape), _NONE
     _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
                       centre[reached], rotor.radius[f[reached], j[reached]], cells,
                       rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell,
-        moment[reached][:, None])
+        pair[reached, 3:4])
     if track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
                         axial_induction_i, overlap[reached], ambient, added_rule)
-    return result.reshape(u_initial.shape)
+    return result.reshape(u_initial.shape), (f[reached], j[reached])
 
 
 def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):

@@ -141,6 +141,61 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
                                                  ground_image)
 
 
+@numba.njit(**JIT)
+def _near_pairs(f, j, x, table, width_column, amplitude_column, centre_column, negligible,
+                points, rotor_y, rotor_z, rotor_radius, rotor_moment, y_i, hub_height,
+                overlap_edge, edge_factor, hub_speed, speed_fraction, keep, pair):
+    count = 0
+    for p in range(f.size):
+        fp, jp = f[p], j[p]
+        width, amplitude = table[p, width_column], table[p, amplitude_column]
+        reach_squared = 2.0 * width**2 * np.log(max(amplitude, negligible) / negligible)
+        offset = rotor_y[fp, jp] - y_i[fp]
+        radius_j = rotor_radius[fp, jp]
+        if points.shape[2] > 0:
+            top = bottom = points[fp, jp, 0]
+            for h in range(1, points.shape[2]):
+                top = max(top, points[fp, jp, h])
+                bottom = min(bottom, points[fp, jp, h])
+            margin = top - bottom + 0.25 * radius_j
+            lateral_gap = max(max(offset - top, bottom - offset) - margin - radius_j, 0.0)
+            vertical_gap = max(abs(rotor_z[fp, jp] - hub_height[fp]) - radius_j, 0.0)
+            if not lateral_gap**2 + vertical_gap**2 < reach_squared:
+                continue
+        keep[count] = p
+        edge = overlap_edge
+        if edge_factor > 0.0:
+            edge = edge_factor * table[p, centre_column] * hub_speed[fp] * speed_fraction[fp]
+        pair[count, 0] = x[p]
+        pair[count, 1] = offset
+        pair[count, 2] = radius_j
+        pair[count, 3] = rotor_moment[fp, jp]
+        pair[count, 4] = reach_squared
+        pair[count, 5] = edge
+        count += 1
+    return count
+
+
+def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overlap_edge,
+               edge_factor, hub_speed, speed_fraction):
+    """The rotors (f, j) downstream of a wake that it can reach, and the kernel's PAIR_COLUMNS
+    table of them, in one pass (plugin/rotor/rotor.py ``rotor_cell_deficit`` says why each
+    is dropped): each rotor's reach^2 = 2 sigma_max^2 ln(C / ``negligible``) from the velocity
+    model's ``table`` (WAKE_TABLE) and, with the wake's centre at the grid's point heights
+    ``points`` (pairs' (n_findex, n_turbines, n), or n = 0: no culling), the rotors beyond it
+    dropped. The overlap edge is ``overlap_edge``, or with ``edge_factor`` > 0 that times the
+    wake's centre deficit, U_h and the incoming fraction (per condition). Returns the kept
+    indices into the pairs and their table."""
+    keep = np.empty(f.size, dtype=np.int64)
+    pair = np.empty((f.size, len(PAIR_COLUMNS)))
+    count = _near_pairs(
+        f, j, x, table, WAKE_TABLE.index("width_bound"), WAKE_TABLE.index("amplitude_bound"),
+        WAKE_TABLE.index("centre_deficit"), float(negligible), points, rotor.y, rotor.z,
+        rotor.radius, rotor.moment, y_i, hub_height, float(overlap_edge), float(edge_factor),
+        hub_speed, speed_fraction, keep, pair)
+    return keep[:count], pair[:count]
+
+
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area

@@ -123,6 +123,8 @@ class RotorWakes:
         turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
             ambient one.
         turbulence_model: FLORIS's wake-added turbulence model, or None.
+        reached: the rotors (f, j) the latest wake reached (plugin/rotor/rotor.py), a superset
+            of those where its deficit is not 0, or None.
     """
 
     cells: RotorCells
@@ -132,6 +134,7 @@ class RotorWakes:
     wake: np.ndarray
     turbulence: np.ndarray
     turbulence_model: object = None
+    reached: tuple | None = None
 
     @classmethod
     def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,
