@@ -112,8 +112,9 @@ def _vortex_pair_offset(abs_t):
 def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
                         friction_velocity, veer, ground_image):
     """(drift, bound) with |:func:`centre_offset` - drift| <= bound, without its exponential
-    (U(z) > 0): the veer's x V/U exactly, and the vortex pair's offset (Eq. yhatc, increasing
-    in |t_hat|, and its ground image's, linear in it) at the bound
+    (U(z) > 0): the veer's x V/U exactly, and the larger of the vortex pair's offset (Eq.
+    yhatc, increasing in |t_hat|) and its ground image's (linear in it, of the opposite sign)
+    at the bound
     |t_hat| <= |strength| min(2a / (2 + a), 1) of Eq. (that) (1 - exp(-a) <= 2a / (2 + a) for
     a = 0.35 (u*/U) x/R >= 0, exp's Pade bound); widened by a millionth and a micrometre for
     the round-off. The rotor-cell kernel skips the exact centre of the rows that this bound
@@ -123,8 +124,9 @@ def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, ra
     t_bound = abs(strength) * min(2.0 * a / (2.0 + a), 1.0)
     offset = _vortex_pair_offset(t_bound)
     if ground_image:
+        # The image's offset has the opposite sign: the difference is at most the larger.
         eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
-        offset += (2.0 / np.pi) * t_bound / (eta * eta - 1.0)
+        offset = max(offset, (2.0 / np.pi) * t_bound / (eta * eta - 1.0))
     return drift, r_tube * offset * (1.0 + 1e-6) + 1e-6
 
 
