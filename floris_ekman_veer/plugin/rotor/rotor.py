@@ -174,7 +174,7 @@ def reached_rotor_cell_deficit(
     # are not integrated and their rows not evaluated.
     points = np.zeros((1, 1, 0))
     if centre_table is not None and cells.n > 1:
-        points = np.asarray(deflection_field_i)[:, :, 0, :]
+        points = np.ascontiguousarray(np.asarray(deflection_field_i)[:, :, 0, :])
     speed_fraction = column(speed_fraction)
     edge_factor = 0.0
     if track and model.turbulence_overlap == "wake_radius":

@@ -188,8 +188,9 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     indices into the pairs and their table."""
     keep = np.empty(f.size, dtype=np.int64)
     pair = np.empty((f.size, len(PAIR_COLUMNS)))
+    # (contiguous index arrays: one compiled signature)
     count = _near_pairs(
-        f, j, x, table, WAKE_TABLE.index("width_bound"), WAKE_TABLE.index("amplitude_bound"),
+        np.ascontiguousarray(f), np.ascontiguousarray(j), x, table, WAKE_TABLE.index("width_bound"), WAKE_TABLE.index("amplitude_bound"),
         WAKE_TABLE.index("centre_deficit"), float(negligible), points, rotor.y, rotor.z,
         rotor.radius, rotor.moment, y_i, hub_height, float(overlap_edge), float(edge_factor),
         hub_speed, speed_fraction, keep, pair)
