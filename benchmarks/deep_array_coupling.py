@@ -13,12 +13,18 @@ time (docs/coupling.md#wakes-deep-in-an-array):
     overlap           the part of a rotor a wake's added turbulence is weighted with: "velocity",
                       where the wake's velocity exceeds 0.05 m/s (FLORIS's count), or "radius",
                       inside the wake radius 2 sigma (Niayifar & Porte-Agel 2016);
-    Crespo-Hernandez  the added turbulence's constants: "FLORIS" (FLORIS 4.7's defaults: 0.9
-                      a^0.8 I0^0.1 (x/D)^-0.32) or "1996" (Crespo & Hernandez's published
-                      0.73 a^0.8325 I0^0.0325 (x/D)^-0.32, as PyWake's Niayifar and Zong models
-                      take them; "1996-" with the exponent -0.0325 of the paper's scans);
+    added-turbulence  the added turbulence's form: Crespo-Hernandez with "FLORIS" (FLORIS 4.7's
+    form              defaults: 0.9 a^0.8 I0^0.1 (x/D)^-0.32) or "1996" (Crespo & Hernandez's
+                      published 0.73 a^0.8325 I0^0.0325 (x/D)^-0.32, as PyWake's Niayifar and
+                      Zong models take them; "1996-" with the exponent -0.0325 of the paper's
+                      scans), weighted with the overlap; or "Ishihara-Qian" (Ishihara & Qian
+                      2018, ``wake_turbulence: ishihara_qian``), its ring-shaped profile
+                      averaged over the rotor (its own overlap: the overlap column is "-");
     deficit scale     "free stream" (FLORIS's gauss) or "incoming" (Niayifar & Porte-Agel 2016);
-    superposition     "sosfs" (squares summed) or "fls" (summed).
+    superposition     "sosfs" (squares summed), "fls" (summed), "zong" (Zong & Porte-Agel's
+                      2020 momentum-conserving weights on the sum, ``wake_superposition:
+                      momentum_conserving``) or "cumulative" (Bastankhah et al.'s 2021
+                      cumulative wake, summed: ``wake_superposition: cumulative``).
 
 Prints the RMSE (bias) of the direction-averaged P_i/P_1 over the waked positions (Horns Rev,
 Lillgrund) and of Horns Rev's farm efficiency against the LES. Takes about 5 minutes.
@@ -58,18 +64,41 @@ COUPLINGS = (
     ("quadrature", "radius", "1996", "incoming", "fls"),
     ("quadrature", "radius", "1996-", "incoming", "fls"),
     ("quadrature", "radius", "FLORIS", "incoming", "fls"),
+    ("quadrature", "-", "Ishihara-Qian", "incoming", "fls"),
+    ("max", "-", "Ishihara-Qian", "incoming", "fls"),
+    ("quadrature", "radius", "FLORIS", "incoming", "zong"),
+    ("quadrature", "radius", "1996-", "incoming", "zong"),
+    ("quadrature", "velocity", "1996-", "incoming", "zong"),
+    ("quadrature", "-", "Ishihara-Qian", "incoming", "zong"),
+    ("max", "radius", "FLORIS", "incoming", "zong"),
+    ("max", "radius", "1996-", "incoming", "zong"),
+    ("max", "velocity", "FLORIS", "incoming", "zong"),
+    ("quadrature", "radius", "FLORIS", "incoming", "cumulative"),
+    ("max", "radius", "FLORIS", "incoming", "cumulative"),
+    ("quadrature", "radius", "1996-", "incoming", "cumulative"),
+    ("quadrature", "-", "Ishihara-Qian", "incoming", "cumulative"),
 )
 
 
 def setup(turbulence: str, overlap: str, constants: str, scale: str, superposition: str):
     """A (name, set-up) pair of M-1 with this coupling (validation.models.WAKE_MODELS' form)."""
     strings, gch, parameters = models.WAKE_MODELS["M-1"]
-    velocity = {"wake_expansion": EXPANSION[turbulence], "deficit_velocity": SCALE[scale],
-                "turbulence_overlap": OVERLAP[overlap]}
+    velocity = {"wake_expansion": EXPANSION[turbulence], "deficit_velocity": SCALE[scale]}
+    if constants == "Ishihara-Qian":
+        velocity["wake_turbulence"] = "ishihara_qian"
+        crespo_hernandez = None
+    else:
+        velocity["turbulence_overlap"] = OVERLAP[overlap]
+        crespo_hernandez = CRESPO_HERNANDEZ[constants]
+    if superposition in ("zong", "cumulative"):
+        velocity["wake_superposition"] = ("momentum_conserving" if superposition == "zong"
+                                          else superposition)
+    summed = superposition in ("zong", "cumulative")
     return (f"{turbulence}, {overlap}, {constants}, {scale}, {superposition}",
-            ({**strings, "combination_model": superposition}, gch,
+            ({**strings, "combination_model": "fls" if summed else superposition},
+             gch,
              {**parameters, "velocity": velocity,
-              "turbulence": {"crespo_hernandez": CRESPO_HERNANDEZ[constants]}}))
+              "turbulence": {"crespo_hernandez": crespo_hernandez}}))
 
 
 def _cell(errors, kind="averaged") -> str:
@@ -77,11 +106,11 @@ def _cell(errors, kind="averaged") -> str:
     return f"{row.rmse:.3f} ({row.bias:+.3f})"
 
 
-def main() -> None:
-    print("| added turbulence | overlap | Crespo-Hernandez | deficit scale | superposition | "
+def main(couplings=COUPLINGS) -> None:
+    print("| added turbulence | overlap | added-turbulence form | deficit scale | superposition | "
           "Horns Rev rows | Horns Rev efficiency | Lillgrund rows |")
     print("|---|---|---|---|---|---|---|---|")
-    for coupling in COUPLINGS:
+    for coupling in couplings:
         model = setup(*coupling)
         horns_rev = metrics.row_errors(models.row_ratios(HORNS_REV, [model]))
         efficiency = metrics.efficiency_errors(models.farm_efficiency(HORNS_REV, [model]))
@@ -91,4 +120,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    # ``python -m benchmarks.deep_array_coupling 15 16``: only those rows of COUPLINGS (0-based).
+    main([COUPLINGS[int(k)] for k in sys.argv[1:]] or COUPLINGS)

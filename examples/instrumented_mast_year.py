@@ -40,6 +40,13 @@ The instruments, each effect seeded and recorded (module constants):
   record, rounded to 0.01 m/s; the cup in the mast's wake (the wind from the boom's
   orientation + 180 deg) reads low by up to 25 % (a Gaussian deficit 12 deg wide, IEC
   61400-12-1 Annex G's lattice-mast wake) and its standard deviation is raised;
+* calibration certificates: each cup's own (``table.attrs["cup_calibration_certificates"]``,
+  as ``fit_site``'s ``cup_calibrations`` takes them): the logger's generic transfer function
+  :data:`LOGGER_TRANSFER` (slope per Hz, offset) divided by the cup's drawn calibration, off by
+  the certificate's own error (:data:`CERTIFICATE_ERROR`, relative, standard: the part that
+  differs between cups calibrated in one accredited tunnel, MEASNET's repeatability; drawn from
+  a second stream of the seed, so the records are those without certificates), which each
+  certificate states as its uncertainty;
 * spikes: :data:`SPIKE_FRACTION` of the cup readings jump up by 3 to 10 m/s (logger noise);
 * standard deviations: the model's I_u at the cup's height times its speed, times the
   terrain's :data:`TERRAIN_TURBULENCE`, with a 10 % sampling error (log-normal);
@@ -92,6 +99,10 @@ WEIBULL_SHAPE, WEIBULL_SCALE = 2.0, 8.0
 SHADOW_DEFICIT, SHADOW_WIDTH = 0.25, 12.0
 CUP_BIAS, CUP_ERROR, CUP_OFFSET_ERROR = 0.005, 0.01, 0.05
 VANE_ERROR = 1.0
+#: The logger's generic transfer function of the cups (slope [m/s per Hz], offset [m/s]: a
+#: class-1 cup's consensus one) and the certificates' relative standard error of the slope.
+LOGGER_TRANSFER = (0.046, 0.2)
+CERTIFICATE_ERROR = 0.0015
 STD_SAMPLING_ERROR = 0.1
 SPIKE_FRACTION = 0.002
 N_ICING = 6
@@ -129,7 +140,8 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     """The records (module docstring): one row per record, the instruments' columns and the
     generator's truth (``true_class``, ``true_obukhov_length``, ``true_calm``,
     ``true_stuck_<h>m``, ``true_direction_80m``, ``true_roughness_length``), in time order; each
-    cup's drawn calibration factor in ``table.attrs["true_cup_calibration"]``."""
+    cup's drawn calibration factor in ``table.attrs["true_cup_calibration"]`` and its certificate
+    in ``table.attrs["cup_calibration_certificates"]``."""
     rng = np.random.default_rng(seed)
     time = pd.date_range("2025-01-01 00:00", periods=periods, freq=freq)
     n = time.size
@@ -234,7 +246,24 @@ def mast_year(seed: int = SEED, periods: int = 8760, freq: str = "h") -> pd.Data
     # Each cup's drawn calibration (reading / truth): constant per cup, so kept beside the table
     # (what the cup's calibration certificate would say) rather than as a column.
     table.attrs["true_cup_calibration"] = calibration
+    table.attrs["cup_calibration_certificates"] = certificates(calibration, seed)
     return table
+
+
+def certificates(calibration, seed=SEED):
+    """Each cup's calibration certificate (module docstring) from its drawn calibration
+    (reading / truth): a logged speed v = s_L f + o_L is the truth s f + o with s = s_L / c and
+    o = o_L / c, c the calibration; the certificate's own error drawn from the seed's second
+    stream (``default_rng([seed, 1])``), its stated uncertainty :data:`CERTIFICATE_ERROR`."""
+    rng = np.random.default_rng([seed, 1])
+    slope, offset = LOGGER_TRANSFER
+    out = {}
+    for column, factor in calibration.items():
+        certified = factor * (1.0 + rng.normal(0.0, CERTIFICATE_ERROR))
+        out[column] = {"slope": slope / certified, "offset": offset / certified,
+                       "logger_slope": slope, "logger_offset": offset,
+                       "uncertainty": CERTIFICATE_ERROR}
+    return out
 
 
 if __name__ == "__main__":

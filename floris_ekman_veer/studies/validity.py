@@ -274,11 +274,14 @@ def farm_coupling_beyond_paper(core) -> bool:
     """Whether the farm's waked rotors go through the package's farm coupling, beyond the
     paper's single-wake validation: more than one turbine and the ekman_veer or bastankhah2014
     velocity model with the upstream wakes' added turbulence in k_w (``wake_expansion`` other
-    than ``ambient``) or the incoming-speed deficits (docs/coupling.md#wakes-deep-in-an-array)."""
+    than ``ambient``, in either ``wake_turbulence`` form), the incoming-speed deficits or a
+    published superposition (``wake_superposition`` momentum_conserving or cumulative)
+    (docs/coupling.md#wakes-deep-in-an-array)."""
     velocity = getattr(core.wake, "velocity_model", None)
     if core.farm.n_turbines < 2 or not hasattr(velocity, "deficit_velocity"):
         return False
-    return velocity.wake_expansion != "ambient" or velocity.deficit_velocity == "incoming"
+    return (velocity.wake_expansion != "ambient" or velocity.deficit_velocity == "incoming"
+            or velocity.wake_superposition != "combination_model")
 
 
 def validity_summary(report: pd.DataFrame, label: str = "") -> str:

@@ -167,6 +167,11 @@ def test_farm_coupling_is_flagged_beyond_the_paper():
     paper = FlorisModel(config)
     paper.set(**conditions)
     assert not floris_ekman_veer.validity_report(paper).farm_coupling_beyond_paper.any()
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_superposition"] = "cumulative"
+    config["wake"]["model_strings"]["combination_model"] = "fls"
+    cumulative = FlorisModel(config)
+    cumulative.set(**conditions)
+    assert floris_ekman_veer.validity_report(cumulative).farm_coupling_beyond_paper.all()
 
 
 def test_rotors_inside_a_potential_core_are_flagged_with_the_near_wake():

@@ -197,7 +197,8 @@ def _states(model, deficit_model_args, floris_turbulence) -> turbine_states.Turb
     rotor = ambient.rotor
     n_findex, n_turbines = rotor.x.shape
     fraction = np.ones((n_findex, n_turbines))
-    if model.deficit_velocity == "incoming" and wakes.rule is not None:
+    if ((model.deficit_velocity == "incoming" or wakes.superposition == "cumulative")
+            and wakes.rule is not None):
         u_cells = deficit_model_args["u_initial"].reshape(n_findex * n_turbines, -1)
         fraction = wakes.incoming_fraction(np.arange(n_findex * n_turbines),
                                            u_cells).reshape(n_findex, n_turbines)
@@ -210,11 +211,13 @@ def _states(model, deficit_model_args, floris_turbulence) -> turbine_states.Turb
 
 def hands_turbine_states(model) -> bool:
     """Whether the velocity model's wakes need the turbine grid's states on other grids: the
-    rotors' incoming speeds (``deficit_velocity: incoming``) or their array turbulence
-    (``wake_expansion: array_turbulence``), which FLORIS's point-wise solvers do not carry.
+    rotors' incoming speeds (``deficit_velocity: incoming``, and the cumulative wake's thrust)
+    or their array turbulence (``wake_expansion: array_turbulence``), which FLORIS's point-wise
+    solvers do not carry.
     (``local_turbulence`` and ``free_stream`` they express themselves.)"""
     return isinstance(model, EkmanWakeModel) and (
-        model.deficit_velocity == "incoming" or model.wake_expansion == "array_turbulence")
+        model.deficit_velocity == "incoming" or model.wake_expansion == "array_turbulence"
+        or model.wake_superposition == "cumulative")
 
 
 def turbine_grid_states(farm, flow_field, model_manager) -> turbine_states.TurbineStates:

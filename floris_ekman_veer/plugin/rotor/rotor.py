@@ -15,17 +15,21 @@ import warnings
 import attrs
 import numpy as np
 
+from floris_ekman_veer.plugin.rotor.convection import removed_moments
 from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     CONDITION_COLUMNS,
+    PAIR_COLUMNS,
     integrate_wake,
     near_pairs,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
-from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
 from floris_ekman_veer.wake.fused import WAKE_TABLE
+from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -51,6 +55,12 @@ ADDED_TURBULENCE = {"local_turbulence": "max", "array_turbulence": "quadrature"}
 #: (FLORIS's count) or where the rotor lies inside the wake radius 2 sigma (Niayifar &
 #: Porte-Agel 2016, docs/coupling.md#wakes-deep-in-an-array).
 TURBULENCE_OVERLAPS = ("wake_velocity", "wake_radius")
+
+#: The velocity models' ``wake_turbulence`` choices: the form of a wake's added turbulence,
+#: FLORIS's turbulence model (Crespo & Hernandez 1996 as FLORIS has it) weighted with the
+#: overlap, or Ishihara & Qian (2018, wake/added_turbulence.py) averaged over the rotor's
+#: sub-points, its radial profile being its own overlap (docs/coupling.md#wakes-deep-in-an-array).
+WAKE_TURBULENCES = ("crespo_hernandez", "ishihara_qian")
 
 #: The velocity models' ``deficit_velocity`` choices: the speed a wake's C(x) scales with.
 DEFICIT_VELOCITIES = ("incoming", "free_stream")
@@ -132,7 +142,10 @@ def reached_rotor_cell_deficit(
     added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
     track = (added_rule is not None and wakes.rule is not None
              and wakes.turbulence_model is not None)
-    incoming = model.deficit_velocity == "incoming" and wakes.rule is not None
+    cumulative = wakes.superposition == "cumulative"
+    # The cumulative wake's thrust needs turbine i's incoming speed whatever the deficit's scale.
+    incoming = ((model.deficit_velocity == "incoming" or cumulative)
+                and wakes.rule is not None)
     if track or incoming:
         # Turbine i among the rotors, per condition.
         source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
@@ -202,25 +215,74 @@ def reached_rotor_cell_deficit(
     flat = f * n_turbines + j
     kind = rotor.kind[f, j]
     # The solver's part of the kernel's tables per condition (turbine i's).
-    velocity_scale = source_wake["hub_speed"] * speed_fraction
-    per_condition = {"velocity_scale": velocity_scale, "cos": column(cos_a),
-                     "sin": column(sin_a), "friction_velocity": source_wake["friction_velocity"],
+    per_condition = {"cos": column(cos_a), "sin": column(sin_a),
+                     "friction_velocity": source_wake["friction_velocity"],
                      "radius": source_wake["radius"], "hub_height": column(hub_height_i),
                      **{f"centre_{k}": v for k, v in centre_table.items()}}
+    scale, edge = PAIR_COLUMNS.index("velocity_scale"), PAIR_COLUMNS.index("overlap_edge")
+    moment = pair[:, PAIR_COLUMNS.index("moment")]
+    per_pair = {k: v[f] for k, v in source_wake.items()}
+    per_pair.update(speed_fraction=speed_fraction[f], cos=column(cos_a)[f],
+                    sin=column(sin_a)[f], offset=pair[:, PAIR_COLUMNS.index("offset")])
+    convecting = wakes.superposition == "momentum_conserving"
+    if cumulative:
+        # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
+        # wakes kept at each rotor (plugin/rotor/convection.py), at each of its grid points (the
+        # veer-sheared centres differ with height, as on FLORIS's other grids); the kernel's
+        # deficit is the model's shape scaled to the rotor's mean C_n, and the wakes are summed.
+        single = model.centre_deficit(x_pair,
+                                      *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
+        width_squared = (table[:, WAKE_TABLE.index("kx")]
+                         + table[:, WAKE_TABLE.index("xi0")])[:, None] ** 2
+        centre_y = y_i[f, 0, 0, 0][:, None] + deflection_field_i[f, j].reshape(f.size, -1)
+        centre_z = np.broadcast_to(hub_height_i[f, 0, 0, 0][:, None], centre_y.shape)
+        incoming_speed = (per_pair["hub_speed"] * per_pair["speed_fraction"])[:, None]
+        deficit = cumulative_deficit(
+            single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
+            wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
+            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
+        pair[:, scale] = deficit.mean(axis=1) / np.where(single > 0.0, single, 1.0)
+        if track and model.turbulence_overlap == "wake_radius":
+            pair[:, edge] = np.exp(-2.0) * deficit.mean(axis=1)
+    if convecting:
+        # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
+        # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
+        centre_speed = model.centre_deficit(
+            x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
+        ) * pair[:, scale]
+        wake_convection = pair[:, scale] - 0.5 * centre_speed
+        pair[:, scale] = pair[:, scale] * wake_convection
+        pair[:, edge] = pair[:, edge] * wake_convection
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
         kind, rotor, wakes, track)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE
+    if cumulative:
+        wakes.convection.keep(flat[reached], deficit[reached],
+                              np.broadcast_to(width_squared, deficit.shape)[reached],
+                              centre_y[reached], centre_z[reached])
+    if convecting:
+        removed = _momentum_conserving(
+            wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
+            table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
+            wake_convection)
     _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
                       centre[reached], rotor.radius[f[reached], j[reached]], cells,
                       rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
-        flat[reached], removed[reached], u_cell,
-        pair[reached, 3:4])
-    if track:
+        flat[reached], removed[reached], u_cell, moment[reached][:, None])
+    if track and model.wake_turbulence == "ishihara_qian":
+        added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
+                               rotor, f[reached], j[reached], kind[reached],
+                               hub_height_i[f[reached], 0, 0, 0],
+                               ambient.floris_turbulence, x_i.shape[0])
+        wakes.add_turbulence(f[reached], j[reached], added, np.broadcast_to(
+            ambient.floris_turbulence, (x_i.shape[0], 1, 1, 1))[f[reached], 0, 0, 0],
+            added_rule)
+    elif track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
                         axial_induction_i, overlap[reached], ambient, added_rule)
     return result.reshape(u_initial.shape), (f[reached], j[reached])
@@ -247,6 +309,71 @@ def _columns(values, names, shape):
     for k, name in enumerate(names):
         table[..., k] = values[name]
     return table
+
+
+#: A wake joins a rotor's combined convection velocity where its deficit on the rotor exceeds
+#: this fraction of U_0 (PyWake's WeightedSum: weaker wakes add linearly); Zong & Porte-Agel's
+#: U_c is that of the wakes that overlap there.
+CONVECTION_THRESHOLD = 0.01
+
+
+def _momentum_conserving(wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair,
+                         y_i, hub_height_i, width, centre_speed, wake_convection):
+    """The cells' removed moment (pairs, n^2), as the kernel returns it, of the rotors reached by
+    turbine i's wake after Zong & Porte-Agel's superposition (plugin/rotor/convection.py): the
+    wake's Gaussian equivalent (centre deficit, width k_w x + xi0 of the kernel's table, centre
+    at the rows' mean) joins the rotor's where its deficit on the rotor exceeds
+    CONVECTION_THRESHOLD U_0, U_c is updated and the whole rotor's moment recomputed, less what
+    the cells already removed."""
+    pick = lambda a: np.broadcast_to(a, flat.shape)[reached]  # noqa: E731
+    pairs = flat[reached]
+    f, j, kind = f[reached], j[reached], kind[reached]
+    hub_speed, width = pick(per_pair["hub_speed"]), pick(width)
+    centre_speed, wake_convection = pick(centre_speed), pick(wake_convection)
+    centre_y = y_i[f, 0, 0, 0] + centre[reached].mean(axis=1)
+    centre_z = hub_height_i[f, 0, 0, 0]
+    # The rotor's nearest sub-point row to the wake's centre line (veer shears it row by row).
+    radius_j = rotor.radius[f, j][:, None]
+    lateral = np.maximum(np.abs(pick(per_pair["offset"])[:, None] - centre[reached])
+                         - radius_j * wakes.cells.row_chord, 0.0)
+    gap_squared = np.min(lateral**2 + (rotor.kind_heights[kind] - centre_z[:, None]) ** 2,
+                         axis=1)
+    joins = (centre_speed * np.exp(-gap_squared / (2.0 * width**2))
+             > CONVECTION_THRESHOLD * hub_speed)
+    state = wakes.convection
+    state.add(pairs[joins], (wake_convection * centre_speed)[joins], width[joins] ** 2,
+              centre_y[joins], centre_z[joins], hub_speed[joins])
+    # A rotor no wake has joined yet: its wakes add linearly (weight 1 for this one).
+    convection = np.where(state.count[pairs] > 0, state.velocity[pairs], wake_convection)
+    u, v = rotor.kind_u[f, kind], rotor.kind_v[f, kind]
+    flowing = u * pick(per_pair["cos"])[:, None] + v * pick(per_pair["sin"])[:, None] > 0.0
+    total = removed_moments(wakes.cells, wakes.combined, pairs, convection,
+                            np.where(flowing, u, 0.0), moment[reached])
+    removed = np.zeros((flat.size, wakes.cells.n**2))
+    removed[reached] = total - wakes.removed[pairs] / wakes.cells.n**2
+    return removed
+
+
+def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
+                   ambient_turbulence, n_findex):
+    """Ishihara & Qian's (2018) added turbulence of turbine i's wake at rotors (f, j), the mean
+    over each rotor's sub-points (the wake's centre at the rows, ``centre``: (pairs, rows)),
+    not below 0 (the ground term lowers it below the hub), within 15 D downstream as FLORIS has
+    Crespo-Hernandez (docs/coupling.md#wakes-deep-in-an-array)."""
+    cells = rotor.cells
+    radius_j = rotor.radius[f, j][:, None, None]
+    lateral = (per_pair["offset"][reached][:, None] - centre)[:, :, None] \
+        + radius_j * cells.sub_y
+    heights = rotor.kind_heights[kind][:, :, None]
+    r = np.hypot(lateral, heights - hub_height[:, None, None])
+    diameter = 2.0 * per_pair["radius"][reached]
+    ambient = np.broadcast_to(ambient_turbulence, (n_findex, 1, 1, 1))[f, 0, 0, 0]
+    column = lambda a: a[:, None, None]  # noqa: E731
+    added = ishihara_qian_added_turbulence(
+        column(x), r, np.broadcast_to(heights, r.shape), column(per_pair["ct"][reached]),
+        column(ambient), column(diameter), column(hub_height))
+    mean = np.einsum("prs,rs->p", added, cells.weight)
+    return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 
 def _check_resolution(x, source_wake, centre, radius_j, cells, warned):

@@ -42,10 +42,11 @@ from floris_ekman_veer.wake.fused import (
 #: deflection model's (its ``kernel_table``: the centre's t_hat prefactor, R sqrt(A*), the image
 #: vortex's hub height, the veer and ground-image switches).
 WAKE_COLUMNS = WAKE_TABLE[:7]
-PAIR_COLUMNS = ("x", "offset", "radius_j", "moment", "reach_squared", "overlap_edge")
+PAIR_COLUMNS = ("x", "offset", "radius_j", "moment", "reach_squared", "overlap_edge",
+                "velocity_scale")
 CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
-CONDITION_COLUMNS = ("velocity_scale", "cos", "sin", "friction_velocity", "radius",
-                     "hub_height", *(f"centre_{k}" for k in CENTRE_COLUMNS))
+CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
+                     *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
 #: numba's threading layer where the user has not chosen one: one that survives a fork
 #: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
@@ -64,9 +65,9 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
     for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
         strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
-        x, offset, radius_j, moment, reach_squared, overlap_edge = pair[k]
+        x, offset, radius_j, moment, reach_squared, overlap_edge, scale = pair[k]
         f, kk = condition[k], kind[k]
-        (scale, cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
+        (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
          ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
@@ -172,6 +173,7 @@ def _near_pairs(f, j, x, table, width_column, amplitude_column, centre_column, n
         pair[count, 3] = rotor_moment[fp, jp]
         pair[count, 4] = reach_squared
         pair[count, 5] = edge
+        pair[count, 6] = hub_speed[fp] * speed_fraction[fp]
         count += 1
     return count
 

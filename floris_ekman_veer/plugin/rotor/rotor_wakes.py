@@ -20,6 +20,7 @@ import attrs
 import numba
 import numpy as np
 
+from floris_ekman_veer.plugin.rotor.convection import WakeConvection
 from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells
 from floris_ekman_veer.wake.fused import JIT
 
@@ -48,7 +49,13 @@ COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
 
 #: Each rule's number in the compiled kernel (:func:`superposed`; 0: no rule, each wake alone).
 #: A new rule is a row here and a branch there.
-RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3}
+RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3, "momentum_conserving": 4}
+
+#: The velocity models' ``wake_superposition`` choices: FLORIS's combination model point-wise
+#: at the sub-points, or Zong & Porte-Agel's (2020) momentum-conserving weights, on FLORIS's
+#: ``fls``, or Bastankhah et al.'s (2021) cumulative wake, summed by ``fls``
+#: (plugin/rotor/convection.py, docs/coupling.md#wakes-deep-in-an-array).
+WAKE_SUPERPOSITIONS = ("combination_model", "momentum_conserving", "cumulative")
 
 #: FLORIS's sequential solver counts a rotor point as overlapped by a wake where the wake's
 #: velocity there exceeds this [m/s]; the rotor cells take the area of the disk where it does.
@@ -59,13 +66,16 @@ WAKE_OVERLAP_VELOCITY = 0.05
 def superposed(rule, old, du):
     """The combined wake velocity at a sub-point after adding ``du`` to ``old`` by the rule
     numbered ``rule`` (:data:`RULE_CODES`): sqrt(old^2 + du^2), old + du, max(old, du), or du
-    alone."""
+    alone; for the momentum-conserving rule (4) the sum of U_c,i u_i, ``du`` being the wake's
+    deficit times its convection velocity (plugin/rotor/convection.py)."""
     if rule == 1:
         return np.sqrt(old * old + du * du)
     if rule == 2:
         return old + du
     if rule == 3:
         return du if du > old else old
+    if rule == 4:
+        return old + du
     return du
 
 
@@ -123,6 +133,9 @@ class RotorWakes:
         turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
             ambient one.
         turbulence_model: FLORIS's wake-added turbulence model, or None.
+        convection: the wakes kept at each rotor (``superposition`` "momentum_conserving"
+            or "cumulative"), or None.
+        superposition: the velocity model's ``wake_superposition``.
         reached: the rotors (f, j) the latest wake reached (plugin/rotor/rotor.py), a superset
             of those where its deficit is not 0, or None.
     """
@@ -134,18 +147,35 @@ class RotorWakes:
     wake: np.ndarray
     turbulence: np.ndarray
     turbulence_model: object = None
+    convection: WakeConvection | None = None
+    superposition: str = "combination_model"
     reached: tuple | None = None
 
     @classmethod
     def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,
-              ambient_turbulence) -> RotorWakes:
-        """An empty farm for ``wake_models`` (FLORIS's WakeModelManager or None)."""
+              ambient_turbulence, superposition="combination_model") -> RotorWakes:
+        """An empty farm for ``wake_models`` (FLORIS's WakeModelManager or None) and the
+        velocity model's ``wake_superposition``."""
         rule = None
         turbulence_model = None
         if wake_models is not None:
             rule = COMBINATION_RULES.get(type(wake_models.combination_model).__name__)
             turbulence_model = wake_models.turbulence_model
         pairs = n_findex * n_turbines
+        convection = None
+        if superposition == "momentum_conserving" and rule not in (None, "fls"):
+            raise ValueError(
+                "wake_superposition: momentum_conserving returns the rotors' wakes as "
+                "increments of a sum: it needs wake.model_strings.combination_model: fls, "
+                f"got {rule!r} (docs/coupling.md#wakes-deep-in-an-array)")
+        if superposition != "combination_model" and rule == "fls":
+            # (The cumulative wake is summed; with another combination, each wake is combined
+            # by it alone, as input_checks.warn_deficit_superposition says.)
+            if superposition == "momentum_conserving":
+                rule = "momentum_conserving"
+            # (the cumulative wake keeps its upstream wakes at each grid point of a rotor)
+            convection = WakeConvection.start(
+                pairs, n_turbines, cells.n**2 if superposition == "cumulative" else 1)
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
         combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),
@@ -153,7 +183,8 @@ class RotorWakes:
         turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
                                      (n_findex, n_turbines)).copy()
         return cls(cells, rule, combined, np.zeros((pairs, cells.n**2)),
-                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model)
+                   np.zeros((pairs, cells.n**2)), turbulence, turbulence_model, convection,
+                   superposition if convection is not None else "combination_model")
 
     @property
     def rule_code(self) -> int:
@@ -188,7 +219,7 @@ class RotorWakes:
         total = u_cell * equivalent_deficit(removed, u_cell, moment)
         if self.rule == "sosfs":
             increment = np.sqrt(np.maximum(total**2 - self.wake[pair] ** 2, 0.0))
-        elif self.rule == "fls":
+        elif self.rule in ("fls", "momentum_conserving"):
             increment = total - self.wake[pair]
         else:  # max, or each wake alone
             increment = total

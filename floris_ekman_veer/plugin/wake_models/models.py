@@ -56,12 +56,14 @@ from floris_ekman_veer.plugin.rotor.rotor import (
     ROTOR_PLANE_MARGIN,
     TURBULENCE_OVERLAPS,
     WAKE_EXPANSIONS,
+    WAKE_TURBULENCES,
     WAKE_MODELS,
     RotorWakes,
     TurbineWake,
     rotor_cell_deficit,
 )
 from floris_ekman_veer.plugin.inflow.shallow import POLICIES as SHALLOW_POLICIES
+from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_SUPERPOSITIONS
 from floris_ekman_veer.plugin.rotor.turbine_states import handed as handed_turbine_states
 from floris_ekman_veer.plugin.wake_models.wake_inputs import (
     GLAUERT_THRUST_COEFFICIENT,
@@ -75,6 +77,7 @@ from floris_ekman_veer.plugin.wake_models.wake_inputs import (
 from floris_ekman_veer.wake.deficit import (
     CURL_ALPHA,
     WIDTH_FACTOR,
+    axial_induction,
     max_deficit,
     normalised_deficit,
     stream_tube_area_ratio,
@@ -88,6 +91,7 @@ from floris_ekman_veer.wake.fused import (
 )
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit, bastankhah2014_wake
 from floris_ekman_veer.wake.near_wake import NEAR_WAKES, near_wake_shape
+from floris_ekman_veer.wake.superposition import cumulative_deficit, overlap_weight
 
 __all__ = ["EkmanVeerVelocityDeficit", "EkmanVeerVelocityDeflection", "EkmanWakeModel",
            "Gaussian2014VelocityDeficit"]
@@ -125,6 +129,19 @@ class EkmanWakeModel(BaseModel):
     #: Porte-Agel 2016), or "wake_velocity", the area where the wake's velocity exceeds 0.05 m/s
     #: (FLORIS's count) (docs/coupling.md#wakes-deep-in-an-array).
     turbulence_overlap: str = choice_field("wake_radius", TURBULENCE_OVERLAPS)
+    #: The form of a wake's added turbulence (turbine grid): "crespo_hernandez" (the default),
+    #: FLORIS's turbulence model weighted with ``turbulence_overlap``; "ishihara_qian", Ishihara
+    #: & Qian (2018, wake/added_turbulence.py) averaged over the rotor, its ring-shaped profile
+    #: its own overlap (docs/coupling.md#wakes-deep-in-an-array).
+    wake_turbulence: str = choice_field("crespo_hernandez", WAKE_TURBULENCES)
+    #: How the wakes superpose (docs/coupling.md#wakes-deep-in-an-array): "combination_model"
+    #: (the default), FLORIS's combination model point-wise with C(x) scaled by
+    #: ``deficit_velocity``; "cumulative", the cumulative wake of Bastankhah et al. (2021,
+    #: wake/superposition.py): each wake's centre deficit carries its rotor's thrust through the
+    #: upstream wakes there, the deficits summed (with FLORIS's ``fls``; with another
+    #: combination each wake is combined by it alone); "momentum_conserving", Zong & Porte-Agel
+    #: (2020, plugin/rotor/convection.py; turbine grid only), with ``fls``.
+    wake_superposition: str = choice_field("combination_model", WAKE_SUPERPOSITIONS)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/inflow/shallow.py).
@@ -168,14 +185,14 @@ class EkmanWakeModel(BaseModel):
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
         ambient = Ambient.of(grid, flow_field)
         wakes = None
+        # FLORIS's wake models only if they are the ones calling this model.
+        wake_models = WAKE_MODELS.get()
+        if wake_models is not None and wake_models.velocity_model is not self:
+            wake_models = None
         if ambient.rotor is not None:
-            # A fresh superposition per solve (plugin/rotor/rotor.py); FLORIS's wake models only if
-            # they are the ones calling this model.
-            wake_models = WAKE_MODELS.get()
-            if wake_models is not None and wake_models.velocity_model is not self:
-                wake_models = None
+            # A fresh superposition per solve (plugin/rotor/rotor.py).
             wakes = RotorWakes.start(ambient.rotor.cells, *ambient.rotor.x.shape, wake_models,
-                                     ambient.floris_turbulence)
+                                     ambient.floris_turbulence, self.wake_superposition)
         return {
             "x": grid.x_sorted,
             "y": grid.y_sorted,
@@ -186,7 +203,16 @@ class EkmanWakeModel(BaseModel):
             # Other grids: the turbine grid's rotor states, when the solve hands them
             # (plugin/rotor/turbine_states.py, docs/coupling.md#one-physics-on-every-grid).
             "states": None if ambient.rotor is not None else handed_turbine_states(),
+            # Other grids with the cumulative wake: the upstream wakes' centre deficits, widths
+            # and centres at every point, appended wake by wake (:meth:`_cumulative_scale`).
+            "upstream": [] if ambient.rotor is None and self._cumulative(wake_models) else None,
         }
+
+    def _cumulative(self, wake_models) -> bool:
+        """Whether the cumulative wake runs: ``wake_superposition: cumulative`` with FLORIS's
+        ``fls`` (with another combination each wake is combined by it alone)."""
+        return (self.wake_superposition == "cumulative" and wake_models is not None
+                and type(wake_models.combination_model).__name__ == "FLS")
 
     def function(
         self,
@@ -208,6 +234,7 @@ class EkmanWakeModel(BaseModel):
         ambient: Ambient,
         wakes: RotorWakes | None = None,
         states=None,
+        upstream: list | None = None,
     ) -> np.ndarray:
         """FLORIS's velocity-model call: Delta u / u_initial of turbine i's wake at the grid.
 
@@ -254,14 +281,37 @@ class EkmanWakeModel(BaseModel):
         if ambient.cubature_points is not None:
             self._check_cubature(wake, deflection_field_i, ambient)
         deficit = self.normalised_deficit(wake)
+        scale = hub_speed * speed_fraction
+        if upstream is not None:
+            fraction = 1.0 if states is None else states.at(x_i, y_i)[0]
+            scale = self._cumulative_scale(wake, y_i + deflection_field_i, hub_height_i,
+                                           hub_speed * fraction, upstream)
         # FLORIS multiplies the returned deficit by u_initial: return Delta u / u_initial. Where
         # there is no inflow (at and below z0) there is no wake. A wake at most stops the flow:
         # where the Gaussian's tail, scaled by U_h, reaches an inflow slower than itself (next to
         # the ground, where U(z) -> 0) Delta u is limited to U(z) (docs/wake_model.md#which-velocity-goes-where).
         flowing = (u_initial > 0) & (local_u > 0)
         safe_u = np.where(flowing, u_initial, 1.0)
-        return np.where(
-            flowing, np.minimum(deficit * (hub_speed * speed_fraction) / safe_u, 1.0), 0.0)
+        return np.where(flowing, np.minimum(deficit * scale / safe_u, 1.0), 0.0)
+
+    def _cumulative_scale(self, wake: TurbineWake, centre_y, centre_z, incoming_speed,
+                          upstream: list):
+        """C_n / C(x) at the points of a grid other than the turbine grid: the cumulative wake's
+        centre deficit (Bastankhah et al. 2021, wake/superposition.py) over the model's own, with
+        the upstream wakes of ``upstream`` at each point; this wake is appended to it (0 where
+        the points are not downstream). The turbine grid does the same per rotor
+        (plugin/rotor/convection.py)."""
+        args = (wake.dx, wake.k_w, wake.radius, wake.ct, wake.yaw)
+        single = self.centre_deficit(*args)
+        table = self.kernel_table(*args, wake.friction_velocity, wake.hub_speed)
+        width_squared = (table["kx"] + table["xi0"]) ** 2
+        overlap = sum((overlap_weight(width_squared, w, (centre_y - y) ** 2 + (centre_z - z) ** 2)
+                       * c for c, w, y, z in upstream), np.zeros_like(single))
+        deficit = cumulative_deficit(single, wake.hub_speed, incoming_speed, overlap,
+                                     2.0 * axial_induction(wake.ct, wake.yaw) * incoming_speed)
+        deficit = np.where(wake.dx > 0.0, deficit, 0.0)
+        upstream.append((deficit, width_squared, centre_y, centre_z))
+        return deficit / np.where(single > 0.0, single, 1.0)
 
     def wake_thrust_coefficient(self, ct_i, yaw):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""

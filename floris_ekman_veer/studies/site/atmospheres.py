@@ -43,7 +43,8 @@ class SiteSummary:
         class_by_hour: fitted records per hour of day (rows 0-23) and class (None when the
             records' names are no time stamps).
         offsets: the vane offsets applied [deg] (reading minus true direction, relative to the
-            reference vane), their standard errors, the records they come from, and the source.
+            reference vane), their standard errors (statistical) and the reference turning's
+            systematic uncertainty (offsets.py), the records they come from, and the source.
         cup_pairs: each redundant cup pair's median ratio where neither is in the mast's wake,
             its standard error and whether the pair disagrees.
         flags: the instruments' values removed, per kind and column: the count, the first time
@@ -52,6 +53,8 @@ class SiteSummary:
             neutral TI with its standard error, the model's neutral TI; baseline.py).
         tops_below_reference: fitted records whose layer is so shallow that their I_u at the
             reference height is 0 (its top below 1 / 1.62 of it; warned by :func:`fit_site`).
+        cup_calibrations: per cup the calibration applied (its certificate's slope, offset and
+            uncertainty, and the logger's transfer function it replaced; readings.py).
     """
 
     exclusions: pd.DataFrame
@@ -66,6 +69,7 @@ class SiteSummary:
     flags: pd.DataFrame
     tops_below_reference: int = 0
     baseline: pd.DataFrame | None = None
+    cup_calibrations: pd.DataFrame | None = None
 
     def plot_class_by_hour(self, ax=None):
         """Stacked bars of the fitted classes' fractions per hour of day; returns the Axes."""
@@ -94,6 +98,11 @@ class SiteSummary:
                  f"%; {100 * self.kept_fraction_not_calm:.1f} % of those not calm)",
                  "classes: " + ", ".join(f"{k} {int(v)}" for k, v in self.classes.items()),
                  "left out:\n" + self.exclusions.drop(columns="example").to_string()]
+        if self.cup_calibrations is not None and (
+                self.cup_calibrations["source"] == "certificate").any():
+            parts.append("cup calibrations applied (certificate replacing the logger's transfer "
+                         "function; uncertainty relative):\n"
+                         + self.cup_calibrations.to_string(float_format="{:.5g}".format))
         if self.offsets is not None and len(self.offsets):
             parts.append("vane offsets applied [deg] (reading minus true, relative to the "
                          "reference vane):\n" + self.offsets.to_string(float_format="{:.2f}".format))
@@ -155,6 +164,8 @@ class SiteAtmosphere:
     baseline: NeutralBaseline | None = None
     #: The mast's metadata file as read (wra_file.py: location, logger's UTC offset, columns).
     metadata: MastMetadata | None = None
+    #: Per cup the calibration applied (readings.py's calibrated_cups).
+    cup_calibrations: pd.DataFrame | None = None
 
     @property
     def neutral_roughness_lengths(self) -> np.ndarray | None:
@@ -216,6 +227,7 @@ class SiteAtmosphere:
             class_by_hour=by_hour, offsets=self.offsets, cup_pairs=self.cup_pairs,
             tops_below_reference=int(np.count_nonzero(self.turbulence_intensities <= 0.0)),
             baseline=None if self.baseline is None else self.baseline.sectors,
+            cup_calibrations=self.cup_calibrations,
             flags=flags.groupby(["kind", "column"]).agg(
                 records=("row", "size"), first=("time", "first"), example=("reason", "first")))
 

@@ -3,8 +3,9 @@ direction relative to the vane nearest the reference height, estimated from the 
 (docs/measurements.md#vane-offsets).
 
 Two passes: first from the strong-wind records (near-neutral by their wind: mechanical mixing)
-as the median turning from the reference vane minus the model's own neutral turning between those
-heights (:func:`neutral_turning`), the cups then read again with the corrected directions
+as the median turning from the reference vane minus the neutral reference turning between those
+heights (:func:`neutral_turning`: the published neutral forms compared, the constant-stress
+surface layer's chosen, the others' departure from it the systematic uncertainty), the cups then read again with the corrected directions
 (stage 2's :func:`~.readings.read_cups_again`); then again from the strong-wind records that a
 fit of either sign finds neutral, since a strong wind of a stable night turns with height more
 than a neutral one and would move the median (:func:`offsets_from_neutral_fits`). Given offsets
@@ -14,6 +15,7 @@ than a neutral one and would move the median (:func:`offsets_from_neutral_fits`)
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
@@ -81,15 +83,66 @@ def offsets_from_neutral_fits(instruments: Instruments, reference_height: float,
                              neutral_turning(fit_options_and_inputs))
 
 
+#: The surface layer, where the stress is constant with height and the wind does not turn
+#: (Monin-Obukhov similarity), is the lowest tenth of the neutral boundary layer (Stull 1988,
+#: *An Introduction to Boundary Layer Meteorology*, sect. 1.3 and 9.7).
+SURFACE_LAYER_FRACTION = 0.1
+#: The neutral turning forms compared between the vanes (docs/measurements.md#vane-offsets); the
+#: first is the reference, the others' departures from it its systematic uncertainty.
+TURNING_FORMS = ("surface layer", "Ekman layer from the ground", "model")
+
+
 def neutral_turning(fit_options_and_inputs: dict):
-    """The model's neutral turning between heights (for the vane offsets): the direction at
-    ``heights`` minus that at ``height`` [deg, meteorological] per speed at ``height``."""
+    """The neutral turning between heights by the published forms (module docstring): a
+    function of (speeds at ``height``, ``height``, ``heights``) giving ``{form: (n, m) array}``,
+    the direction at ``heights`` minus that at ``height`` [deg, meteorological: positive
+    clockwise], per :data:`TURNING_FORMS`:
+
+    * "surface layer" (the reference): none within the constant-stress surface layer (the lowest
+      :data:`SURFACE_LAYER_FRACTION` of the neutral layer's depth h), and above it the
+      geostrophic drag law's whole turning alpha_0 (Eq. GDL: tan alpha_0 = -V_g / U_g) spread
+      evenly up to h, veering (clockwise with height in the northern hemisphere);
+    * "Ekman layer from the ground": alpha_0 spread evenly from the ground to h (no
+      constant-stress layer: the most an Ekman layer turns near the ground with a uniform rate);
+    * "model": the model's own neutral turning (EkmanABL with L = inf at the site's inputs),
+      which near the ground turns counterclockwise by a few tenths of a degree before veering
+      above (its surface layer's matching, not a published neutral form).
+
+    h, alpha_0 and u* are the model's neutral state at each speed."""
     fixed = {k: (float(np.median(v)) if np.ndim(v) else v)
              for k, v in fit_options_and_inputs.items() if k not in FIT_OPTIONS}
 
     def turning(speed, height, heights):
         abl = EkmanABL.from_reference_wind(speed, height, obukhov_length=np.inf, **fixed)
-        angle = np.asarray(abl.wind_angle(np.asarray(heights, float)[:, None]), float)
-        return -(angle - np.asarray(abl.wind_angle(height), float)[None, :]).T
+        heights = np.asarray(heights, float)
+        angle = np.asarray(abl.wind_angle(heights[:, None]), float)
+        model = -(angle - np.asarray(abl.wind_angle(height), float)[None, :]).T
+        depth = np.asarray(abl.boundary_layer_height, float).reshape(-1, 1)
+        # the whole turning, clockwise with height in the northern hemisphere
+        whole = (np.abs(np.asarray(abl.cross_isobaric_angle, float)).reshape(-1, 1)
+                 * np.asarray(abl.hemisphere, float).reshape(-1, 1))
+        top = SURFACE_LAYER_FRACTION * depth
+
+        def above_surface_layer(z):
+            return whole * np.clip(z - top, 0.0, None) / (depth - top)
+
+        def from_ground(z):
+            return whole * np.minimum(z, depth) / depth
+
+        return {"surface layer": above_surface_layer(heights[None, :])
+                - above_surface_layer(height),
+                "Ekman layer from the ground": from_ground(heights[None, :]) - from_ground(height),
+                "model": model}
 
     return turning
+
+
+def turning_forms_between(fit_options_and_inputs: dict, speeds, height: float, lower: float,
+                          upper: float) -> pd.DataFrame:
+    """The neutral forms' median turning from ``lower`` to ``upper`` [deg, meteorological] at
+    the speeds ``speeds`` at ``height`` (:func:`neutral_turning`): the comparison behind the
+    reference turning, for a report or the docs."""
+    forms = neutral_turning(fit_options_and_inputs)(np.asarray(speeds, float), height,
+                                                     np.array([upper, lower]))
+    return pd.DataFrame({"turning_deg": {k: float(np.median(v[:, 0] - v[:, 1]))
+                                         for k, v in forms.items()}})

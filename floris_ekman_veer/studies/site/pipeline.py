@@ -9,8 +9,9 @@ the records. :func:`fit_site` runs, each stage a module a user can call and insp
 
 1. the instruments the columns hold (:func:`.columns.mast_columns`), named by the mast's IEA
    Wind Task 43 metadata file where one is given (:func:`.wra_file.read_wra_file`);
-2. the cleaned readings: bad and stuck readings removed and named, redundant cups out of the
-   mast's wake (:func:`.readings.read_instruments`);
+2. the cleaned readings: the cups' calibration certificates applied first where given
+   (:func:`.readings.calibrated_cups`), bad and stuck readings removed and named, redundant cups
+   out of the mast's wake (:func:`.readings.read_instruments`);
 3. the site's neutral baseline (its roughness rose and neutral turbulence,
    :func:`.baseline.neutral_baseline`) and the vane offsets, both from the strong-wind,
    near-neutral records (:func:`.offsets.estimate_vane_offsets`);
@@ -29,7 +30,8 @@ from floris_ekman_veer.studies.site.atmospheres import SiteAtmosphere, site_atmo
 from floris_ekman_veer.studies.site.baseline import checked_roughness, neutral_baseline
 from floris_ekman_veer.studies.site.columns import mast_columns
 from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
-from floris_ekman_veer.studies.site.readings import SHADOW_HALF_WIDTH, read_instruments
+from floris_ekman_veer.studies.site.readings import (SHADOW_HALF_WIDTH, calibrated_cups,
+                                                     read_instruments)
 from floris_ekman_veer.studies.site.record_fit import fit_records
 from floris_ekman_veer.studies.site.stability import checked_site_type
 from floris_ekman_veer.studies.site.wra_file import read_wra_file
@@ -47,7 +49,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
              direction_offsets="estimate", shadow_half_width: float = SHADOW_HALF_WIDTH,
              roughness_length="estimate", metadata=None, site_type: str | None = None,
              longitude: float | None = None, time_zone: str | None = None,
-             **fit_options_and_inputs) -> SiteAtmosphere:
+             cup_calibrations: dict | None = None, **fit_options_and_inputs) -> SiteAtmosphere:
     """Fit every record of a site (module docstring) and give FLORIS's inputs per record.
 
     The mast's instruments are read first (columns.py, readings.py, offsets.py;
@@ -100,6 +102,14 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
         longitude: [deg, east positive] the site's, for the sun's position.
         time_zone: the time zone of naive time stamps ("UTC", "Europe/London", "+01:00"):
             never guessed; stamps that carry their offset need none.
+        cup_calibrations: the cups' calibration certificates, ``{cup column: {"slope": s,
+            "offset": o, "logger_slope": s_L, "logger_offset": o_L[, "uncertainty": u]}}``: each
+            cup's readings re-calibrated from the logger's generic transfer function (s_L, o_L)
+            to its certificate's (s, o) before anything else, as wind-resource practice does;
+            ``u`` the certificate's relative uncertainty of the slope (readings.py's
+            ``calibrated_cups``; docs/measurements.md#the-sites-neutral-baseline). A metadata
+            file's sensor calibrations are read the same way; a cup the records lack, or a
+            certificate that contradicts the file's, is refused naming both.
         **fit_options_and_inputs: ``EkmanABL.fit_profile``'s options and fixed inputs
             (``latitude``, ``roughness_length``, ``speed_noise``...).
 
@@ -176,14 +186,21 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
                          f"times the highest measurement ({top:g} m: the fitted profile is not "
                          f"extrapolated further); got {reference_height!r} m")
     z_ref = float(reference_height)
-    # 2. the cleaned readings
+    # 2. the cleaned readings: the cups' certificates first (every later stage reads them)
+    records, calibrations = calibrated_cups(records, columns, _certificates(
+        cup_calibrations, mast, metadata))
     instruments = read_instruments(records, columns, booms=booms,
                                    direction_offsets=direction_offsets,
                                    shadow_half_width=shadow_half_width, labels=labels)
-    # 3. the neutral baseline and the vane offsets (whose reference turning is the model's
-    # neutral one at the site's roughness)
+    # 3. the neutral baseline and the vane offsets (whose reference turning is the neutral
+    # surface layer's, the model's state at the site's roughness giving its depth: offsets.py)
+    # (a height's speed is its cups' mean: its calibration uncertainty, relative, is theirs
+    # combined over their number)
+    per_height = calibrations.groupby("height")["uncertainty"].agg(
+        lambda u: float(np.sqrt(np.sum(np.square(u))) / len(u)))
     baseline = neutral_baseline(instruments, z_ref, fit_options_and_inputs, roughness_length,
-                                cups_per_height=[len(columns.cups[h]) for h in columns.cup_heights])
+                                cups_per_height=[len(columns.cups[h]) for h in columns.cup_heights],
+                                calibration_uncertainty=per_height.loc[columns.cup_heights])
     fit_inputs = {**fit_options_and_inputs, "roughness_length": (
         roughness_length if np.ndim(roughness_length) == 0 and not isinstance(
             roughness_length, (str, dict)) else baseline.roughness_lengths)}
@@ -198,4 +215,29 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     # 5. the atmospheres
     site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
                            stability_input=stability_input)
+    site = attrs.evolve(site, cup_calibrations=calibrations)
     return site if mast is None else attrs.evolve(site, metadata=mast)
+
+
+def _certificates(cup_calibrations, mast, metadata):
+    """The cups' certificates given and the metadata file's together (by the records' column
+    names: the file's logger names are accepted too); ValueError where both give one cup's and
+    they differ."""
+    from_file = dict(mast.cup_calibrations) if mast is not None else {}
+    if cup_calibrations is None:
+        return from_file or None
+    if not isinstance(cup_calibrations, dict):
+        raise ValueError(f"fit_site: cup_calibrations must be {{cup column: certificate}}; got "
+                         f"{type(cup_calibrations).__name__}")
+    names = dict(zip(mast.columns["column"], mast.columns["name"])) if mast is not None else {}
+    merged = dict(from_file)
+    for column, certificate in cup_calibrations.items():
+        name = names.get(column, column)
+        if name in from_file and isinstance(certificate, dict) and any(
+                not np.isclose(certificate.get(k, np.nan), v, rtol=1e-9, atol=0.0)
+                for k, v in from_file[name].items() if k != "uncertainty"):
+            raise ValueError(f"fit_site: cup_calibrations[{column!r}] = {certificate} contradicts "
+                             f"the mast's metadata file {str(metadata)!r}, whose certificate of "
+                             f"that cup is {from_file[name]}; give one of them")
+        merged[name] = certificate
+    return merged

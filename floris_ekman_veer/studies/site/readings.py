@@ -19,6 +19,10 @@ What :func:`read_instruments` makes of them:
 * given vane offsets (``direction_offsets={38: -4.1}``) subtracted from the readings; estimated
   ones are stage 3's (offsets.py), which reads the cups again with them (:func:`read_cups_again`).
 
+Before anything else, the cups' calibration certificates where given
+(:func:`calibrated_cups`): each cup's reading re-calibrated from the logger's generic transfer
+function to its own certificate's, as wind-resource practice does (IEC 61400-12-1 Annex F).
+
 Also the readings as the fit's data (:func:`fit_heights`, :func:`fit_data`) and the measured
 turbulence intensity (:func:`measured_turbulence`).
 """
@@ -72,6 +76,19 @@ UNIT_SITE_RECORDS = 720
 #: height is dead or stalled, not in a calm.
 DEAD_CUP_SPEED = 0.5
 DEAD_CUP_PARTNER = 2.0
+#: A cup's calibration uncertainty, relative, without its certificate applied: the logger's
+#: generic transfer function against the cup's own (IEC 61400-12-1 Annex E: about 1 % for a
+#: class-1 cup).
+CUP_CALIBRATION_GENERIC = 0.01
+#: A calibration certificate's standard uncertainty of a cup's slope, relative, where the
+#: certificate gives none: the part that differs between cups calibrated in one accredited wind
+#: tunnel (its repeatability and the cup's own fit; MEASNET, *Cup anemometer calibration
+#: procedure*, v2, 2009). The tunnel's reference, common to the cups, cancels in a ratio of two
+#: of them, which is what the roughness rose reads (baseline.py).
+CERTIFICATE_UNCERTAINTY = 0.0015
+#: A certificate's entries: its own slope [m/s per logger unit] and offset [m/s], and the
+#: logger's generic transfer function (slope and offset) the readings were logged with.
+CERTIFICATE_KEYS = ("slope", "offset", "logger_slope", "logger_offset")
 #: What is named per value removed.
 FLAG_KINDS = ("infinite reading", "dead cup", "cups disagree", "stuck vane")
 
@@ -87,8 +104,8 @@ class Instruments:
         vane_heights, directions: the vanes' directions with their offsets removed [deg];
         offsets: per vane height (index) ``offset_deg`` (reading minus true direction, relative
             to the reference vane), ``uncertainty_deg`` (standard error), ``systematic_deg``
-            (the reference turning's: the model's neutral turning against the surface
-            layer's), ``records`` and
+            (the reference turning's: the largest departure of the published neutral forms'
+            turning between the vanes from the surface layer's, offsets.py), ``records`` and
             ``source`` ("reference", "estimated", "given", or "not estimated");
         cup_pairs: per cup height with two cups or more: the cups, their median ratio over the
             records where none is in the mast's wake, its standard error, the records, and
@@ -105,6 +122,80 @@ class Instruments:
     offsets: pd.DataFrame
     cup_pairs: pd.DataFrame
     flags: pd.DataFrame
+
+
+def calibrated_cups(records: pd.DataFrame, columns: MastColumns, cup_calibrations=None):
+    """``records`` with each certified cup's readings re-calibrated (module docstring), and the
+    table of the calibrations applied (per cup column: ``slope``, ``offset``, ``logger_slope``,
+    ``logger_offset``, ``uncertainty`` and ``source``; every cup, "logged" where no certificate
+    was given, with :data:`CUP_CALIBRATION_GENERIC` as its uncertainty).
+
+    ``cup_calibrations``: ``{cup column: {"slope": s, "offset": o, "logger_slope": s_L,
+    "logger_offset": o_L[, "uncertainty": u]}}``: the logger's value v = s_L f + o_L (f the
+    cup's rotation frequency or pulse rate) becomes s f + o = s (v - o_L) / s_L + o, its
+    standard deviation times s / s_L; a reading of 0 or less (a stopped or dead cup) is left as
+    it is. ``uncertainty``: the certificate's relative standard uncertainty of the slope
+    (default :data:`CERTIFICATE_UNCERTAINTY`). ValueError naming a cup the records lack, or an
+    entry missing or out of range."""
+    cups = {c: (h, std) for h in columns.cup_heights for _, c, std in columns.cups[h]}
+    given = {} if cup_calibrations is None else cup_calibrations
+    if not isinstance(given, dict):
+        raise ValueError(f"fit_site: cup_calibrations must be {{cup column: {{'slope': ..., "
+                         f"'offset': ..., 'logger_slope': ..., 'logger_offset': ...}}}}; got "
+                         f"{type(given).__name__}")
+    lacking = [c for c in given if c not in cups]
+    if lacking:
+        raise ValueError(f"fit_site: cup_calibrations names cup {lacking[0]!r}, which the "
+                         f"records lack (their cups: {sorted(cups)}); give the certificates of "
+                         "the mast's own cups")
+    rows = []
+    out = records.copy() if given else records
+    for column, (height, std) in cups.items():
+        entry = given.get(column)
+        if entry is None:
+            rows.append({"cup": column, "height": height, "slope": np.nan, "offset": np.nan,
+                         "logger_slope": np.nan, "logger_offset": np.nan,
+                         "uncertainty": CUP_CALIBRATION_GENERIC, "source": "logged"})
+            continue
+        values = _certificate(column, entry)
+        gain = values["slope"] / values["logger_slope"]
+        reading = out[column].to_numpy(dtype=float)
+        out[column] = np.where(reading > 0, (reading - values["logger_offset"]) * gain
+                               + values["offset"], reading)
+        if std is not None:
+            out[std] = out[std].to_numpy(dtype=float) * gain
+        rows.append({"cup": column, "height": height, **values, "source": "certificate"})
+    table = pd.DataFrame(rows, columns=["cup", "height", *CERTIFICATE_KEYS, "uncertainty",
+                                        "source"]).set_index("cup")
+    return out, table
+
+
+def _certificate(column, entry):
+    """A certificate's entries checked (calibrated_cups)."""
+    if not isinstance(entry, dict):
+        raise ValueError(f"fit_site: cup_calibrations[{column!r}] must be a mapping with "
+                         f"{list(CERTIFICATE_KEYS)} (and optionally 'uncertainty'); got {entry!r}")
+    missing = [k for k in CERTIFICATE_KEYS if k not in entry]
+    unknown = sorted(set(entry) - set(CERTIFICATE_KEYS) - {"uncertainty"})
+    if missing or unknown:
+        raise ValueError(f"fit_site: cup_calibrations[{column!r}] "
+                         + (f"lacks {missing}" if missing else f"has unknown entries {unknown}")
+                         + f": give {list(CERTIFICATE_KEYS)} (and optionally 'uncertainty')")
+    values = {k: entry[k] for k in CERTIFICATE_KEYS}
+    values["uncertainty"] = entry.get("uncertainty", CERTIFICATE_UNCERTAINTY)
+    for key, value in values.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer,
+                                                             np.floating)) or not np.isfinite(value):
+            raise ValueError(f"fit_site: cup_calibrations[{column!r}][{key!r}] must be a finite "
+                             f"number; got {value!r}")
+    for key in ("slope", "logger_slope"):
+        if values[key] <= 0:
+            raise ValueError(f"fit_site: cup_calibrations[{column!r}][{key!r}] must be > 0 "
+                             f"(m/s per logger unit); got {values[key]!r}")
+    if not 0 <= values["uncertainty"] < 0.1:
+        raise ValueError(f"fit_site: cup_calibrations[{column!r}]['uncertainty'] must be a "
+                         f"relative uncertainty in [0, 0.1); got {values['uncertainty']!r}")
+    return {k: float(v) for k, v in values.items()}
 
 
 def _numbers(records, columns):

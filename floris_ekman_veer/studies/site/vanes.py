@@ -149,14 +149,14 @@ def estimate_offsets(directions, vane_heights, speeds, cup_heights, reference_he
         if rows.size < OFFSET_MIN_RECORDS:
             table.loc[height, ["records", "source"]] = [rows.size, "not estimated"]
             continue
-        model = neutral_turning(speeds[rows, cup], cup_heights[cup],
+        forms = neutral_turning(speeds[rows, cup], cup_heights[cup],
                                 np.array([height, vane_heights[ref]]))
+        between = {name: form[:, 0] - form[:, 1] for name, form in forms.items()}
+        reference = next(iter(between.values()))  # (the first form is the reference)
         turning = wrapped_angle(directions[rows, k] - directions[rows, ref])
-        reference = model[:, 0] - model[:, 1]
         median, error = median_and_error(wrapped_angle(turning - reference))
-        # The reference turning's own uncertainty: the model's neutral turning between the
-        # vanes against the surface layer's, which Monin-Obukhov similarity makes zero (the
-        # stress and the wind aligned in the constant-flux layer); systematic, not statistical.
-        systematic = abs(float(np.median(reference)))
+        # The reference turning's own uncertainty: how far the other published forms turn
+        # between the vanes from it; systematic, not statistical.
+        systematic = max(abs(float(np.median(form - reference))) for form in between.values())
         table.loc[height, :] = [median, error, systematic, rows.size, "estimated"]
     return table

@@ -12,6 +12,13 @@ and the logger's columns with their statistics (``logger_measurement_config[].co
 column names of columns.py (cups on several booms at one height named ``b<orientation>``, e.g.
 ``speed_80m_b0``) with their booms, and refuses records that contradict the file (a column it
 names missing, naming both the measurement point and the records' columns).
+
+A cup's calibration certificate is read where the file gives one: the last calibration of the
+point's last sensor (``sensor[].calibration[]``: ``slope``, ``offset`` and
+``calibration_uncertainty[]``, the ``uncertainty`` [m/s] at each ``reference_bin`` [m/s], taken
+relative at the bin nearest :data:`CERTIFICATE_SPEED`), with the logger's generic transfer
+function it replaces (``logger_measurement_config[].slope`` and ``offset``, the last
+configuration's): ``fit_site``'s ``cup_calibrations`` (readings.py).
 """
 
 from __future__ import annotations
@@ -30,6 +37,9 @@ QUANTITIES = {"wind_speed": "speed", "wind_direction": "direction",
               "air_temperature": "temperature", "air_pressure": "pressure"}
 #: The file's statistics the fit reads, as the columns' suffixes ("" the mean).
 STATISTICS = {"avg": "", "sd": "_std"}
+#: [m/s] the certificate's uncertainty is read at its reference bin nearest this speed: the
+#: strong winds of the site's neutral baseline (baseline.py).
+CERTIFICATE_SPEED = 12.0
 
 
 @attrs.frozen(eq=False)
@@ -43,6 +53,8 @@ class MastMetadata:
             ``direction_78m``), the measurement point's name and height.
         booms: ``{boom: orientation_deg}`` of the cups on several booms at one height.
         vane_dead_bands: ``{vane height: dead-band orientation deg}`` where the file gives it.
+        cup_calibrations: ``{cup column (columns.py's name): certificate}`` of the cups whose
+            calibration the file gives (module docstring), as ``fit_site``'s ``cup_calibrations``.
     """
 
     latitude: float
@@ -51,6 +63,7 @@ class MastMetadata:
     columns: pd.DataFrame
     booms: dict
     vane_dead_bands: dict
+    cup_calibrations: dict = attrs.field(factory=dict)
 
     @property
     def time_zone(self) -> str | None:
@@ -99,12 +112,16 @@ def read_wra_file(path) -> MastMetadata:
     if len(offsets) > 1:
         raise ValueError(f"fit_site: metadata {where.name!r}: the logger's configurations give "
                          f"offsets from UTC {sorted(offsets)} h; the fit takes one")
-    points = []
+    points, certificates = [], {}
     for point in location.get("measurement_point") or []:
         quantity = QUANTITIES.get(point.get("measurement_type_id"))
         if quantity is None:
             continue
         mounting = (point.get("mounting_arrangement") or [{}])[-1]
+        if quantity == "speed":
+            certificate = _certificate(point, where.name)
+            if certificate is not None:
+                certificates[point.get("name")] = certificate
         for config in point.get("logger_measurement_config") or []:
             for column in config.get("column_name") or []:
                 suffix = STATISTICS.get(column.get("statistic_type_id"))
@@ -137,8 +154,41 @@ def read_wra_file(path) -> MastMetadata:
         names.append(name + row.suffix)
     table["name"] = names
     vanes = table[(table["quantity"] == "direction") & table["dead_band"].notna()]
+    means = table[(table["quantity"] == "speed") & (table["suffix"] == "")]
+    calibrations = {name: certificates[point] for point, name in zip(means["point"], means["name"])
+                    if point in certificates}
     return MastMetadata(
         latitude=float(latitude), longitude=float(longitude),
         utc_offset_hours=float(offsets.pop()) if offsets else None,
         columns=table[["column", "name", "point", "height"]].reset_index(drop=True),
-        booms=booms, vane_dead_bands=dict(zip(vanes["height"], vanes["dead_band"].astype(float))))
+        booms=booms, vane_dead_bands=dict(zip(vanes["height"], vanes["dead_band"].astype(float))),
+        cup_calibrations=calibrations)
+
+
+def _certificate(point, file_name):
+    """A wind-speed point's calibration certificate with the logger's transfer function it
+    replaces (module docstring), or None where the file gives no calibration; ValueError where
+    it gives one but not the logger's slope and offset."""
+    sensors = [s for s in point.get("sensor") or [] if s.get("calibration")]
+    if not sensors:
+        return None
+    calibration = sensors[-1]["calibration"][-1]
+    if calibration.get("slope") is None or calibration.get("offset") is None:
+        return None
+    logger = [c for c in point.get("logger_measurement_config") or []
+              if c.get("slope") is not None and c.get("offset") is not None]
+    if not logger:
+        raise ValueError(f"fit_site: metadata {file_name!r}: measurement point "
+                         f"{point.get('name')!r} gives its cup's calibration but not the "
+                         "logger's slope and offset (logger_measurement_config), which the "
+                         "certificate replaces")
+    certificate = {"slope": calibration["slope"], "offset": calibration["offset"],
+                   "logger_slope": logger[-1]["slope"], "logger_offset": logger[-1]["offset"]}
+    bins = [(b["reference_bin"], b["uncertainty"])
+            for b in calibration.get("calibration_uncertainty") or []
+            if b.get("reference_bin") and b.get("uncertainty") is not None
+            and b.get("reference_unit") in (None, "m/s")]
+    if bins:
+        speed, uncertainty = min(bins, key=lambda b: abs(b[0] - CERTIFICATE_SPEED))
+        certificate["uncertainty"] = uncertainty / speed
+    return certificate

@@ -954,3 +954,93 @@ def test_turbulence_overlap_counts_the_rotor_inside_the_wake_radius(lateral, sam
         np.testing.assert_array_equal(powers["wake_radius"], powers["wake_velocity"])
     else:
         assert powers["wake_radius"][2] < powers["wake_velocity"][2] * (1.0 - 1e-4)
+
+
+def _neutral_row(spacings, **velocity_settings):
+    """farm_sbl6's NREL 5 MW along the wind at ``spacings`` [D] in a neutral ABL without veer,
+    at 8 m/s, with ``velocity_settings`` in the ekman_veer block; run."""
+    cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+    cfg["farm"]["layout_x"] = [126.0 * s for s in spacings]
+    cfg["farm"]["layout_y"] = [0.0] * len(spacings)
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(velocity_settings)
+    fmodel = FlorisModel(cfg)
+    fmodel.set(wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+    fmodel.run()
+    return fmodel
+
+
+def test_ishihara_qian_turbulence_is_its_rotor_average(monkeypatch):
+    """``wake_turbulence: ishihara_qian``: the added turbulence a wake hands a rotor is Ishihara
+    & Qian's (2018) Delta I averaged over the rotor (the cells' sub-points), equal to an
+    independent polar quadrature of the published form computed here; 15 D on, none (FLORIS's
+    cut-off). A single wake is unchanged (turbulence acts on the wake of the rotor it reaches)."""
+    from floris_ekman_veer.plugin.rotor import rotor_wakes
+    from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
+
+    diameter, hub = 126.0, 90.0  # the NREL 5 MW of the farm input
+    added, powers = [], {}
+    original = rotor_wakes.RotorWakes.add_turbulence
+
+    def spy(self, f, j, values, ambient, rule="max"):
+        added.append(dict(zip(j.tolist(), np.asarray(values).tolist())))
+        return original(self, f, j, values, ambient, rule)
+
+    monkeypatch.setattr(rotor_wakes.RotorWakes, "add_turbulence", spy)
+    for form in ("ishihara_qian", "crespo_hernandez"):
+        added.clear()
+        fmodel = _neutral_row((0.0, 5.0, 15.0), wake_turbulence=form)
+        powers[form] = fmodel.get_turbine_powers()[0]
+        if form == "ishihara_qian":
+            ct = fmodel.get_turbine_thrust_coefficients()[0, 0]
+            first = added[0]
+    n = 400
+    r = (np.arange(n) + 0.5) / n * 0.5 * diameter
+    theta = (np.arange(n) + 0.5) * 2.0 * np.pi / n
+    r, theta = np.meshgrid(r, theta)
+    z = hub + r * np.sin(theta)
+    point = ishihara_qian_added_turbulence(5.0 * diameter, r, z, ct, 0.06, diameter, hub)
+    assert first[1] == pytest.approx(np.sum(point * r) / np.sum(r), rel=2e-3)
+    assert first[1] > 0.05
+    assert first[2] == 0.0
+    np.testing.assert_array_equal(powers["ishihara_qian"][:2], powers["crespo_hernandez"][:2])
+    assert powers["ishihara_qian"][2] != powers["crespo_hernandez"][2]
+
+
+@pytest.mark.parametrize("superposition", ["momentum_conserving", "cumulative"])
+def test_published_superpositions_on_the_rotor_cells(superposition):
+    """``wake_superposition``: one wake behind an unwaked rotor is the model's wake with both, so
+    the second turbine's power is the summed wakes' (to the single-precision sub-point sum of
+    momentum_conserving, 1e-7). Behind two aligned wakes, momentum_conserving (Zong &
+    Porte-Agel 2020): the second wake, shed by a waked rotor (incoming speed about 0.7 U_0),
+    convects slower than the combined wake, weighs less than 1 and dominates at the third
+    turbine, which gets more than the plain sum gives; cumulative (Bastankhah et al. 2021): the
+    second wake's thrust is carried through the first wake's centre-line overlap
+    a = U_0 - lambda C_1 (6.6 m/s), faster than the second rotor's disk-averaged incoming speed
+    U_n (6.2 m/s) that the plain sum scales it with, so its centre deficit
+    C_2 = K U_n^2 / (a + sqrt(a^2 - K U_n^2)) is smaller and the third turbine gets more.
+    FLORIS's sosfs cannot carry Zong & Porte-Agel's weights (ValueError naming fls); the
+    cumulative wake (the sum of the deficits) then leaves each wake to sosfs alone."""
+    powers = {}
+    for setting in ("combination_model", superposition):
+        fmodel = _neutral_row((0.0, 5.0, 10.0), wake_superposition=setting)
+        powers[setting] = fmodel.get_turbine_powers()[0]
+    summed, other = powers["combination_model"], powers[superposition]
+    assert other[0] == summed[0]
+    assert other[1] == pytest.approx(summed[1], rel=1e-7)
+    assert other[2] > summed[2] * (1.0 + 0.02)
+    cfg = config("farm_sbl6", veer=False, atmosphere={"stability_parameter": 0.0})
+    cfg["farm"].update(layout_x=[0.0, 630.0, 1260.0], layout_y=[0.0, 0.0, 0.0])
+    cfg["wake"]["model_strings"]["combination_model"] = "sosfs"
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
+        deficit_velocity="free_stream", wake_superposition=superposition)
+    fmodel = FlorisModel(cfg)
+    if superposition == "momentum_conserving":
+        with pytest.raises(ValueError, match="combination_model: fls"):
+            fmodel.run()
+        return
+    fmodel.run()
+    cfg["wake"]["wake_velocity_parameters"]["ekman_veer"]["wake_superposition"] = (
+        "combination_model")
+    plain = FlorisModel(cfg)
+    plain.run()
+    np.testing.assert_array_equal(fmodel.get_turbine_powers(), plain.get_turbine_powers())

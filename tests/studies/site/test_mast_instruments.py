@@ -13,9 +13,9 @@ import floris_ekman_veer
 from floris_ekman_veer import fit_site
 from floris_ekman_veer.studies.site.baseline import neutral_baseline
 from floris_ekman_veer.studies.site.columns import mast_columns
-from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets
-from floris_ekman_veer.studies.site.readings import read_instruments
-from floris_ekman_veer.studies.site.readings import measured_turbulence
+from floris_ekman_veer.studies.site.offsets import estimate_vane_offsets, turning_forms_between
+from floris_ekman_veer.studies.site.readings import (calibrated_cups, measured_turbulence,
+                                                     read_instruments)
 from instrumented_mast_year import (BOOMS, CUP_HEIGHTS, LONGITUDE, N_ICING, TERRAIN_TURBULENCE,
                                      SECTOR_ROUGHNESS, TIME_ZONE, VANE_HEIGHTS, VANE_OFFSETS,
                                      mast_year,
@@ -44,11 +44,13 @@ def instruments(year):
 
 @pytest.fixture(scope="module")
 def site(year):
-    """The year fitted as a site engineer would: the defaults and the mast's booms."""
+    """The year fitted as a site engineer would: the defaults, the mast's booms and its cups'
+    calibration certificates."""
     # Five northerly records turn by less than a degree within 0 to 2 pi, as directions in
     # radians would; the year's other northerly winds show the wind turning through north: no
     # DirectionUnitsWarning (package warnings are errors in the suite).
-    return fit_site(year, 80.0, on_misfit="drop", booms=BOOMS, **SITE)
+    return fit_site(year, 80.0, on_misfit="drop", booms=BOOMS,
+                    cup_calibrations=year.attrs["cup_calibration_certificates"], **SITE)
 
 
 # ---------------------------------------------------------------------------- the generator
@@ -110,17 +112,30 @@ def test_stuck_vanes_are_found_and_their_records_named(year, instruments):
     assert flags["reason"].str.contains(r"in \d+ records in a row .*\(icing\)").all()
 
 
-def test_vane_offsets_are_found_within_a_tenth_of_the_half_degree(instruments, site):
+def test_vane_offsets_are_found_within_their_uncertainty(year, instruments, site):
+    """The offsets are estimated against the surface layer's neutral turning (none between the
+    vanes, offsets.py); the generator's vanes turn as the model's neutral layer does (about
+    0.5 deg counterclockwise from 38 to 78 m), one of the forms the systematic uncertainty
+    spans: each offset is the generator's plus the model's turning within three statistical
+    errors, and the generator's within its statistical and systematic parts."""
+    strong = instruments.speeds[:, -1] >= 12.0
     for table in (instruments.offsets, site.offsets):
         for height, offset in VANE_OFFSETS.items():
             row = table.loc[height]
-            assert row["offset_deg"] == pytest.approx(offset, abs=0.5)
-            if offset:
-                assert row["source"] == "estimated" and row["records"] > 300
-                assert 0.0 < row["uncertainty_deg"] < 0.15
-    # Beside the statistical error, the reference turning's systematic uncertainty: the model's
-    # neutral turning from the 78 m vane (about 0.5 deg down to 38 m, 0.2 deg to 58 m at
-    # 12-18 m/s) against the surface layer's none, larger than the statistical part.
+            if not offset:
+                assert row["offset_deg"] == 0.0 and row["source"] == "reference"
+                continue
+            assert row["source"] == "estimated" and row["records"] > 300
+            assert 0.0 < row["uncertainty_deg"] < 0.15
+            model = turning_forms_between(FIT_INPUTS, instruments.speeds[strong, -1], 80.0,
+                                          height, 78.0).loc["model", "turning_deg"]
+            assert row["offset_deg"] == pytest.approx(offset - model,
+                                                      abs=3.0 * row["uncertainty_deg"])
+            assert abs(row["offset_deg"] - offset) < 2.0 * np.hypot(row["uncertainty_deg"],
+                                                                    row["systematic_deg"])
+    # Beside the statistical error, the reference turning's systematic uncertainty: the
+    # published forms' largest departure from the surface layer's (about 0.5 deg between 38 and
+    # 78 m, 0.25 deg between 58 and 78 m at 12-18 m/s), larger than the statistical part.
     systematic = site.offsets["systematic_deg"]
     assert 0.4 < systematic.loc[38.0] < 0.6 and 0.15 < systematic.loc[58.0] < 0.3
     assert np.all(systematic.loc[[38.0, 58.0]] > site.offsets["uncertainty_deg"].loc[[38.0, 58.0]])
@@ -131,6 +146,37 @@ def test_vane_offsets_are_found_within_a_tenth_of_the_half_degree(instruments, s
     assert given.offsets["source"].tolist() == ["given", "given", "reference"]
     with pytest.raises(ValueError, match=r"direction_offsets names a vane at 40 m"):
         fit_site(mast_year(periods=48), 80.0, booms=BOOMS, direction_offsets={40: 1.0}, **SITE)
+
+
+def test_an_offset_known_by_construction_is_found_against_the_surface_layers_turning():
+    """Strong-wind records whose wind does not turn between the vanes (the constant-stress
+    surface layer's neutral turning, the reference chosen: docs/measurements.md#vane-offsets),
+    speeds of the neutral log law, vanes offset by -3.0 and +1.5 deg with 0.7 deg noise: each
+    offset found within three of its statistical errors, and the systematic part (the other
+    published forms' departure) reported beside it."""
+    rng = np.random.default_rng(7)
+    n, z0, kappa = 300, 0.05, 0.41
+    speed = rng.uniform(12.0, 18.0, n)
+    u_star = kappa * speed / np.log(80.0 / z0)
+    direction = rng.uniform(0.0, 360.0, n)
+    offsets = {38.0: -3.0, 58.0: 1.5, 78.0: 0.0}
+    records = {f"speed_{h:g}m": np.round(u_star / kappa * np.log(h / z0)
+                                          * (1.0 + rng.normal(0.0, 0.005, n)), 2)
+               for h in (40.0, 60.0, 80.0)}
+    for h, offset in offsets.items():
+        records[f"direction_{h:g}m"] = np.mod(direction + offset + rng.normal(0.0, 0.7, n), 360.0)
+    records = pd.DataFrame(records)
+    columns = mast_columns(records)
+    found = estimate_vane_offsets(read_instruments(records, columns), records, columns, 80.0,
+                                  FIT_INPUTS).offsets
+    for h, offset in offsets.items():
+        row = found.loc[h]
+        if not offset:
+            assert row["source"] == "reference"
+            continue
+        assert row["records"] >= 200 and 0.0 < row["uncertainty_deg"] < 0.1
+        assert row["offset_deg"] == pytest.approx(offset, abs=3.0 * row["uncertainty_deg"])
+        assert row["systematic_deg"] > 2.0 * row["uncertainty_deg"]
 
 
 def test_cup_pairs_agree_within_their_calibration(instruments):
@@ -150,21 +196,29 @@ def test_a_pair_that_disagrees_over_the_year_is_named(year, instruments):
     assert pairs.loc[60.0, "median_ratio"] == pytest.approx(1.06 * own, abs=0.01)
 
 
-def _roughness_rose(records):
-    """Stages 1-3 of fit_site's default (roughness_length="estimate"): the readings and the
-    roughness rose of ``records``."""
+def _roughness_rose(records, certificates=None):
+    """Stages 1-3 of fit_site's default (roughness_length="estimate"), as pipeline.py runs them:
+    the readings and the roughness rose of ``records`` with the cups' ``certificates``."""
     columns = mast_columns(records, BOOMS)
+    records, calibrations = calibrated_cups(records, columns, certificates)
     readings = read_instruments(records, columns, booms=BOOMS)
     cups = [len(columns.cups[h]) for h in columns.cup_heights]
-    return readings, neutral_baseline(readings, 80.0, {"latitude": 53.3},
-                                      cups_per_height=cups).sectors
+    per_height = calibrations.groupby("height")["uncertainty"].agg(
+        lambda u: float(np.sqrt(np.sum(np.square(u))) / len(u)))
+    return readings, neutral_baseline(readings, 80.0, {"latitude": 53.3}, cups_per_height=cups,
+                                      calibration_uncertainty=per_height.to_numpy()).sectors
 
 
 def test_the_roughness_rose_is_the_generators_within_the_cups_calibration(year):
-    """The rose's error on the fixture is its cups' calibration, not the estimator: the
-    strong-wind records are all neutral; as logged the truth lies within the reported
-    (statistical and calibration) uncertainty; with each cup's calibration applied (its
-    certificate, ``attrs["true_cup_calibration"]``) the rose is the generator's."""
+    """The issue's criterion, with the defaults and the cups' certificates (as a site engineer
+    applies them): the rose within a factor 1.5 of the generator's in every sector, and within
+    three of its reported standard uncertainties (statistical and the certificates' in
+    quadrature; at most 2.1 here). The 270-deg sector is the closest to the factor (1.49: its
+    records' 80/40 m ratio reads 0.3 % low through the certificates' own errors, boom a's 40 m
+    certificate 2.2 of its stated 0.15 % off), the 300-deg one next (1.42: its boom b cups'
+    random errors read the ratio 0.6 % high, three standard errors of their median). Without
+    certificates the reported uncertainty (the generic 1 % calibration) holds the truth within
+    two of them (docs/measurements.md#the-sites-neutral-baseline)."""
     truth = np.asarray(SECTOR_ROUGHNESS)
     readings, logged = _roughness_rose(year)
     # The selection: every record from 12 m/s at 80 m is neutral in the generator (|L| > 3 km).
@@ -172,27 +226,26 @@ def test_the_roughness_rose_is_the_generators_within_the_cups_calibration(year):
     assert strong.sum() > 800
     assert (year["true_obukhov_length"].abs()[strong] > 3e3).all()
     assert (logged["records"] >= 20).all() and (logged["half_width_deg"] == 15.0).all()
+
+    def standard_errors(rose):
+        found = np.log(rose["roughness_length"].to_numpy() / truth)
+        sigma = np.hypot(np.log(rose["roughness_factor"]),
+                         np.log(rose["roughness_factor_calibration"])).to_numpy()
+        return found, sigma
+
     # As logged: this seed's cups read the 80/40 m ratio 1.5 % low (2.9 % with boom b's cups
-    # alone, from 285 to 345 deg), about a factor 3 (6) in z0; the reported uncertainty, the
-    # statistical and the calibration factors in quadrature, holds the truth within 2 sigma.
-    error = np.abs(np.log(logged["roughness_length"].to_numpy() / truth))
-    sigma = np.hypot(np.log(logged["roughness_factor"]), np.log(
-        logged["roughness_factor_calibration"])).to_numpy()
-    assert (error < 2.0 * sigma).all()
-    assert np.exp(np.mean(np.log(logged["roughness_length"].to_numpy() / truth))) < 0.5
-    # With each cup's calibration applied, as a logger with the certificates applied records:
-    # no bias left (the geometric mean of estimate/truth within 10 %), every sector within a
-    # factor 1.6 and all but one within 1.5 (the 300-deg sector, 51 records on one cup's
-    # readings, 1.52: three of its statistical sigmas).
-    certified = year.copy()
-    for column, factor in year.attrs["true_cup_calibration"].items():
-        certified[column] = year[column] / factor
-    _, rose = _roughness_rose(certified)
-    found = rose["roughness_length"].to_numpy() / truth
-    assert abs(np.mean(np.log(found))) < np.log(1.1)
-    assert (np.abs(np.log(found)) < np.log(1.6)).all()
-    assert np.count_nonzero(np.abs(np.log(found)) < np.log(1.5)) >= 11
-    assert (np.abs(np.log(found)) < 3.5 * np.log(rose["roughness_factor"].to_numpy())).all()
+    # alone, from 285 to 345 deg), about a factor 3 (6) in z0, within the reported uncertainty.
+    found, sigma = standard_errors(logged)
+    assert (np.abs(found) < 2.0 * sigma).all()
+    assert np.exp(np.mean(found)) < 0.5
+    # With the certificates: the calibration factor is the certificates' (0.15 % a cup: 1.07 to
+    # 1.16), the rose the generator's.
+    _, certified = _roughness_rose(year, year.attrs["cup_calibration_certificates"])
+    found, sigma = standard_errors(certified)
+    assert (certified["roughness_factor_calibration"] < 1.2).all()
+    assert abs(np.mean(found)) < np.log(1.25)
+    assert (np.abs(found) < np.log(1.5)).all(), np.exp(found)
+    assert (np.abs(found) < 3.0 * sigma).all()
 
 
 def test_one_inf_reading_is_named_by_its_time_stamp_and_aborts_nothing(year):

@@ -44,8 +44,12 @@ def site(records):
     # Three northerly records of the year turn by less than a degree within 0 to 2 pi, as
     # directions in radians would; the year's other northerly winds (beyond 2 pi in degrees)
     # show the wind turning through north: no DirectionUnitsWarning (package warnings are
-    # errors in the suite).
-    return fit_site(records, 90.0, on_misfit="drop", **SITE)
+    # errors in the suite). Three convective afternoons come out as stable layers 30 m deep, the
+    # vane offsets taken against the surface layer's neutral turning (the generator's vanes
+    # turn as the model does: docs/measurements.md#vane-offsets): one warning names them.
+    with pytest.warns(floris_ekman_veer.ShallowBoundaryLayerWarning,
+                      match=r"3 of 8451 fitted records have their boundary layer top so far below"):
+        return fit_site(records, 90.0, on_misfit="drop", **SITE)
 
 
 def test_the_year_is_what_its_generator_writes(tmp_path, records):
@@ -83,7 +87,7 @@ def test_one_call_fits_every_fittable_record_and_names_the_others(records, site)
     # where their fit lies inside the physical domain. A fit on a bound is never kept
     # (docs/measurements.md#reading-stability): the convective afternoons whose best fit, under
     # the weak prior on 1/L, still lies on the 800 W/m^2 bound are named "physical bound"
-    # (measured: 222 of the 360 kept convective, 81 on the bound, 50 with no top in the mast).
+    # (measured: 231 of the 360 kept convective, 80 on the bound, 45 with no top in the mast).
     assert (kind[records["true_kind"] == "backing"] == "backing").sum() >= 36
     convective = records["true_kind"] == "convective"
     classes = pd.Series(site.profile_fit.stability_class, index=kind.index[kind == "fitted"])

@@ -15,28 +15,45 @@ from floris_ekman_veer.studies.site.wra_file import read_wra_file
 from instrumented_mast_year import mast_year
 
 
-def point(name, kind, height, columns, boom=None, dead_band=None):
+def point(name, kind, height, columns, boom=None, dead_band=None, certificate=None):
+    """A measurement point; ``certificate``: a cup's calibration (fit_site's cup_calibrations
+    entry) written as the schema's sensor calibration, with the logger's transfer function."""
     mounting = {"date_from": "2025-01-01T00:00:00", "boom_orientation_deg": boom}
     if dead_band is not None:
         mounting["vane_dead_band_orientation_deg"] = dead_band
-    return {"name": name, "measurement_type_id": kind, "height_m": height,
-            "height_reference_id": "ground_level", "mounting_arrangement": [mounting],
-            "logger_measurement_config": [{
-                "date_from": "2025-01-01T00:00:00", "slope": 0.0458, "offset": 0.2,
-                "column_name": [{"column_name": c, "statistic_type_id": s, "is_ignored": False}
-                                for c, s in columns]}]}
+    logger = (0.0458, 0.2) if certificate is None else (certificate["logger_slope"],
+                                                        certificate["logger_offset"])
+    out = {"name": name, "measurement_type_id": kind, "height_m": height,
+           "height_reference_id": "ground_level", "mounting_arrangement": [mounting],
+           "logger_measurement_config": [{
+               "date_from": "2025-01-01T00:00:00", "slope": logger[0], "offset": logger[1],
+               "column_name": [{"column_name": c, "statistic_type_id": s, "is_ignored": False}
+                               for c, s in columns]}]}
+    if certificate is not None:
+        # (the certificate's uncertainty in m/s per reference bin, as the schema gives it)
+        out["sensor"] = [{"oem": "cup maker", "model": "class 1", "serial_number": name,
+                          "sensor_type_id": "anemometer", "calibration": [{
+                              "measurement_type_id": "wind_speed", "slope": certificate["slope"],
+                              "offset": certificate["offset"], "calibration_uncertainty": [
+                                  {"reference_bin": v, "reference_unit": "m/s",
+                                   "uncertainty": certificate["uncertainty"] * v}
+                                  for v in (4.0, 8.0, 12.0, 16.0)]}]}]
+    return out
 
 
-def task43_file(tmp_path, heights=(80, 60, 40), latitude=53.3):
+def task43_file(tmp_path, heights=(80, 60, 40), latitude=53.3, certificates=None):
     """A Task 43 file of the instrumented mast: two cups per height on booms at 135 and 315 deg
     (logger names Spd_<h>mA_Avg, ..._SD), vanes at 78, 58 and 38 m (Dir_<h>m_Avg), thermometers
-    at 10 and 78 m (T_<h>m_Avg)."""
+    at 10 and 78 m (T_<h>m_Avg); ``certificates``: the cups' calibrations by the generator's
+    column names (``speed_80m_a``...)."""
     points = []
     for h in heights:
         for boom, angle in (("A", 135.0), ("B", 315.0)):
+            certificate = (certificates or {}).get(f"speed_{h}m_{boom.lower()}")
             points.append(point(f"Spd_{h}m{boom}", "wind_speed", float(h),
                                 [(f"Spd_{h}m{boom}_Avg", "avg"), (f"Spd_{h}m{boom}_SD", "sd"),
-                                 (f"Spd_{h}m{boom}_Max", "max")], boom=angle))
+                                 (f"Spd_{h}m{boom}_Max", "max")], boom=angle,
+                                certificate=certificate))
     for h in (78, 58, 38):
         points.append(point(f"Dir_{h}m", "wind_direction", float(h), [(f"Dir_{h}m_Avg", "avg")],
                             boom=315.0, dead_band=135.0))
@@ -130,3 +147,36 @@ def test_a_file_that_contradicts_the_records_or_the_call_is_refused_naming_both(
     broken.write_text("{not json")
     with pytest.raises(ValueError, match=r"no readable IEA Task 43 WRA data model JSON file"):
         fit_site(records, 80.0, metadata=broken, roughness_length=0.05)
+
+
+def test_the_files_cup_calibrations_are_applied_as_the_arguments_are(tmp_path):
+    """The file's sensor calibrations (slope, offset, uncertainty per reference bin) with the
+    logger's transfer function (logger_measurement_config's slope and offset) are the cups'
+    certificates: fitted with the file, the records are fitted as with ``cup_calibrations``
+    given by hand; a certificate given that contradicts the file's, or one for a cup the
+    records lack, is refused naming both."""
+    records, year = logger_records(96)
+    certificates = year.attrs["cup_calibration_certificates"]
+    path = task43_file(tmp_path, certificates=certificates)
+    mast = read_wra_file(path)
+    assert mast.cup_calibrations["speed_80m_b315"]["slope"] == certificates["speed_80m_b"]["slope"]
+    assert mast.cup_calibrations["speed_80m_b315"]["uncertainty"] == pytest.approx(
+        certificates["speed_80m_b"]["uncertainty"], rel=1e-12)
+    with_file = fit_site(records, 80.0, on_misfit="drop", roughness_length=0.05, metadata=path)
+    by_hand = fit_site(year, 80.0, on_misfit="drop", roughness_length=0.05, latitude=53.3,
+                       booms={"a": 135.0, "b": 315.0}, cup_calibrations=certificates)
+    np.testing.assert_array_equal(with_file.wind_speeds, by_hand.wind_speeds)
+    assert (with_file.cup_calibrations["source"] == "certificate").all()
+    uncalibrated = fit_site(year, 80.0, on_misfit="drop", roughness_length=0.05, latitude=53.3,
+                            booms={"a": 135.0, "b": 315.0})
+    assert np.any(uncalibrated.wind_speeds != by_hand.wind_speeds)
+    changed = {**certificates["speed_80m_b"], "slope": 0.05}
+    with pytest.raises(ValueError, match=r"cup_calibrations\['Spd_80mB_Avg'\] = .* contradicts "
+                                         r"the mast's metadata file .* whose certificate"):
+        fit_site(records, 80.0, roughness_length=0.05, metadata=path,
+                 cup_calibrations={"Spd_80mB_Avg": changed})
+    with pytest.raises(ValueError, match=r"cup_calibrations names cup 'speed_20m_a', which the "
+                                         r"records lack"):
+        fit_site(year, 80.0, roughness_length=0.05, latitude=53.3,
+                 booms={"a": 135.0, "b": 315.0},
+                 cup_calibrations={"speed_20m_a": certificates["speed_80m_a"]})
