@@ -62,11 +62,21 @@ def test_the_yawed_rotor_sees_the_night_veer(study):
     assert 0.88 < ratio.loc[("night -0.25 K/h", "ekman_veer")] < 0.95
 
 
-def test_veer_makes_the_two_signs_differ_at_night(study):
+def test_veer_makes_the_best_steering_mix_the_signs_at_night(study):
+    """On the veered night no one-signed search finds the optimum: the both-signs search gains
+    0.39 points more than the better sign (0.94 % against 0.55 %; the reduced study's row at
+    8 m/s), steering turbines to both sides; on the neutral day the plus-only search already
+    finds it (1.034 % both ways)."""
     _, result = study
-    night = result["yaw"].set_index(["atmosphere", "model"]).loc[("night -0.25 K/h", "ekman_veer")]
+    yaw = result["yaw"].set_index(["atmosphere", "model"])
+    night = yaw.loc[("night -0.25 K/h", "ekman_veer")]
+    day = yaw.loc[("CNBL", "ekman_veer")]
+    best_one_sign = max(night["gain_plus_only"], night["gain_minus_only"])
     assert night["gain_percent"] > 0.5
-    assert abs(night["gain_plus_only"] - night["gain_minus_only"]) > 0.5
+    assert night["gain_percent"] - best_one_sign > 0.3
+    angles = night[["yaw_T1", "yaw_T2", "yaw_T3"]].to_numpy(dtype=float)
+    assert angles.max() > 1.0 and angles.min() < -1.0
+    assert day["gain_percent"] - max(day["gain_plus_only"], day["gain_minus_only"]) < 0.01
 
 
 def test_day_night_energy_table(study):
