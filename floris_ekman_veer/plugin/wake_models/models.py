@@ -32,6 +32,7 @@ Conventions (docs/conventions.md, docs/coupling.md), each pinned by tests:
 from __future__ import annotations
 
 import warnings
+from abc import abstractmethod
 from typing import Any
 
 import numpy as np
@@ -320,13 +321,14 @@ class EkmanWakeModel(BaseModel):
         """The thrust coefficient the model's formulas take: the paper's un-yawed-basis C_T."""
         return unyawed_thrust_coefficient(ct_i, yaw, self.max_thrust_coefficient)
 
+    @abstractmethod
     def kernel_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> dict:
         """The deficit's factors that depend on the wake only, for the rotor-cell kernel
         (plugin/rotor/rotor_kernel.py ``WAKE_COLUMNS``: Delta u / U_h = amplitude
         exp(-(rho^2 / (2 sigma^2))^(shape / 2)) with sigma = kx + xi0 xi_hat(theta) /
         sqrt(1 - sin2b sin^2 theta), xi_hat of Eq. xi_emp with t_hat's prefactor ``strength``),
-        per wake and rotor reached (1-D arrays or scalars); each model defines them."""
-        raise NotImplementedError("EkmanWakeModel.kernel_table")
+        per wake and rotor reached (1-D arrays or scalars); each model defines them, as FLORIS's
+        BaseModel leaves ``prepare_function`` and ``function`` to its models."""
 
     def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> np.ndarray:
         """(pairs, wake/fused.py ``WAKE_TABLE``): :meth:`kernel_table`'s columns, then
