@@ -28,7 +28,7 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
-from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
@@ -239,7 +239,7 @@ def rotor_cell_deficit(
         deficit = cumulative_deficit(
             single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
             wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
-            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
+            model.core_deficit(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
         per_pair["velocity_scale"] = 1.0 / np.where(single > 0.0, single, 1.0)
         row_scale = deficit
         if track and model.turbulence_overlap == "wake_radius":
