@@ -60,6 +60,8 @@ def configuration(model: str, side: int = SIDE) -> dict:
     config["farm"]["layout_y"] = y.ravel().tolist()
     wake = config["wake"]
     if model in ("gauss", "GCH"):
+        # FLORIS's models on FLORIS's usual 3 x 3 turbine grid (the farm input's is M-1's).
+        config["solver"] = {"type": "turbine_grid", "turbine_grid_points": 3}
         wake["model_strings"]["velocity_model"] = "gauss"
         wake["model_strings"]["deflection_model"] = "gauss"
         for flag in ("enable_secondary_steering", "enable_yaw_added_recovery",

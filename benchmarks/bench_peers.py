@@ -13,14 +13,21 @@ turbine yawed uniformly in [-20, 20] deg). Contenders:
     M-1              ekman_veer velocity and deflection (veer, curl, yaw), the shipped input;
     empirical_gauss  FLORIS's empirical Gaussian (velocity, deflection, wake-induced mixing);
     GCH              FLORIS gauss with GCH's terms on;
+    cc               FLORIS's cumulative-curl model (its own sums, gauss deflection);
     PyWake 3x3       PyWake's Niayifar_PorteAgel_2016 (NiayifarGaussianDeficit, linear sum,
                      Crespo-Hernandez) with Jimenez yaw deflection, on 3 x 3 rotor points at
                      +-R/2 (FLORIS's turbine grid);
-    PyWake centre    the same at the rotor centre.
+    PyWake centre    the same at the rotor centre;
+    foxes grid9      foxes's "Niayifar" (Bastankhah 2014 with k = 0.3837 TI + 0.003678, linear
+                     sum) with Crespo-Hernandez added turbulence (same k, max), Jimenez
+                     deflection projected on the rotor ("JimenezProj"), rotor model "grid9"
+                     (3 x 3 points), partial wakes at the rotor points, numpy engine (one
+                     process); foxes centre: the same at the rotor centre ("centre").
 
-The FLORIS models run on the SBL-6 Ekman inflow of ``inputs/farm_sbl6.yaml`` on a 3 x 3 turbine
-grid; PyWake on its uniform site at the same hub-height wind (its cost does not depend on the
-profile). PyWake's power and thrust curves are FLORIS's NREL 5 MW table.
+The FLORIS models run on the SBL-6 Ekman inflow of ``inputs/farm_sbl6.yaml``, FLORIS's own on its
+3 x 3 turbine grid, M-1 on the input's rotor cells (the shipped 3 x 3); PyWake and foxes on a
+uniform site at the same hub-height wind (their cost does not depend on the profile). PyWake's power and thrust curves are FLORIS's NREL 5 MW table; foxes's its own
+NREL 5 MW table ("NREL5MW").
 
 Timed: one run of each contender (``FlorisModel.run()``; PyWake's call with ``time=True`` and
 the turbines' power read), wall (perf_counter) and CPU (process_time: all threads) per run,
@@ -29,7 +36,8 @@ the shared machine weighs on all alike, best of ``--repeats`` after a warm-up (f
 10 x 10); ratios to FLORIS gauss of the same farm. Peak memory: tracemalloc's peak above the level before one run,
 measured in a separate run. Scaling: the exponent b of a least-squares fit of
 CPU time = a n_turbines^b over the farms. ``--profile`` adds a cProfile of M-1 on the 10 x 10
-farm on one thread (top functions by internal time). ``--threads`` sets numexpr's threads (FLORIS's gauss sums
+farm on one thread (top functions by internal time). ``--quick`` (for 20 x 20 x 100): one repeat,
+no warm-up, no peak-memory run. ``--threads`` sets numexpr's threads (FLORIS's gauss sums
 run on them) and numba's (the package's rotor-cell kernel, plugin/rotor/rotor_kernel.py); default: each
 library's own, all cores.
 """
@@ -43,6 +51,7 @@ import sys
 import time
 import tracemalloc
 import warnings
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import numpy as np
@@ -53,8 +62,16 @@ import numba  # noqa: E402
 import numexpr  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-FLORIS_CONTENDERS = ("gauss", "M-1", "empirical_gauss", "GCH")
+FLORIS_CONTENDERS = ("gauss", "M-1", "empirical_gauss", "GCH", "cc")
 PYWAKE_CONTENDERS = ("PyWake 3x3", "PyWake centre")
+FOXES_CONTENDERS = ("foxes grid9", "foxes centre")
+#: FLORIS's own models other than gauss/GCH: model strings on the farm input.
+OTHER_FLORIS = {
+    "empirical_gauss": dict(velocity_model="empirical_gauss", deflection_model="empirical_gauss",
+                            turbulence_model="wake_induced_mixing"),
+    "cc": dict(velocity_model="cc", deflection_model="gauss", turbulence_model="crespo_hernandez",
+               combination_model="sosfs"),
+}
 #: Farms up to this side get an untimed warm-up run of every contender (larger farms come after
 #: them in the process and find the caches warm).
 WARM_UP_SIDE = 10
@@ -62,16 +79,14 @@ WARM_UP_SIDE = 10
 
 def floris_model(name: str, directions, speeds, yaw):
     """A FlorisModel of one FLORIS contender, set for the conditions."""
-    if name != "empirical_gauss":
+    if name not in OTHER_FLORIS:
         return bench_models.build(name, directions, speeds, yaw)
     side = int(round(np.sqrt(yaw.shape[1])))
     from floris import FlorisModel
 
     config = bench_models.configuration("gauss", side)
-    config["wake"]["model_strings"].update(velocity_model="empirical_gauss",
-                                          deflection_model="empirical_gauss",
-                                          turbulence_model="wake_induced_mixing")
-    # FLORIS's default parameters of the three models (the farm input holds gauss's).
+    config["wake"]["model_strings"].update(OTHER_FLORIS[name])
+    # FLORIS's default parameters of the models (the farm input holds gauss's).
     defaults = FlorisModel.get_defaults()["wake"]
     for block in ("wake_velocity_parameters", "wake_deflection_parameters",
                   "wake_turbulence_parameters"):
@@ -83,12 +98,13 @@ def floris_model(name: str, directions, speeds, yaw):
     return fmodel
 
 
-def pywake_model(name: str, directions, speeds, yaw):
-    """A callable running PyWake's NiayifarGaussian on the same farm and conditions."""
+def pywake_wind_farm(rotor, shear=None):
+    """PyWake's Niayifar_PorteAgel_2016 (NiayifarGaussianDeficit, linear sum, Crespo-Hernandez)
+    with Jimenez yaw deflection on FLORIS's NREL 5 MW table, uniform site at TI 0.06, the rotor
+    average ``rotor`` (a py_wake rotor_avg_model) and ``shear`` (a py_wake shear model or None)."""
     import floris
     from py_wake.deflection_models import JimenezWakeDeflection
     from py_wake.literature.gaussian_models import Niayifar_PorteAgel_2016
-    from py_wake.rotor_avg_models import GridRotorAvg, RotorCenter
     from py_wake.site import UniformSite
     from py_wake.wind_turbines import WindTurbine
     from py_wake.wind_turbines.power_ct_functions import PowerCtTabular
@@ -97,15 +113,24 @@ def pywake_model(name: str, directions, speeds, yaw):
     table = table["power_thrust_table"]
     turbine = WindTurbine("NREL 5 MW", 126.0, 90.0, PowerCtTabular(
         table["wind_speed"], table["power"], "kW", table["thrust_coefficient"]))
-    if name == "PyWake 3x3":
-        offsets = np.array([-0.5, 0.0, 0.5])  # FLORIS's turbine grid, in rotor radii
-        lateral, vertical = np.meshgrid(offsets, offsets)
-        rotor = GridRotorAvg(lateral.ravel(), vertical.ravel())
-    else:
-        rotor = RotorCenter()
-    wind_farm = Niayifar_PorteAgel_2016(UniformSite(ti=0.06), turbine,
-                                        deflectionModel=JimenezWakeDeflection(),
-                                        rotorAvgModel=rotor)
+    return Niayifar_PorteAgel_2016(UniformSite(ti=0.06, shear=shear), turbine,
+                                   deflectionModel=JimenezWakeDeflection(), rotorAvgModel=rotor)
+
+
+def floris_like_grid(n: int):
+    """PyWake's GridRotorAvg on FLORIS's n x n turbine-grid points (+-R/2)."""
+    from py_wake.rotor_avg_models import GridRotorAvg
+
+    offsets = np.linspace(-0.5, 0.5, n)  # in rotor radii
+    lateral, vertical = np.meshgrid(offsets, offsets)
+    return GridRotorAvg(lateral.ravel(), vertical.ravel())
+
+
+def pywake_model(name: str, directions, speeds, yaw):
+    """A callable running PyWake's NiayifarGaussian on the same farm and conditions."""
+    from py_wake.rotor_avg_models import RotorCenter
+
+    wind_farm = pywake_wind_farm(floris_like_grid(3) if name == "PyWake 3x3" else RotorCenter())
     side = int(round(np.sqrt(yaw.shape[1])))
     x, y = np.meshgrid(np.arange(side) * bench_models.SPACING,
                        np.arange(side) * bench_models.SPACING)
@@ -114,6 +139,42 @@ def pywake_model(name: str, directions, speeds, yaw):
         result = wind_farm(x.ravel(), y.ravel(), wd=directions, ws=speeds, yaw=yaw.T, tilt=0,
                            time=True)
         return result.Power.values
+
+    return run
+
+
+def foxes_model(name: str, directions, speeds, yaw):
+    """A callable running foxes's Niayifar model on the same farm and conditions."""
+    import foxes
+    import foxes.variables as FV
+    import pandas as pd
+    from foxes.input.farm_layout import add_grid
+
+    book = foxes.models.ModelBook()
+    yaw_setter = foxes.models.turbine_models.SetFarmVars()
+    yaw_setter.add_var(FV.YAWM, np.asarray(yaw, dtype=float))
+    book.turbine_models["set_yawm"] = yaw_setter
+    book.wake_models["crespo_hernandez"] = foxes.models.wake_models.ti.CrespoHernandezTIWake(
+        superposition="ti_max", ka=0.3837, kb=0.003678, ti_var=FV.AMB_TI)
+    states = foxes.input.states.StatesTable(
+        pd.DataFrame({"wd": directions, "ws": speeds}),
+        output_vars=[FV.WS, FV.WD, FV.TI, FV.RHO], var2col={FV.WS: "ws", FV.WD: "wd"},
+        fixed_vars={FV.RHO: 1.225, FV.TI: 0.06})
+    side = int(round(np.sqrt(yaw.shape[1])))
+    farm = foxes.WindFarm()
+    # add_grid numbers the turbines x fastest, as the meshgrid of the other contenders.
+    add_grid(farm, xy_base=[0.0, 0.0], step_vectors=[[bench_models.SPACING, 0.0],
+                                                     [0.0, bench_models.SPACING]],
+             steps=(side, side), turbine_models=["NREL5MW", "set_yawm", "yawm2yaw"],
+             verbosity=0)
+    algorithm = foxes.algorithms.Downwind(
+        farm, states, wake_models=["Niayifar", "crespo_hernandez"],
+        rotor_model="grid9" if name == "foxes grid9" else "centre", wake_frame="rotor_wd",
+        wake_deflection="JimenezProj", partial_wakes="rotor_points", mbook=book, verbosity=0)
+
+    def run():
+        with foxes.Engine.new("numpy", verbosity=0):
+            return algorithm.calc_farm()[FV.P].values
 
     return run
 
@@ -137,16 +198,19 @@ def peak_memory(run) -> float:
     return (peak - before) / 1e6
 
 
-def farm_table(side: int, n: int, seed: int, repeats: int, contenders, with_memory=True):
+def farm_table(side: int, n: int, seed: int, repeats: int, contenders, with_memory=True,
+               warm_up=True):
     """Best-of wall and CPU times and peak memory of every contender on one farm."""
     directions, speeds, yaw = bench_models.conditions(n, seed, side)
     runs = {}
     for name in contenders:
         if name in FLORIS_CONTENDERS:
             runs[name] = floris_model(name, directions, speeds, yaw).run
+        elif name in FOXES_CONTENDERS:
+            runs[name] = foxes_model(name, directions, speeds, yaw)
         else:
             runs[name] = pywake_model(name, directions, speeds, yaw)
-    if side <= WARM_UP_SIDE:
+    if warm_up and side <= WARM_UP_SIDE:
         for run in runs.values():
             run()  # warm-up (first-call caches: the same in every farm of the process)
     best = {name: (np.inf, np.inf) for name in runs}
@@ -172,25 +236,30 @@ def main(argv=None) -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--threads", type=int, default=None)
-    parser.add_argument("--contenders", default=",".join(FLORIS_CONTENDERS + PYWAKE_CONTENDERS))
+    everyone = FLORIS_CONTENDERS + PYWAKE_CONTENDERS + FOXES_CONTENDERS
+    parser.add_argument("--contenders", default=",".join(everyone))
     parser.add_argument("--profile", action="store_true")
     parser.add_argument("--no-memory", action="store_true", help="skip the peak-memory runs")
+    parser.add_argument("--quick", action="store_true",
+                        help="one repeat, no warm-up, no peak-memory runs (20 x 20 x 100)")
     args = parser.parse_args(argv)
+    if args.quick:
+        args.repeats, args.no_memory = 1, True
     if args.threads:
         numexpr.set_num_threads(args.threads)
         numba.set_num_threads(args.threads)
     contenders = [c.strip() for c in args.contenders.split(",")]
-    unknown = [c for c in contenders if c not in FLORIS_CONTENDERS + PYWAKE_CONTENDERS]
+    unknown = [c for c in contenders if c not in everyone]
     if unknown:
-        parser.error(f"--contenders: unknown {unknown}; choose from "
-                     f"{', '.join(FLORIS_CONTENDERS + PYWAKE_CONTENDERS)}")
-    try:
-        import py_wake
-        pywake = f"PyWake {py_wake.__version__}"
-    except ImportError:
-        print("PyWake is not installed (pip install '.[peers]'): FLORIS contenders only\n")
-        contenders = [c for c in contenders if c in FLORIS_CONTENDERS]
-        pywake = "no PyWake"
+        parser.error(f"--contenders: unknown {unknown}; choose from {', '.join(everyone)}")
+    peers = []
+    for module, names in (("py_wake", PYWAKE_CONTENDERS), ("foxes", FOXES_CONTENDERS)):
+        try:
+            peers.append(f"{module} {version(module)}")
+        except PackageNotFoundError:
+            print(f"{module} is not installed (pip install '.[peers]'): left out\n")
+            contenders = [c for c in contenders if c not in names]
+    pywake = ", ".join(peers) or "no peer package"
     sides = [int(s) for s in args.sides.split(",")]
     load = os.getloadavg()
     print(f"NREL 5 MW farms at 7 D, {args.conditions} random yawed conditions (seed {args.seed}), "
@@ -205,7 +274,8 @@ def main(argv=None) -> None:
         warnings.simplefilter("ignore")  # the SBL-6 night's shallow-layer summary
         for side in sides:
             best, memory = results[side] = farm_table(
-                side, args.conditions, args.seed, args.repeats, contenders, not args.no_memory)
+                side, args.conditions, args.seed, args.repeats, contenders, not args.no_memory,
+                not args.quick)
             for name in contenders:  # each farm's rows as soon as it is done
                 wall, cpu = best[name]
                 print(f"| {side} x {side} | {name} | {wall:.3f} | {wall / best['gauss'][0]:.2f}"

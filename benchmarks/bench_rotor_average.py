@@ -1,6 +1,7 @@
 """Convergence of the rotor average on single and multiple wakes (hand-run study, not a test):
 
     python -m benchmarks.bench_rotor_average [--reference 48x192] [--quick] [--multiwake]
+                                             [--points N]
 
 ``--multiwake`` prints only the multi-wake table (below).
 
@@ -24,6 +25,8 @@ input (``inputs/farm_sbl6.yaml``, 9 m/s at 90 m); veer on and off (M-1, M-2); up
 +-20 deg; downstream rotor 5, 7, 10, 15 D behind, laterally offset -1.5 D to +1.5 D in steps of
 0.25 D. Prints the largest |error| per input, veer and quadrature (the README's table), the
 worst case, and the errors of an unwaked rotor (the ambient profile alone). ``--quick`` uses steps of 0.5 D and 5 and 10 D only.
+``--points N`` adds FLORIS's ``turbine_grid`` with N x N rotor cells (``NxN cells``; in the
+multi-wake table: every case on N x N cells in place of the shipped grid).
 
 Multiple wakes: every turbine's power with the shipped settings (the farm input's wake settings:
 sosfs, crespo_hernandez, local_turbulence; 3 x 3 rotor cells) against the converged point-wise
@@ -67,7 +70,8 @@ def mean(u, weight, moment):
     return np.sum(weight * u, -1) if moment == 1 else np.cbrt(np.sum(weight * u**3, -1))
 
 
-def single_wake_errors(input_name, veer, distance, offset, reference, solver=None):
+def single_wake_errors(input_name, veer, distance, offset, reference, solver=None,
+                       quadratures=QUADRATURES):
     """Power errors of the downstream rotor for the upstream yaws YAWS: dict quadrature ->
     (n_yaw,) array. ``solver`` restricts to one FLORIS quadrature (None: all)."""
     config = load_yaml(REPOSITORY / "inputs" / input_name)
@@ -99,7 +103,7 @@ def single_wake_errors(input_name, veer, distance, offset, reference, solver=Non
 
     u_ref = mean(sampled(y, z), weight, moment)
     errors = {}
-    for quadrature in QUADRATURES:
+    for quadrature in quadratures:
         if solver is not None and quadrature != solver:
             continue
         if quadrature == "3x3 points":
@@ -108,8 +112,9 @@ def single_wake_errors(input_name, veer, distance, offset, reference, solver=Non
             u = mean(sampled(gy, gz), np.full(9, 1.0 / 9.0), moment)
         else:
             fmodel = FlorisModel(copy.deepcopy(config))
-            if quadrature == "3x3 cells":
-                settings = {"type": "turbine_grid", "turbine_grid_points": 3}
+            if quadrature.endswith(" cells"):
+                settings = {"type": "turbine_grid",
+                            "turbine_grid_points": int(quadrature.split("x")[0])}
             else:
                 settings = {"type": "turbine_cubature_grid",
                             "turbine_grid_points": int(quadrature.split()[1])}
@@ -149,18 +154,22 @@ MULTIWAKE_CASES = {
 }
 
 
-def multiwake_table(rings: int = 32, angles: int = 128) -> None:
-    """Print the multi-wake convergence table (module docstring)."""
+def multiwake_table(rings: int = 32, angles: int = 128, points: int | None = None) -> None:
+    """Print the multi-wake convergence table (module docstring); ``points``: N x N rotor cells
+    in place of the shipped grid."""
     atmospheres = ("SBL-6", "SBL-4", "neutral")
+    grid = "shipped settings" if points is None else f"{points} x {points} rotor cells"
     print(f"Multiple wakes: largest |P / P_ref - 1| per turbine against the point-wise disk "
-          f"reference ({rings} x {angles} equal-area points per rotor), shipped settings\n")
+          f"reference ({rings} x {angles} equal-area points per rotor), {grid}\n")
     print("| case | " + " | ".join(atmospheres) + " |")
     print("|---|" + "---:|" * len(atmospheres))
     for label, (turbine, speed, layout, conditions) in MULTIWAKE_CASES.items():
         cells = []
         for atmosphere in atmospheres:
-            errors = power_errors(farm_config(atmosphere, turbine, layout, speed), conditions,
-                                  rings=rings, angles=angles)
+            config = farm_config(atmosphere, turbine, layout, speed)
+            if points is not None:
+                config["solver"]["turbine_grid_points"] = points
+            errors = power_errors(config, conditions, rings=rings, angles=angles)
             cells.append(f"{100 * errors.flat[np.argmax(np.abs(errors))]:+.2f} %")
         print(f"| {label} | " + " | ".join(cells) + " |", flush=True)
 
@@ -170,10 +179,13 @@ def main(argv=None) -> None:
     parser.add_argument("--reference", default="48x192")
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--multiwake", action="store_true")
+    parser.add_argument("--points", type=int, default=None)
     args = parser.parse_args(argv)
+    quadratures = QUADRATURES if args.points is None or args.points == 3 else (
+        QUADRATURES[:2] + (f"{args.points}x{args.points} cells",) + QUADRATURES[2:])
     if args.multiwake:
         warnings.simplefilter("ignore", RuntimeWarning)
-        multiwake_table()
+        multiwake_table(points=args.points)
         return
     reference = disk_quadrature(*(int(v) for v in args.reference.split("x")))
     distances = (5.0, 10.0) if args.quick else (5.0, 7.0, 10.0, 15.0)
@@ -182,27 +194,29 @@ def main(argv=None) -> None:
     print(f"Single-wake rotor averages against a {args.reference} polar disk integral; power "
           f"error (u/u_ref)^3 - 1, largest |error| over yaw {YAWS} deg, downstream "
           f"{distances} D and lateral offsets {offsets[0]:+.2f}..{offsets[-1]:+.2f} D\n")
-    print("| case | veer | " + " | ".join(QUADRATURES) + " |")
-    print("|---|---|" + "---:|" * len(QUADRATURES))
+    print("| case | veer | " + " | ".join(quadratures) + " |")
+    print("|---|---|" + "---:|" * len(quadratures))
     worst = (0.0, None)
     for label, input_name in INPUTS.items():
         for veer in (True, False):
-            largest = dict.fromkeys(QUADRATURES, 0.0)
+            largest = dict.fromkeys(quadratures, 0.0)
             for distance in distances:
                 for offset in offsets:
-                    errors = single_wake_errors(input_name, veer, distance, offset, reference)
+                    errors = single_wake_errors(input_name, veer, distance, offset, reference,
+                                                quadratures=quadratures)
                     for quadrature, error in errors.items():
                         largest[quadrature] = max(largest[quadrature], np.max(np.abs(error)))
                     cells = np.max(np.abs(errors["3x3 cells"]))
                     if cells > worst[0]:
                         worst = (cells, (label, veer, distance, offset))
             print(f"| {label} | {'on' if veer else 'off'} | "
-                  + " | ".join(f"{100 * largest[q]:.1f} %" for q in QUADRATURES) + " |")
+                  + " | ".join(f"{100 * largest[q]:.1f} %" for q in quadratures) + " |")
     print(f"\nworst 3x3 cells case: {100 * worst[0]:.2f} % at {worst[1]}")
     # The ambient part alone: a rotor 8 D aside of the wake (no wake on it).
-    unwaked = single_wake_errors(INPUTS["NREL 5 MW, farm input"], True, 7.0, 8.0, reference)
+    unwaked = single_wake_errors(INPUTS["NREL 5 MW, farm input"], True, 7.0, 8.0, reference,
+                                 quadratures=quadratures)
     print("unwaked NREL 5 MW in the farm input (9 m/s): "
-          + ", ".join(f"{q} {100 * unwaked[q][0]:+.1f} %" for q in QUADRATURES))
+          + ", ".join(f"{q} {100 * unwaked[q][0]:+.1f} %" for q in quadratures))
 
 
 if __name__ == "__main__":
