@@ -128,7 +128,8 @@ def main():
 
     fmodel = farm(args.side)
     series, classes = records(args.records, args.classes)
-    block = atmosphere_of(fmodel.core).sliced(slice(None))
+    block = dict(atmosphere_of(fmodel.core).sliced(slice(None)))
+    block.pop("cooling_rate", None)  # the input's own stability, replaced by each class's L
     stability = {f"L={length:.6g}": {"atmosphere": dict(block, obukhov_length=float(length))}
                  for length in np.geomspace(100.0, 2000.0, args.classes)}
     names = np.array(list(stability))[classes]

@@ -56,6 +56,7 @@ def configuration(stability_parameter: float, variant: str, speed: float, direct
     config["farm"].update(layout_x=x.ravel().tolist(), layout_y=y.ravel().tolist())
     wake = config["wake"]
     block = wake["wake_velocity_parameters"]["ekman_veer"]
+    block["atmosphere"].pop("cooling_rate", None)  # the input's own stability, replaced
     block["atmosphere"]["stability_parameter"] = stability_parameter
     turbulence = builtin_inflow_settings(block["atmosphere"], [speed], 90.0, HUB_HEIGHT,
                                          ROTOR_DIAMETER)["turbulence_intensities"]

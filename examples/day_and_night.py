@@ -3,9 +3,9 @@ implies at every wind speed (docs/atmosphere.md#convective-boundary-layer,
 docs/yaw_steering.md#the-validated-envelope).
 
 ``inputs/farm_day.yaml`` is a convective afternoon named by its surface heat flux (+150 W/m^2)
-and mixed-layer depth (1500 m); ``inputs/farm_night.yaml`` a stable night named by its Obukhov
-length (100 m); ``inputs/farm_sbl6.yaml`` fixes Table 1's SBL-6 mu. For each, at 3-19 m/s at
-90 m, this prints the boundary-layer height, the
+and mixed-layer depth (1500 m); ``inputs/farm_night.yaml`` a stable night named by its surface
+cooling rate (-0.25 K/h, the paper's SBL-3); ``inputs/farm_sbl6.yaml`` the paper's SBL-6 by its
+cooling rate (-1 K/h). For each, at 3-25 m/s at 90 m, this prints the boundary-layer height, the
 Obukhov length, the implied surface sensible heat flux, the friction Rossby number, the
 stability class, the veer across the NREL 5 MW rotor, I_u(90 m) and whether the condition lies
 inside the paper's validated envelope (floris_ekman_veer.validity_report), then the farm power
@@ -41,9 +41,9 @@ OBUKHOV_LENGTHS = [-1e5, -1e3, -300.0, -150.0, -100.0]
 #: domain (docs/atmosphere.md#physical-domain).
 DRAG_LAW_LENGTHS = {-1e5: "-1e5", -1e4: "-1e4", -1e3: "-1000", -300.0: "-300", -100.0: "-100",
                     -30.0: "-30"}
-#: To 19 m/s: above it the fixed mu of farm_sbl6 and L of farm_night imply H < -300 W/m^2,
-#: outside the physical domain (docs/atmosphere.md#physical-domain).
-SPEEDS = [3.0, 4.0, 6.0, 8.0, 10.0, 11.0, 12.0, 15.0, 19.0]
+#: Cut-in to cut-out: the cooling rates stay inside the physical domain (farm_sbl6's -1 K/h is
+#: carried at H = -300 W/m^2 from 21 m/s, its outside_domain: limit; stability_limited).
+SPEEDS = [3.0, 4.0, 6.0, 8.0, 9.0, 10.0, 11.0, 12.0, 15.0, 19.0, 25.0]
 
 
 def farm(name: str, speeds=SPEEDS) -> FlorisModel:
@@ -141,7 +141,7 @@ def deep_mixed_layer(speed=8.0):
 def main():
     columns = ["wind_speed", "boundary_layer_height", "obukhov_length", "sensible_heat_flux",
                "friction_rossby_number", "stability_class", "veer_across_rotor_deg",
-               "turbulence_intensity", "inside_envelope"]
+               "turbulence_intensity", "inside_envelope", "stability_limited"]
     for name in ("farm_day", "farm_night", "farm_sbl6"):
         report = table(name)
         print(f"\n{name}:")

@@ -4,8 +4,8 @@ Run it from anywhere (after ``pip install -e .`` in the repository, or from a ch
 
     python examples/farm_main.py [--output DIR]
 
-It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 stability: f_c =
-1e-4 1/s, z0 = 0.1 m, mu = 148.49, N = 6.1e-3 1/s) and compares, on the SAME Ekman inflow:
+It loads ``inputs/farm_sbl6.yaml`` (3 x 3 NREL 5 MW at 7 D, the paper's SBL-6 by its surface
+cooling rate: f_c = 1e-4 1/s, z0 = 0.1 m, C_r = -1 K/h, N = 6.1e-3 1/s) and compares, on the SAME Ekman inflow:
 
 * M-1    ``ekman_veer`` velocity + deflection (yaw and veer deflection: the wake is sheared),
 * M-2    the same with the veer deflection off (``wake_deflection_parameters.ekman_veer.veer``),
@@ -21,7 +21,7 @@ gives gauss the rotor-layer veer as FLORIS's ``wind_veer`` (as
 ``floris_ekman_veer.studies.comparison.builtin_inflow_settings`` suggests). It is off by default:
 FLORIS's gauss narrows its initial width by cos(wind_veer) and tilts its ellipse, and with this
 night's ~40 degrees and I_u ~ 0.02 its deficit saturates (u = 0 on part of the waked rotor at
-9 m/s, 81 kW instead of 401 kW for the turbine 7 D behind). It prints the ABL of each
+9 m/s, 107 kW instead of 495 kW for the turbine 7 D behind). It prints the ABL of each
 wind speed, per-turbine and farm powers at 270 deg, farm power over a small wind rose at 9 m/s
 and a yaw-optimisation demo (FLORIS's YawOptimizationSR over -25..25 deg: with veer the optimum
 is not symmetric in the sign of yaw), and writes figures to DIR (default ./output).
@@ -154,7 +154,7 @@ def print_abl(farm: Farm, speeds) -> dict:
     k_w = abl.wake_expansion_rate(z_h)
     print(f"Atmosphere (Ekman-surface-layer ABL of {FARM_INPUT.name}): f_c = "
           f"{farm.atmosphere['coriolis_parameter']:g} 1/s, z0 = {farm.atmosphere['roughness_length']:g} m, "
-          f"mu = {farm.atmosphere['stability_parameter']:g}, "
+          f"C_r = {farm.atmosphere['cooling_rate']:g} K/h, "
           f"N = {farm.atmosphere['brunt_vaisala_frequency']:g} 1/s")
     print(f"  rotor layer {z_h - radius:.0f}-{z_h + radius:.0f} m (NREL 5 MW, D = "
           f"{farm.diameter:.0f} m, z_h = {z_h:.0f} m)")

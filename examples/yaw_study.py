@@ -6,8 +6,8 @@ Run it from anywhere (after ``pip install .``, or from a checkout):
 
 Three atmospheres, each named by a forcing fixed across wind speeds and read from the project's
 inputs: the neutral day (CNBL, ``inputs/cnbl.yaml``'s atmosphere), the paper's SBL-4 cooling rate
-(-0.375 K/h, ``inputs/sbl4.yaml``) and the shipped stable night (Obukhov length 100 m,
-``inputs/farm_night.yaml``). One line per atmosphere says which conditions lie inside the
+(-0.375 K/h, ``inputs/sbl4.yaml``) and the shipped stable night (the paper's SBL-3 cooling rate,
+-0.25 K/h, ``inputs/farm_night.yaml``). One line per atmosphere says which conditions lie inside the
 paper's validated envelope (``floris_ekman_veer.validity_report``): SBL-4 at 8 m/s has h below
 the NREL 5 MW rotor top, and its rows are flagged.
 
@@ -75,13 +75,13 @@ ROSE_WEIBULL = (2.0, 8.0)                      # shape k, scale A [m/s] of the s
 ROSE_PREVAILING, ROSE_SPREAD = 270.0, 60.0     # deg: direction of most wind, its spread
 GRIDS = {
     False: dict(spacings=(4.0, 5.0, 7.0), speeds=(8.0, 10.0, 12.0), models=tuple(MODELS),
-                atmospheres=("CNBL", "SBL-4", "night L=100 m"),
+                atmospheres=("CNBL", "SBL-4", "night -0.25 K/h"),
                 rose_directions=np.arange(0.0, 360.0, 30.0), rose_speeds=np.arange(4.0, 14.1, 2.0),
                 rose_models=("ekman_veer", "gch"), rose_bounds=(-YAW_LIMIT, YAW_LIMIT)),
     # Each FLORIS optimiser evaluation rebuilds a model: the reduced study makes few of them
     # (and steers the farm one way only, two optimiser runs instead of six).
     True: dict(spacings=(5.0,), speeds=(8.0,), models=("ekman_veer",),
-               atmospheres=("CNBL", "night L=100 m"),
+               atmospheres=("CNBL", "night -0.25 K/h"),
                rose_directions=np.array([270.0]), rose_speeds=np.array([8.0]),
                rose_models=("ekman_veer",), rose_bounds=(0.0, YAW_LIMIT)),
 }
@@ -94,7 +94,7 @@ def _block(path):
 def atmospheres() -> dict[str, dict]:
     """The neutral day, SBL-4 and the shipped night, from the inputs."""
     return {"CNBL": _block(CNBL_INPUT), "SBL-4": _block(SBL4_INPUT),
-            "night L=100 m": _block(NIGHT_INPUT)}
+            "night -0.25 K/h": _block(NIGHT_INPUT)}
 
 
 def wind_rose(directions, speeds) -> WindRose:
@@ -196,7 +196,7 @@ def row_yaw_study(atmospheres_: dict, spacings, speeds, models, inside: dict):
 
 
 def day_night_energy(atmospheres_: dict, directions, speeds, models, bounds=(-YAW_LIMIT, YAW_LIMIT)):
-    """AEP of the 3 x 3 farm: neutral days and stable nights (L = 100 m), with and without
+    """AEP of the 3 x 3 farm: neutral days and stable nights (-0.25 K/h), with and without
     steering."""
     stability = {
         "neutral day": {"frequency": 1.0 - NIGHT_FREQUENCY, "atmosphere": atmospheres_["CNBL"]},
@@ -349,7 +349,7 @@ def main(argv=None) -> None:
         return
     print("\n3 x 3 farm, day/night annual energy [GWh] with and without wake steering "
           f"(Weibull k = {ROSE_WEIBULL[0]:g}, A = {ROSE_WEIBULL[1]:g} m/s; nights "
-          f"{NIGHT_FREQUENCY:.0%} of the year, L = 100 m; days CNBL):")
+          f"{NIGHT_FREQUENCY:.0%} of the year, -0.25 K/h; days CNBL):")
     print(energy.table.to_string(index=False, float_format="%.3f"))
     for path in paths + [plot_energy(energy, args.output)]:
         print(f"wrote {path}")

@@ -140,3 +140,23 @@ def own_turbine(config: dict, name: str = "my_nrel_5MW") -> dict:
         turbine if t in ("nrel_5MW",) or (isinstance(t, dict) and t.get("turbine_type") == "nrel_5MW")
         else t for t in config["farm"]["turbine_type"]]
     return config
+
+
+#: Table 1's SBL-6 stability parameter: the state the LES reached at G = 15 m/s.
+TABLE1_SBL6_MU = 148.49
+
+
+def table1_sbl6(config) -> dict:
+    """``config`` (an input dict, or a YAML path) with its atmosphere's stability given as
+    Table 1's SBL-6 mu = 148.49, fixed across speeds, instead of the input's own (farm_sbl6's
+    cooling rate -1 K/h since issue 39, whose layer is below the hub at 8-9 m/s). For tests of
+    machinery and rotor accuracy designed on that state: h (110-165 m at 8-11 m/s) stays above
+    the hub."""
+    from floris.utilities import load_yaml
+
+    config = copy.deepcopy(load_yaml(str(config)) if not isinstance(config, dict) else config)
+    atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
+    for key in ("cooling_rate", "obukhov_length", "surface_heat_flux", "sensible_heat_flux"):
+        atmosphere.pop(key, None)
+    atmosphere["stability_parameter"] = TABLE1_SBL6_MU
+    return config

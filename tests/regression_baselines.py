@@ -1,8 +1,9 @@
 """The tests' regression baselines, pinned to catch unintended changes (FLORIS's regression style);
 the physics assertions next to their tests are what establishes correctness.
 
-* ``baseline_row``, ``yawed_baseline_row``, ``baseline_square``: NREL 5 MW farms in the farm_sbl6
-  atmosphere (tests/plugin/wake_models/test_models.py, section 4; set its ``DEBUG = True`` to print them).
+* ``baseline_row``, ``yawed_baseline_row``, ``baseline_square``: NREL 5 MW farms with the blocks of
+  farm_sbl6 in Table 1's SBL-6 state mu = 148.49 (the input's stability until issue 39;
+  tests/plugin/wake_models/test_models.py, section 4; set its ``DEBUG = True`` to print them).
 * ``ARC_BASELINE``, ``ROWS_BASELINE``, ``EFFICIENCY_BASELINE``: the validation study's error tables
   on its reduced set (tests/studies/test_validation_cases.py).
 """

@@ -47,6 +47,8 @@ BAD_CALLS = {
         (lambda m: EkmanABL(**{**BASE, "geostrophic_wind": -1.0}), "geostrophic_wind"),
         (lambda m: EkmanABL(**{**BASE, "latitude": 0.0}), "latitude"),
         (lambda m: EkmanABL(**BASE, mixed_layer_height=6000.0), "mixed_layer_height"),
+        (lambda m: EkmanABL(**BASE, turbulence_factor=120.0), "turbulence_factor.*<= 10"),
+        (lambda m: EkmanABL(**BASE, turbulence_factor=[1.2, True]), "turbulence_factor"),
         (lambda m: EkmanABL(**BASE, sensible_heat_flux=900.0), "sensible_heat_flux"),
         (lambda m: EkmanABL(**BASE, obukhov_length=-2.0), "sensible heat flux H"),
         (lambda m: EkmanABL(**{**BASE, "geostrophic_wind": 90.0}), "geostrophic wind G"),

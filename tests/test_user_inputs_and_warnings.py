@@ -138,18 +138,18 @@ def test_shallow_warning_at_the_users_line_once_per_study_with_a_summary():
 
     with caught() as records:
         fmodel = FlorisModel(FARM)
-        fmodel.set(wind_directions=[270.0] * 5, wind_speeds=[6.0, 7.0, 8.0, 9.0, 11.0],
+        fmodel.set(wind_directions=[270.0] * 5, wind_speeds=[6.0, 7.0, 8.0, 9.0, 15.0],
                    turbulence_intensities=[0.06] * 5)
         assert not of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
         YawOptimizationSR(fmodel, minimum_yaw_angle=-10.0, maximum_yaw_angle=10.0,  # OPT-LINE
                           Ny_passes=[3, 2]).optimize(print_progress=False)
-        fmodel.set(wind_speeds=[9.0, 8.0, 7.0, 6.0, 11.0])  # same conditions: nothing new
+        fmodel.set(wind_speeds=[9.0, 8.0, 7.0, 6.0, 15.0])  # same conditions: nothing new
         fmodel.run()
     shallow_records = of(records, floris_ekman_veer.ShallowBoundaryLayerWarning)
     assert [(r.filename, r.lineno) for r in shallow_records] == [
         (__file__, line_of("# OPT" "-LINE"))]
     assert str(shallow_records[0].message).startswith(
-        "4 of 5 conditions (wind speeds 6, 7, 8 and 9 m/s at 90 m; h = 90.11 to 125.4 m)")
+        "4 of 5 conditions (wind speeds 6, 7, 8 and 9 m/s at 90 m; h = 43.24 to 86.3 m)")
 
 
 def test_every_shipped_input_builds_without_a_warning():
@@ -173,7 +173,7 @@ def test_optimize_yaw_counts_the_shallow_conditions_once_at_its_start():
     from floris.optimization.yaw_optimization.yaw_optimizer_sr import YawOptimizationSR
 
     fmodel = FlorisModel(FARM)
-    fmodel.set(wind_directions=[270.0, 280.0, 270.0], wind_speeds=[8.0, 9.0, 12.0],
+    fmodel.set(wind_directions=[270.0, 280.0, 270.0], wind_speeds=[8.0, 9.0, 15.0],
                turbulence_intensities=[0.06] * 3)
     with caught() as records:
         floris_ekman_veer.optimize_yaw(fmodel, YawOptimizationSR, minimum_yaw_angle=-10.0,  # YAW
@@ -272,7 +272,7 @@ def test_parallel_chunks_do_not_repeat_the_shallow_warning():
     from floris import ParFlorisModel
 
     fmodel = FlorisModel(FARM)
-    fmodel.set(wind_speeds=[8.0, 9.0, 11.0, 12.0], wind_directions=[270.0] * 4,
+    fmodel.set(wind_speeds=[8.0, 9.0, 15.0, 16.0], wind_directions=[270.0] * 4,
                turbulence_intensities=[0.06] * 4)
     par = ParFlorisModel(fmodel, interface="multiprocessing", max_workers=2)
     with caught() as records:
@@ -418,8 +418,8 @@ def test_reference_height_minus_one_keeps_the_shallow_check():
 def test_hub_in_the_roughness_sublayer_warns():
     config = load_yaml(str(FARM))
     atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
-    # neutral: with SBL-6's mu a 40 m roughness implies H = -1,969 W/m^2 (docs/atmosphere.md#physical-domain)
-    atmosphere.update(roughness_length=40.0, stability_parameter=0.0)
+    # neutral: the hub in the roughness sublayer, not the stability, is tested here
+    atmosphere.update(roughness_length=40.0, cooling_rate=0.0)
     with caught() as records:
         FlorisModel(config)
     (record,) = of(records, floris_ekman_veer.TurbinePlacementWarning)
@@ -461,7 +461,7 @@ def test_pandas_series_are_accepted_like_arrays():
     np.testing.assert_array_equal(from_series.boundary_layer_height, from_array.boundary_layer_height)
     config = load_yaml(str(FARM))
     atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
-    atmosphere["stability_parameter"] = pd.Series([148.49, 100.0])
+    atmosphere["cooling_rate"] = pd.Series([-1.0, -0.5])
     config["flow_field"].update(wind_speeds=[9.0, 9.0], wind_directions=[270.0] * 2,
                                 turbulence_intensities=[0.06] * 2)
     FlorisModel(config).run()

@@ -51,6 +51,7 @@ from floris_ekman_veer.atmosphere.constants import (
 from floris_ekman_veer.atmosphere.fit.fit import fit_profile
 from floris_ekman_veer.atmosphere.inputs.input_ranges import (
     MAX_MIXED_LAYER_HEIGHT,
+    MAX_TURBULENCE_FACTOR,
     MIN_BOUNDARY_LAYER_HEIGHT,
     POTENTIAL_TEMPERATURE_RANGE,
     VALID_RANGES,
@@ -304,6 +305,11 @@ class EkmanABL(WindProfile, EkmanSolver):
       ``lapse_rate`` dTheta/dz [K/m] >= 0 (N = sqrt(g/Theta0 gamma)); default the paper's
       N_inf = 6.1e-3 1/s. Enters through the Zilitinkevich number mu_N = N/|f_c|.
     - ``reference_potential_temperature`` Theta0 [K], default the paper's 265 K.
+    - ``turbulence_factor`` (beyond the paper; default None, the paper's I_u): the site's
+      ambient streamwise turbulence as a factor on the model's I_u(z) of Eq. (Iu_model), > 0 and
+      <= 10; it scales `turbulence_intensity` and hence the wake expansion rate k_w of
+      Eq. (kw_CNBL_SBL_model), not the mean wind. A measured hub-height TI over the model's I_u
+      there (terrain, upwind roughness: docs/atmosphere.md#ambient-turbulence).
     - Model constants: ``von_karman`` 0.41, ``c_g`` 1.43, ``stress_decay`` (Gamma) 0.83,
       ``c_tn`` 0.5, ``c_cn`` 1.6, ``c_ns`` 0.78, ``matching_fraction`` 0.2, and, beyond the
       paper, ``businger_dyer_gamma`` 16 (Dyer 1974; 19.3 for Hogstrom 1988).
@@ -357,6 +363,7 @@ class EkmanABL(WindProfile, EkmanSolver):
         brunt_vaisala_frequency=None,
         lapse_rate=None,
         reference_potential_temperature=PAPER_POTENTIAL_TEMPERATURE,
+        turbulence_factor=None,
         von_karman=0.41,
         c_g=1.43,
         stress_decay=0.83,
@@ -396,6 +403,10 @@ class EkmanABL(WindProfile, EkmanSolver):
             "mixed_layer_height", mixed_layer_height,
             lambda z: (z >= MIN_BOUNDARY_LAYER_HEIGHT) & (z <= MAX_MIXED_LAYER_HEIGHT),
         )
+        #: The ambient turbulence over the model's I_u (None: the paper's I_u, no factor).
+        self.turbulence_factor = None if turbulence_factor is None else checked(
+            "turbulence_factor", turbulence_factor,
+            lambda c: (c > 0) & (c <= MAX_TURBULENCE_FACTOR))[()]
         given = {
             "coriolis_parameter" if latitude is None else "latitude": self.coriolis_parameter,
             "roughness_length": self.roughness_length,
@@ -406,6 +417,8 @@ class EkmanABL(WindProfile, EkmanSolver):
         }
         if self.mixed_layer_height is not None:
             given["mixed_layer_height"] = self.mixed_layer_height
+        if self.turbulence_factor is not None:
+            given["turbulence_factor"] = self.turbulence_factor
         if geostrophic_wind is _INPUTS_ONLY:
             require_broadcastable(given)
             return

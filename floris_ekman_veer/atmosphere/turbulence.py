@@ -82,6 +82,7 @@ def streamwise_turbulence_intensity(
     A1: float = TOWNSEND_PERRY_A1,
     B1: float = TOWNSEND_PERRY_B1,
     convective=0.0,
+    turbulence_factor=None,
 ):
     """I_u = [A1 ln(h/z) + B1]^(1/2) u*/U_ref, Eq. (Iu_model); above h the law is continued to
     its zero at h exp(B1/A1) and is 0 higher up (see `_variance_factor`). In a convective layer
@@ -90,12 +91,17 @@ def streamwise_turbulence_intensity(
 
     ``reference_speed`` is U_h in the paper (hub-height speed); any positive speed works.
     Heights must be positive (the caller checks them against the roughness length).
+    ``turbulence_factor`` (beyond the paper; None: the paper's I_u) scales it to a site's
+    ambient turbulence (docs/atmosphere.md#ambient-turbulence).
     """
-    return (
+    intensity = (
         _variance_factor(height, boundary_layer_height, A1, B1, convective)
         * np.asarray(friction_velocity, dtype=float)
         / np.asarray(reference_speed, dtype=float)
     )
+    if turbulence_factor is None:
+        return intensity
+    return intensity * np.asarray(turbulence_factor, dtype=float)
 
 
 def wake_expansion_rate(
@@ -109,6 +115,7 @@ def wake_expansion_rate(
     floor: float = MIXING_LAYER_FLOOR,
     n: float = MERGE_EXPONENT,
     convective=0.0,
+    turbulence_factor=None,
 ):
     """k_w = [floor^n + (alpha' I_u(z_h))^n]^(1/n), Eq. (kw_CNBL_SBL_model).
 
@@ -122,9 +129,12 @@ def wake_expansion_rate(
 
     ``convective``: the buoyant variance of a convective layer (`convective_variance`), so
     that k_w = alpha' I_u keeps the paper's form there (docs/atmosphere.md#convective-turbulence).
+    ``turbulence_factor``: I_u scaled to the site's ambient turbulence (beyond the paper;
+    docs/atmosphere.md#ambient-turbulence), so that k_w = alpha' I_0 with the measured I_0.
     """
     hub_height = np.asarray(hub_height, dtype=float)
     turbulent = alpha_prime * streamwise_turbulence_intensity(
-        hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1, convective
+        hub_height, friction_velocity, boundary_layer_height, hub_speed, A1, B1, convective,
+        turbulence_factor,
     )
     return np.power(floor**n + np.power(turbulent, n), 1.0 / n)

@@ -6,7 +6,8 @@ expansion rate, and the stability quantities the solved state implies (L, Q0, H,
 `WindProfile` is the part of `EkmanABL` that reads a solved state: the attributes set by
 `EkmanABL.set_state` (``friction_velocity``, ``boundary_layer_height``, ``h_hat``,
 ``stability_parameter``, ``geostrophic_components``, ``convective_variance``) and the inputs
-(``roughness_length``, ``coriolis_magnitude``, ``hemisphere``, the model constants).
+(``roughness_length``, ``coriolis_magnitude``, ``hemisphere``, the model constants,
+``turbulence_factor``).
 """
 
 from __future__ import annotations
@@ -33,6 +34,10 @@ from floris_ekman_veer.atmosphere.turbulence import (
 class WindProfile:
     """The profiles and implied stability quantities of a solved ABL (the methods of
     `EkmanABL` that read its solved state; module docstring)."""
+
+    #: The ambient turbulence over the model's I_u (an input of EkmanABL beyond the paper,
+    #: docs/atmosphere.md#ambient-turbulence); None: the paper's I_u.
+    turbulence_factor = None
 
     # ----------------------------------------------------------------------------- stability
     @property
@@ -208,7 +213,8 @@ class WindProfile:
         Normalised by the speed at ``reference_height`` (the paper's U_h) when given, else by
         the local speed |(U, V)(z)| (the two agree at the reference height). Above h the
         variance law is continued to its zero at h exp(B1/A1) and is zero higher up
-        (docs/atmosphere.md#shallow-boundary-layer).
+        (docs/atmosphere.md#shallow-boundary-layer). Times ``turbulence_factor`` where the ABL
+        was given one (docs/atmosphere.md#ambient-turbulence).
         """
         z = self._log_layer_heights(z, "z")
         A1, B1 = checked_turbulence_constants(A1=A1, B1=B1).values()
@@ -220,7 +226,7 @@ class WindProfile:
             )
         return streamwise_turbulence_intensity(
             z, self.friction_velocity, self.boundary_layer_height, reference_speed, A1, B1,
-            self.convective_variance,
+            self.convective_variance, self.turbulence_factor,
         )
 
     def wake_expansion_rate(self, hub_height, **constants):
@@ -235,5 +241,5 @@ class WindProfile:
         return wake_expansion_rate(
             self.friction_velocity, self.boundary_layer_height, hub_height,
             np.hypot(*self._velocity(hub_height)), convective=self.convective_variance,
-            **constants,
+            turbulence_factor=self.turbulence_factor, **constants,
         )

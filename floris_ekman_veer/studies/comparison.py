@@ -20,8 +20,8 @@ reference wind, :func:`builtin_inflow_settings` gives each of them the best info
     Caution: at the large rotor-layer veer of strongly stable nights (30-40 degrees) the
     cos(wind_veer) narrowing makes gauss's initial wake so thin and deep that, with the low
     I_u of such nights, its deficit reaches u = 0 on part of a downstream rotor (measured with
-    ``inputs/farm_sbl6.yaml`` at 9 m/s: 41 degrees of veer, the second-row turbine's power falls
-    from 433 kW to 86 kW). Compare with and without it (``wind_veer = 0``) before reading such a
+    ``inputs/farm_sbl6.yaml`` at 9 m/s, ``examples/farm_main.py --gauss-wind-veer``: 39 degrees
+    of veer, the second-row turbine's power falls from 495 kW to 107 kW). Compare with and without it (``wind_veer = 0``) before reading such a
     gauss result as the effect of veer.
 ``wind_shear``
     A rotor-equivalent power-law exponent: the weighted least-squares fit of

@@ -167,7 +167,10 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
     ``rossby_range``, default :data:`ROSSBY_RANGE`) and ``inside_envelope`` (all three), and
     ``at_rest`` (a calm condition: no boundary layer, its columns NaN), and
     ``farm_coupling_beyond_paper`` (:func:`farm_coupling_beyond_paper`: the same for every
-    condition) and ``near_wake_beyond_paper`` (:func:`near_wake_beyond_paper`).
+    condition) and ``near_wake_beyond_paper`` (:func:`near_wake_beyond_paper`), and
+    ``ambient_turbulence_beyond_paper`` (the atmosphere's ``turbulence_factor`` other than 1:
+    the wake's I_u scaled to a site's measured turbulence, docs/atmosphere.md#ambient-turbulence;
+    ``turbulence_intensity`` is then the scaled one).
 
     Raises:
         ValueError: if ``fmodel`` has no atmosphere (plain FLORIS has nothing to report), or if
@@ -231,6 +234,8 @@ def validity_report(fmodel, rossby_range=ROSSBY_RANGE) -> pd.DataFrame:
         "inside_envelope": validated & deep & in_range,
         "farm_coupling_beyond_paper": farm_coupling_beyond_paper(core),
         "near_wake_beyond_paper": near_wake_beyond_paper(core),
+        "ambient_turbulence_beyond_paper": per_condition(
+            1.0 if abl.turbulence_factor is None else abl.turbulence_factor) != 1.0,
     }), rest)
 
 

@@ -15,6 +15,8 @@ on every thread).
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -27,6 +29,7 @@ from .deficit import (
     time_like_strength,
 )
 from .deflection import IMAGE_CORE
+from .near_wake import BISECTION_STEPS, GAUSSIAN_ORDER
 
 #: How the compiled functions are compiled: cached on disk, IEEE arithmetic (no fastmath).
 JIT = {"cache": True, "fastmath": False, "error_model": "numpy"}
@@ -82,14 +85,57 @@ def centre_offset(x, z, local_u, local_v, strength, r_tube, hub_height, radius, 
     ``veer`` times x V(z)/U(z) (Eq. yc_veer); 0 where there is no flow (U(z) <= 0)."""
     if not local_u > 0.0:
         return 0.0
-    t_hat = strength * -np.expm1(-0.35 * (friction_velocity / local_u) * x / radius)
-    abs_t = abs(t_hat)
+    return grown_centre_offset(time_growth(x, local_u, radius, friction_velocity), x, z,
+                               local_u, local_v, strength, r_tube, hub_height, veer,
+                               ground_image)
+
+
+@numba.njit(**JIT)
+def time_growth(x, speed, radius, friction_velocity):
+    """1 - exp(-0.35 (u*/U) x/R), t_hat's growth of Eq. (that) at a height where the speed is
+    U = ``speed`` > 0 (the centre's and the curl's t_hat at a row share it)."""
+    return -np.expm1(-0.35 * (friction_velocity / speed) * x / radius)
+
+
+@numba.njit(**JIT)
+def _vortex_pair_offset(abs_t):
+    # |y_hat_c| of Eq. (yhatc) without the image, at |t_hat| = abs_t (increasing in abs_t).
     pm1 = np.pi - 1.0
     numerator = (pm1 * abs_t * abs_t * abs_t + 2.0 * np.sqrt(3.0) * np.pi**2 * abs_t * abs_t
                  + 48.0 * pm1**2 * abs_t)
     denominator = (2.0 * np.pi * pm1 * abs_t * abs_t + 4.0 * np.sqrt(3.0) * np.pi**2 * abs_t
                    + 96.0 * pm1**2)
-    y_hat = np.sign(t_hat) * numerator / denominator
+    return numerator / denominator
+
+
+@numba.njit(**JIT)
+def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
+                        friction_velocity, veer, ground_image):
+    """(drift, bound) with |:func:`centre_offset` - drift| <= bound, without its exponential
+    (U(z) > 0): the veer's x V/U exactly, and the larger of the vortex pair's offset (Eq.
+    yhatc, increasing in |t_hat|) and its ground image's (linear in it, of the opposite sign)
+    at the bound
+    |t_hat| <= |strength| min(2a / (2 + a), 1) of Eq. (that) (1 - exp(-a) <= 2a / (2 + a) for
+    a = 0.35 (u*/U) x/R >= 0, exp's Pade bound); widened by a millionth and a micrometre for
+    the round-off. The rotor-cell kernel skips the exact centre of the rows that this bound
+    already puts out of a wake's reach."""
+    drift = veer * (x * local_v / local_u)
+    a = 0.35 * (friction_velocity / local_u) * x / radius
+    t_bound = abs(strength) * min(2.0 * a / (2.0 + a), 1.0)
+    offset = _vortex_pair_offset(t_bound)
+    if ground_image:
+        # The image's offset has the opposite sign: the difference is at most the larger.
+        eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
+        offset = max(offset, (2.0 / np.pi) * t_bound / (eta * eta - 1.0))
+    return drift, r_tube * offset * (1.0 + 1e-6) + 1e-6
+
+
+@numba.njit(**JIT)
+def grown_centre_offset(growth, x, z, local_u, local_v, strength, r_tube, hub_height, veer,
+                        ground_image):
+    """:func:`centre_offset` with t_hat's growth (:func:`time_growth`) given (U(z) > 0)."""
+    t_hat = strength * growth
+    y_hat = np.sign(t_hat) * _vortex_pair_offset(abs(t_hat))
     if ground_image:
         eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
         y_hat -= (2.0 / np.pi) * t_hat / (eta * eta - 1.0)
@@ -105,6 +151,38 @@ def _centre_offsets(x, z, local_u, local_v, strength, r_tube, hub_height, radius
                                hub_height[k], radius[k], friction_velocity[k], veer,
                                ground_image)
     return out
+
+
+@numba.njit(**JIT)
+def _centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radius,
+                   friction_velocity, veer, ground_image, points):
+    for f in range(dx.shape[0]):
+        for j in range(dx.shape[1]):
+            if not dx[f, j] > 0.0:
+                continue
+            for h in range(z.shape[2]):
+                u_fjh, v_fjh = u[f, j, h], v[f, j, h]
+                points[f, j, h] = centre_offset(
+                    dx[f, j], z[f, j, h], u_fjh * cos_a[f] + v_fjh * sin_a[f],
+                    v_fjh * cos_a[f] - u_fjh * sin_a[f], strength[f], r_tube[f], hub_height[f],
+                    radius[f], friction_velocity[f], veer, ground_image)
+
+
+def centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radius,
+                  friction_velocity, veer=True, ground_image=True):
+    """:func:`centre_offset` of one wake at the points of every rotor downstream of it (0
+    elsewhere): ``dx`` (n_findex, n_turbines) the rotors' distances behind the wake's rotor,
+    ``z``, ``u``, ``v`` (n_findex, n_turbines, heights) the points' heights and the ambient
+    (U, V) there in FLORIS's frame, turned into the hub-height wind's by (``cos_a``,
+    ``sin_a``); the wake's factors per condition (n_findex,). Returns (n_findex, n_turbines,
+    heights)."""
+    arrays = [np.ascontiguousarray(a, dtype=float) for a in (dx, z, u, v)]
+    per_condition = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), dx.shape[:1]))
+                     for a in (cos_a, sin_a, strength, r_tube, hub_height, radius,
+                               friction_velocity)]
+    points = np.zeros(arrays[1].shape)
+    _centre_points(*arrays, *per_condition, float(veer), float(ground_image), points)
+    return points
 
 
 def centre_offsets(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
@@ -189,3 +267,129 @@ def deficit_on_rows(dy, dz, parameters):
     flat = [np.ascontiguousarray(a).ravel() for a in arrays]
     q = np.stack(flat[6:11], axis=1)
     return _deficits(*flat[:6], q, flat[11]).reshape(arrays[0].shape)
+
+
+#: The columns of :func:`wake_table`, one row per wake and rotor: the kernel's per-wake factors
+#: (plugin/rotor/rotor_kernel.py reads the first seven), then how far the wake reaches (the
+#: largest width over all polar angles and the largest deficit) and its centre deficit C(x).
+WAKE_TABLE = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape",
+              "width_bound", "amplitude_bound", "centre_deficit")
+
+
+@numba.njit(**JIT)
+def _digamma(x):
+    # psi(x), x > 0: the recurrence psi(x) = psi(x + 1) - 1/x up to x >= 6, then the asymptotic
+    # series (to ~1e-13: it sets only the Newton steps of super_gaussian_order, not the root).
+    result = 0.0
+    while x < 6.0:
+        result -= 1.0 / x
+        x += 1.0
+    inverse = 1.0 / x
+    inverse2 = inverse * inverse
+    return result + np.log(x) - 0.5 * inverse - inverse2 * (
+        1.0 / 12.0 - inverse2 * (1.0 / 120.0 - inverse2 * (1.0 / 252.0 - inverse2 * (
+            1.0 / 240.0 - inverse2 / 132.0))))
+
+
+@numba.njit(**JIT)
+def _momentum_excess(n, c, loading, log_width_squared):
+    # wake/near_wake.py's _momentum_excess at one point, n C_T' / (16 Gamma(2/n) s^(4/n)) -
+    # c (2^(2/n) - c), with s^(4/n) = exp((2/n) ln s^2), and its derivative in n (Newton).
+    t = 2.0 / n
+    carried = n * loading / (16.0 * math.gamma(t) * np.exp(t * log_width_squared))
+    power = np.exp(t * np.log(2.0))
+    slope = (carried * (1.0 / n + 0.5 * t * t * (_digamma(t) + log_width_squared))
+             + c * power * np.log(2.0) * 0.5 * t * t)
+    return carried - c * (power - c), slope
+
+
+@numba.njit(**JIT)
+def super_gaussian_order(centre_deficit, loading, width_squared):
+    """wake/near_wake.py's ``super_gaussian_order`` at one point: the same root in the same
+    bracket, by Newton's method kept inside the bracket (a bisection step where Newton would
+    leave it; a handful of evaluations of the momentum integral where the bisection takes 60),
+    down to the resolution of float64, where the bisection ends too
+    (tests/physics/test_near_wake.py)."""
+    log_width_squared = np.log(width_squared)
+    lower = GAUSSIAN_ORDER
+    upper = 2.0 / (1.0 + np.log2(centre_deficit)) if centre_deficit > 0.5 else 64.0
+    excess, slope = _momentum_excess(lower, centre_deficit, loading, log_width_squared)
+    if not excess > 0.0:
+        return GAUSSIAN_ORDER
+    order = lower
+    for _ in range(2 * BISECTION_STEPS):
+        step = excess / slope
+        trial = order - step
+        if not (trial > lower and trial < upper):
+            trial = 0.5 * (lower + upper)
+        if abs(trial - order) <= 2e-16 * order or not (lower < trial < upper):
+            break
+        order = trial
+        excess, slope = _momentum_excess(order, centre_deficit, loading, log_width_squared)
+        if excess > 0.0:
+            lower = order
+        elif excess < 0.0:
+            upper = order
+        else:
+            break
+    return order
+
+
+@numba.njit(**JIT)
+def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, near_wake,
+                polar_veer, out):
+    for k in range(x.size):
+        xk, kw, r, c_t, beta = x[k], k_w[k], radius[k], ct[k], yaw[k]
+        cos_b, sin_b = np.cos(beta), np.sin(beta)
+        # Momentum theory of the yawed rotor, Eqs. (A_star), (ind_factor) (wake/deficit.py).
+        root = np.sqrt(1.0 - c_t * (cos_b * cos_b))
+        area = (1.0 + root) / (2.0 * root)
+        r_tube = r * np.sqrt(area)
+        induction = c_t * (cos_b * cos_b) / (2.0 * (1.0 + root))
+        # x0, Eq. (x0_transition), and C(x), Eq. (Cx), with sigma_tilde^2 of Eq. (sigma_tilde).
+        core = (np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * r**2 * cos_b)
+                + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * kw)
+        width0 = WIDTH_FACTOR * r_tube
+        x_decay = max(xk, core)
+        q = c_t * cos_b**3.0 * r**2 / (2.0 * ((kw * x_decay + width0)
+                                            * (kw * x_decay + width0 * cos_b)))
+        decay = q / (1.0 + np.sqrt(max(1.0 - q, 0.0)))
+        amplitude = 2.0 * induction if xk <= core else decay
+        # The near wake's super-Gaussian inside the core (wake/near_wake.py near_wake_shape).
+        order, factor = GAUSSIAN_ORDER, 1.0
+        x_wake = max(xk, 0.0)
+        if near_wake and x_wake < core:
+            width_squared = ((kw * x_wake + width0) * (kw * x_wake + width0 * cos_b)
+                             / (2.0 * r) ** 2)
+            order = super_gaussian_order(2.0 * induction, c_t * cos_b**3.0, width_squared)
+            if order != GAUSSIAN_ORDER:
+                factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
+        out[k, 0] = amplitude
+        out[k, 1] = kw * xk * factor
+        out[k, 2] = WIDTH_FACTOR * r_tube * abs(cos_b) * factor
+        out[k, 3] = sin_b**2
+        # t_hat's prefactor, Eq. (that) (0: no curl, xi_hat = 1).
+        out[k, 4] = (-1.44 * (hub_speed[k] / friction_velocity[k]) / np.sqrt(area)
+                     * (c_t * (cos_b * cos_b) * sin_b)) if curl else 0.0
+        out[k, 5] = polar_veer
+        out[k, 6] = order
+        out[k, 7] = (kw * xk + WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)) * factor
+        out[k, 8] = amplitude
+        out[k, 9] = amplitude
+
+
+def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
+               near_wake=True, polar_veer=0.0):
+    """The per-wake factors of Eq. (du_model) for the rotor-cell kernel and the wake's reach,
+    (pairs, :data:`WAKE_TABLE`), compiled, one row per wake and rotor: the same numbers as
+    :func:`wake_deficit_parameters` with wake/near_wake.py's ``near_wake_shape`` (with
+    ``near_wake``) and the bounds of the M-1 velocity model (``width_bound``: k_w x +
+    0.4 R sqrt(A*) (1 + alpha), times the near wake's width factor; ``amplitude_bound`` and
+    ``centre_deficit``: C(x)), in one pass (tests/physics/test_near_wake.py compares them).
+    Arguments: 1-D arrays of the pairs (``x`` > 0 the distance behind the rotor; the
+    thrust coefficient ``ct`` within momentum theory, as the velocity model limits it)."""
+    arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), np.shape(x)))
+              for a in (x, k_w, radius, ct, yaw, friction_velocity, hub_speed)]
+    out = np.empty((arrays[0].size, len(WAKE_TABLE)))
+    _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), out)
+    return out

@@ -24,15 +24,16 @@ def study():
 
 
 def test_every_atmosphere_is_summarised_and_the_night_is_flagged(study):
-    """At 8 m/s the CNBL is inside the paper's validated envelope; the L = 100 m night is not:
-    its u*/(f z0) = 2.8e4 is below the LES's 3.39e4 (docs/yaw_steering.md#the-validated-envelope)."""
+    """At 8 m/s the CNBL is inside the paper's validated envelope; the shipped night is not:
+    its h (197 m) is below 1.33 x the rotor top and its u*/(f z0) = 2.5e4 below the LES's 3.39e4
+    (docs/yaw_steering.md#the-validated-envelope)."""
     _, result = study
-    assert set(result["validity"]) == {"CNBL", "night L=100 m"}
+    assert set(result["validity"]) == {"CNBL", "night -0.25 K/h"}
     line = result["validity"]["CNBL"]
     assert line.startswith("CNBL: 1 of 1 conditions inside the paper's validated envelope"), line
     assert "OUTSIDE" not in line
-    line = result["validity"]["night L=100 m"]
-    assert line.startswith("night L=100 m: 0 of 1 conditions inside"), line
+    line = result["validity"]["night -0.25 K/h"]
+    assert line.startswith("night -0.25 K/h: 0 of 1 conditions inside"), line
     assert "OUTSIDE at 8 m/s" in line and "Ro outside the LES's" in line
     yaw = result["yaw"]
     assert yaw[yaw.atmosphere == "CNBL"]["inside_envelope"].all()
@@ -52,18 +53,18 @@ def test_optima_respect_the_bounds_and_search_both_signs(study):
 
 def test_the_yawed_rotor_sees_the_night_veer(study):
     """The front rotor's P(+20)/P(-20): symmetric within 1 % on the neutral day, about 8 % apart
-    on the L = 100 m night (19 deg of veer across the rotor); every model shares the rotor."""
+    on the shipped night at 8 m/s (25 deg of veer across the rotor); every model shares the rotor."""
     _, result = study
     yaw = result["yaw"].set_index(["atmosphere", "model"])
     ratio = yaw["front_P_plus_over_minus"]
     assert np.ptp(ratio.loc["CNBL"].to_numpy()) == 0.0
     assert abs(ratio.loc[("CNBL", "ekman_veer")] - 1.0) < 0.01
-    assert 0.88 < ratio.loc[("night L=100 m", "ekman_veer")] < 0.95
+    assert 0.88 < ratio.loc[("night -0.25 K/h", "ekman_veer")] < 0.95
 
 
 def test_veer_makes_the_two_signs_differ_at_night(study):
     _, result = study
-    night = result["yaw"].set_index(["atmosphere", "model"]).loc[("night L=100 m", "ekman_veer")]
+    night = result["yaw"].set_index(["atmosphere", "model"]).loc[("night -0.25 K/h", "ekman_veer")]
     assert night["gain_percent"] > 0.5
     assert abs(night["gain_plus_only"] - night["gain_minus_only"]) > 0.5
 

@@ -87,3 +87,55 @@ def test_near_wake_is_flatter_and_deeper_across_the_rotor():
     edge = np.array([RADIUS])
     for k, xk in enumerate(x):
         assert _deficit(xk, edge, ct, (order[k], factor[k]))[0] > _deficit(xk, edge, ct, None)[0]
+
+
+def test_compiled_order_is_the_bisection_root():
+    """The rotor cells' compiled order (wake/fused.py super_gaussian_order, Newton kept in the
+    bracket) is the numpy bisection's root to float64 resolution, across loadings, centre
+    deficits on both sides of 1/2 (the two brackets) and widths, and 2 where the Gaussian
+    already carries the thrust."""
+    from floris_ekman_veer.wake.fused import super_gaussian_order as compiled_order
+
+    rng = np.random.default_rng(11)
+    centre = rng.uniform(0.2, 0.7, 2000)
+    loading = rng.uniform(0.3, 0.95, 2000)
+    width_squared = rng.uniform(0.002, 0.3, 2000)
+    bisection = super_gaussian_order(centre, loading, width_squared)
+    newton = np.array([compiled_order(*point) for point in zip(centre, loading, width_squared)])
+    shaped = bisection != 2.0
+    assert 500 < np.count_nonzero(shaped) < 1900 and np.any(centre[shaped] > 0.5)
+    np.testing.assert_array_equal(newton[~shaped], 2.0)
+    np.testing.assert_allclose(newton, bisection, rtol=4e-15, atol=0.0)
+
+
+@pytest.mark.parametrize("near_wake", ["super_gaussian", "potential_core"])
+@pytest.mark.parametrize("polar_angle_centre", ["wake_centre", "yaw_centre"])
+def test_compiled_wake_table_equals_the_model_methods(near_wake, polar_angle_centre):
+    """M-1's compiled table for the rotor cells (wake/fused.py wake_table: C(x), x0, the
+    near wake's order and width factor, the kernel's factors, the width bound, in one pass)
+    equals the model's numpy methods (kernel_table, width_bound, amplitude_bound,
+    centre_deficit: EkmanWakeModel.wake_table) inside and beyond the potential core, yawed
+    both ways, with and without the curl."""
+    from floris_ekman_veer.plugin.wake_models.models import (
+        EkmanVeerVelocityDeficit,
+        EkmanWakeModel,
+    )
+
+    rng = np.random.default_rng(3)
+    pairs = 400
+    x = rng.uniform(0.2, 40.0, pairs) * RADIUS
+    k_w = rng.uniform(0.01, 0.08, pairs)
+    ct = rng.uniform(0.1, 0.95, pairs)
+    yaw = rng.uniform(-0.5, 0.5, pairs)
+    friction_velocity = rng.uniform(0.1, 0.6, pairs)
+    hub_speed = rng.uniform(4.0, 14.0, pairs)
+    for curl in (True, False):
+        model = EkmanVeerVelocityDeficit(near_wake=near_wake, curl=curl,
+                                         polar_angle_centre=polar_angle_centre)
+        arguments = (x, k_w, np.full(pairs, RADIUS), ct, yaw, friction_velocity, hub_speed)
+        compiled = model.wake_table(*arguments)
+        readable = EkmanWakeModel.wake_table(model, *arguments)
+        inside = x < wd.potential_core_length(k_w, RADIUS, ct, yaw)
+        assert 20 < np.count_nonzero(inside) < pairs - 20
+        assert (near_wake == "potential_core") == np.all(compiled[:, 6] == 2.0)
+        np.testing.assert_allclose(compiled, readable, rtol=1e-13, atol=0.0)

@@ -75,7 +75,7 @@ def test_farm_input_runs_each_model_by_name():
     all on the Ekman inflow."""
     config = load_yaml(INPUTS / "farm_sbl6.yaml")
     assert config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"][
-        "stability_parameter"] == 148.49  # the paper's SBL-6 (Table 1)
+        "cooling_rate"] == -1.0  # the paper's SBL-6 by its cooling rate (Table 1)
     powers = {}
     for velocity, deflection in (
         ("ekman_veer", "ekman_veer"), ("bastankhah2014", "ekman_veer"), ("gauss", "gauss"),

@@ -29,6 +29,7 @@ def records_row():
     fmodel = FlorisModel(FARM)
     fmodel.set(layout_x=[0.0, 882.0, 1764.0], layout_y=[0.0, 0.0, 0.0])
     night = atmosphere_of(fmodel.core).sliced(slice(None))
+    del night["cooling_rate"]  # the input's SBL-6 given here by mu instead, per condition
     mu = [148.49, 0.0, 50.0, 0.0, 148.49, 50.0]
     set_atmosphere(fmodel, dict(night, stability_parameter=mu),
                    wind_directions=[270.0, 266.0, 273.0, 270.0, 275.0, 268.0],

@@ -53,6 +53,12 @@ MAX_GEOSTROPHIC_WIND = 75.0
 #: (Ekman 1905) bounds the turning of a layer mixed at least as strongly; convective layers turn
 #: the wind less than neutral ones (docs/atmosphere.md#physical-domain).
 MAX_CONVECTIVE_CROSS_ISOBARIC_ANGLE = 45.0
+#: The largest ambient turbulence factor accepted (docs/atmosphere.md#ambient-turbulence): a
+#: site's streamwise turbulence is typically 0.8-1.5 times the model's neutral I_u (terrain,
+#: upwind roughness), and on weak-wind stable nights the meandering of submeso motions can make
+#: it several times the model's (Mahrt 2014); 10 is beyond both and catches a factor given in
+#: percent (120).
+MAX_TURBULENCE_FACTOR = 10.0
 #: Valid range of every EkmanABL input, as the error messages and docs/atmosphere.md#input-ranges
 #: state it. Every input is a real number or an array of them (strings and booleans are refused).
 VALID_RANGES = {
@@ -99,6 +105,10 @@ VALID_RANGES = {
         f"{MIN_BOUNDARY_LAYER_HEIGHT:g} to {MAX_MIXED_LAYER_HEIGHT:g} m, the convective "
         "mixed-layer depth z_i (used where the layer is convective; default: the neutral height "
         "of Eq. h_hat_model)"
+    ),
+    "turbulence_factor": (
+        f"> 0 and <= {MAX_TURBULENCE_FACTOR:g}, the site's ambient streamwise turbulence over the "
+        "model's I_u of Eq. Iu_model (1 = the paper's; a ratio, not a percentage)"
     ),
     **{name: "> 0 and finite (a model constant)"
        for name in ("von_karman", "c_g", "stress_decay", "c_tn", "c_cn", "c_ns",

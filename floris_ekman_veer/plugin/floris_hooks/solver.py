@@ -126,6 +126,9 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
             x_i, y_i, effective_yaw_i, turbulence_intensity_i, ct_i, rotor_diameter_i,
             **deflection_model_args,
         )
+        wakes = deficit_model_args.get("wakes")
+        if wakes is not None:
+            wakes.reached = None
         velocity_deficit = model_manager.velocity_model.function(
             x_i, y_i, z_i, axial_induction_i, deflection_field, yaw_angle_i,
             turbulence_intensity_i, ct_i, hub_height_i, rotor_diameter_i,
@@ -135,8 +138,14 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         if i == 0:
             turbine_turbulence_intensity = np.broadcast_to(
                 turbine_turbulence_intensity, u_initial.shape).copy()
-        # The rotors (f, j) turbine i's wake reaches: elsewhere FLORIS's update is the identity.
-        f, j = np.nonzero(np.any(velocity_deficit.reshape(n_findex, n_turbines, -1), axis=2))
+        # The rotors (f, j) turbine i's wake reaches: elsewhere FLORIS's update is the identity
+        # (the model's list of them where it gives one: a rotor in it whose deficit is 0 is
+        # left as it is by the update, bit for bit).
+        if wakes is not None and wakes.reached is not None:
+            f, j = wakes.reached
+        else:
+            f, j = np.nonzero(np.any(velocity_deficit.reshape(n_findex, n_turbines, -1),
+                                     axis=2))
         if f.size == 0:
             continue
         deficit = velocity_deficit[f, j] * u_initial[f, j]  # (pairs, n, n)

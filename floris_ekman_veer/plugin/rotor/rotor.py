@@ -10,7 +10,6 @@ the kernel): no FLORIS import.
 
 from __future__ import annotations
 
-import functools
 import warnings
 
 import attrs
@@ -20,15 +19,16 @@ from floris_ekman_veer.plugin.rotor.convection import removed_moments
 from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
-    CENTRE_COLUMNS,
+    CONDITION_COLUMNS,
     PAIR_COLUMNS,
-    WAKE_COLUMNS,
     integrate_wake,
+    near_pairs,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
+from floris_ekman_veer.wake.fused import WAKE_TABLE
 from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
@@ -93,8 +93,26 @@ def rotor_cell_deficit(
     model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
     turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
 ):
+    """:func:`reached_rotor_cell_deficit`'s d_k; the rotors the wake reached (a superset of
+    those where d_k is not 0) are left in ``wakes.reached`` for the solver
+    (plugin/floris_hooks/solver.py), which updates only those."""
+    result, wakes.reached = reached_rotor_cell_deficit(
+        model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+        turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes)
+    return result
+
+
+#: No rotor reached: (f, j) empty.
+_NONE = (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
+
+
+def reached_rotor_cell_deficit(
+    model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
+    turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes,
+):
     """d_k of every rotor cell of the grid after turbine i's wake (the module docstring), for a
-    velocity model's call on a turbine grid (docs/coupling.md#rotor-average).
+    velocity model's call on a turbine grid (docs/coupling.md#rotor-average), and the rotors
+    (f, j) the wake reached.
 
     Only the sub-point rows of the rotors downstream of turbine i that its wake can reach
     (the deficit above NEGLIGIBLE_DEFICIT U_h somewhere on the row, with the widest possible
@@ -118,7 +136,7 @@ def rotor_cell_deficit(
     dx = rotor.x - x_i[:, 0, 0]
     f, j = np.nonzero(dx > ROTOR_PLANE_MARGIN)
     if f.size == 0:
-        return result.reshape(u_initial.shape)
+        return result.reshape(u_initial.shape), _NONE
     abl = ambient.abl
     hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height_i)
     added_rule = ADDED_TURBULENCE.get(model.wake_expansion)
@@ -151,43 +169,38 @@ def rotor_cell_deficit(
         turbulence = np.mean(turbulence_intensity_i, axis=(2, 3), keepdims=True)
     k_w = model.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                               ambient.floris_turbulence)
-    pick = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
-    per_pair = {
-        "yaw": yaw, "ct": ct, "radius": radius_i, "hub_speed": hub_speed, "k_w": k_w,
-        "cos": cos_a, "sin": sin_a, "friction_velocity": abl.friction_velocity,
-        "speed_fraction": speed_fraction,
-    }
-    per_pair = {k: pick(v) for k, v in per_pair.items()}
+    # Turbine i's quantities, one per condition; the wake's factors per rotor downstream.
+    column = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[:, 0, 0, 0]  # noqa: E731
+    source_wake = {"k_w": k_w, "radius": radius_i, "ct": ct, "yaw": yaw,
+                   "friction_velocity": abl.friction_velocity, "hub_speed": hub_speed}
+    source_wake = {k: column(v) for k, v in source_wake.items()}
     x_pair = dx[f, j]
-    width = model.width_bound(x_pair, per_pair["k_w"], per_pair["radius"], per_pair["ct"],
-                             per_pair["yaw"])
-    # The deficit C(x) exp(-gap^2 / (2 sigma^2)) stays below NEGLIGIBLE_DEFICIT beyond
-    # gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT).
-    amplitude = model.amplitude_bound(x_pair, per_pair["k_w"], per_pair["radius"],
-                                     per_pair["ct"], per_pair["yaw"])
-    reach_squared = 2.0 * width**2 * np.log(
-        np.maximum(amplitude, NEGLIGIBLE_DEFICIT) / NEGLIGIBLE_DEFICIT)
+    # The velocity model's table (plugin/rotor/rotor_kernel.py): the deficit's factors that
+    # depend on the wake only, its width and amplitude bounds and its centre deficit.
+    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
     centre_table = getattr(deflection_field_i, "kernel_table", None)
+    # The rotors the wake reaches, with the deficit C(x) exp(-gap^2 / (2 sigma^2)) below
+    # NEGLIGIBLE_DEFICIT beyond gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT) (sigma the widest
+    # width). With the ekman_veer deflection, also those out of reach by the centre at the
+    # grid's points (heights z_h, z_h +- R/2) widened by its spread plus R/4 on either side
+    # (the centre at the rows beyond +-R/2, twice the linear extrapolation, and between them)
+    # are not integrated and their rows not evaluated.
+    points = np.zeros((1, 1, 0))
     if centre_table is not None and cells.n > 1:
-        # Rotors out of reach by the centre at the grid's points (heights z_h, z_h +- R/2)
-        # widened by its spread plus R/4 on either side (the centre at the rows beyond
-        # +-R/2, twice the linear extrapolation, and between them) are not integrated and
-        # their rows not evaluated.
-        # (the n point heights' extremes column by column: numpy's reductions along a short
-        # axis cost more than the comparisons)
-        points = deflection_field_i[f, j, 0, :].T
-        top, bottom = functools.reduce(np.maximum, points), functools.reduce(np.minimum, points)
-        margin = top - bottom + 0.25 * rotor.radius[f, j]
-        offset = rotor.y[f, j] - y_i[f, 0, 0, 0]
-        lateral_gap = np.maximum(np.maximum(offset - top, bottom - offset)
-                                 - margin - rotor.radius[f, j], 0.0)
-        vertical_gap = np.maximum(np.abs(rotor.z[f, j] - hub_height_i[f, 0, 0, 0])
-                                  - rotor.radius[f, j], 0.0)
-        near = lateral_gap**2 + vertical_gap**2 < reach_squared
-        f, j, x_pair, reach_squared = f[near], j[near], x_pair[near], reach_squared[near]
-        per_pair = {k: v[near] for k, v in per_pair.items()}
-        if f.size == 0:
-            return result.reshape(u_initial.shape)
+        points = np.ascontiguousarray(np.asarray(deflection_field_i)[:, :, 0, :])
+    speed_fraction = column(speed_fraction)
+    edge_factor = 0.0
+    if track and model.turbulence_overlap == "wake_radius":
+        # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
+        # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
+        edge_factor = np.exp(-2.0)
+    near, pair = near_pairs(
+        f, j, x_pair, table, points, rotor, column(y_i), column(hub_height_i),
+        NEGLIGIBLE_DEFICIT, WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"],
+        speed_fraction)
+    if near.size == 0:
+        return result.reshape(u_initial.shape), _NONE
+    f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
     centre = None
     if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
@@ -198,26 +211,19 @@ def rotor_cell_deficit(
         centre_table = {"strength": 0.0, "r_tube": 1.0, "image_height": 0.0, "veer": 0.0,
                         "ground_image": 0.0}
     else:
-        centre_table = centre_table(f)
+        centre_table = centre_table()
     flat = f * n_turbines + j
     kind = rotor.kind[f, j]
-    moment = rotor.moment[f, j]
-    # The kernel's tables (plugin/rotor/rotor_kernel.py): the deficit's and the centre's factors
-    # that depend on the wake only (the velocity and deflection models'), and the solver's,
-    # once per rotor within reach.
-    table = model.kernel_table(x_pair, *(per_pair[k] for k in (
-        "k_w", "radius", "ct", "yaw", "friction_velocity", "hub_speed")))
-    per_pair["velocity_scale"] = per_pair["hub_speed"] * per_pair["speed_fraction"]
-    per_pair.update(x=x_pair, offset=rotor.y[f, j] - y_i[f, 0, 0, 0],
-                    radius_j=rotor.radius[f, j], hub_height=hub_height_i[f, 0, 0, 0],
-                    moment=moment, reach_squared=reach_squared,
-                    overlap_edge=WAKE_OVERLAP_VELOCITY)
-    if track and model.turbulence_overlap == "wake_radius":
-        # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
-        # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
-        per_pair["overlap_edge"] = np.exp(-2.0) * model.centre_deficit(
-            x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
-        ) * per_pair["hub_speed"] * per_pair["speed_fraction"]
+    # The solver's part of the kernel's tables per condition (turbine i's).
+    per_condition = {"cos": column(cos_a), "sin": column(sin_a),
+                     "friction_velocity": source_wake["friction_velocity"],
+                     "radius": source_wake["radius"], "hub_height": column(hub_height_i),
+                     **{f"centre_{k}": v for k, v in centre_table.items()}}
+    scale, edge = PAIR_COLUMNS.index("velocity_scale"), PAIR_COLUMNS.index("overlap_edge")
+    moment = pair[:, PAIR_COLUMNS.index("moment")]
+    per_pair = {k: v[f] for k, v in source_wake.items()}
+    per_pair.update(speed_fraction=speed_fraction[f], cos=column(cos_a)[f],
+                    sin=column(sin_a)[f], offset=pair[:, PAIR_COLUMNS.index("offset")])
     convecting = wakes.superposition == "momentum_conserving"
     row_scale = None
     if cumulative:
@@ -229,7 +235,8 @@ def rotor_cell_deficit(
         # grid's point heights, interpolated (rotor_cells.row_interpolation), for every wake.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
-        width_squared = np.broadcast_to(table["kx"] + table["xi0"], f.shape)[:, None] ** 2
+        width_squared = (table[:, WAKE_TABLE.index("kx")]
+                         + table[:, WAKE_TABLE.index("xi0")])[:, None] ** 2
         row_centre = centre if centre is not None else np.sum(
             deflection_field_i[f, j, 0, :, None] * row_interpolation(cells.n, cells.row_z),
             axis=1)
@@ -240,28 +247,25 @@ def rotor_cell_deficit(
             single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
             wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
             model.core_deficit(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
-        per_pair["velocity_scale"] = 1.0 / np.where(single > 0.0, single, 1.0)
+        pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         row_scale = deficit
         if track and model.turbulence_overlap == "wake_radius":
-            per_pair["overlap_edge"] = np.exp(-2.0) * deficit.mean(axis=1)
+            pair[:, edge] = np.exp(-2.0) * deficit.mean(axis=1)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
         centre_speed = model.centre_deficit(
             x_pair, *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw"))
-        ) * per_pair["velocity_scale"]
-        wake_convection = per_pair["velocity_scale"] - 0.5 * centre_speed
-        per_pair["velocity_scale"] = per_pair["velocity_scale"] * wake_convection
-        per_pair["overlap_edge"] = per_pair["overlap_edge"] * wake_convection
-    columns = lambda table, names: np.stack(  # noqa: E731
-        [np.broadcast_to(table[k], f.shape) for k in names], axis=1)
+        ) * pair[:, scale]
+        wake_convection = pair[:, scale] - 0.5 * centre_speed
+        pair[:, scale] = pair[:, scale] * wake_convection
+        pair[:, edge] = pair[:, edge] * wake_convection
     removed, overlap, reached, centre = integrate_wake(
-        columns(table, WAKE_COLUMNS), columns(per_pair, PAIR_COLUMNS),
-        columns(centre_table, CENTRE_COLUMNS), centre, flat, kind, rotor, wakes, track,
-        row_scale)
+        table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
+        kind, rotor, wakes, track, row_scale)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
-        return result.reshape(u_initial.shape)
+        return result.reshape(u_initial.shape), _NONE
     if cumulative:
         wakes.convection.keep(flat[reached], deficit[reached],
                               np.broadcast_to(width_squared, deficit.shape)[reached],
@@ -269,14 +273,14 @@ def rotor_cell_deficit(
     if convecting:
         removed = _momentum_conserving(
             wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
-            np.broadcast_to(table["kx"] + table["xi0"], f.shape), centre_speed,
+            table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
-    _check_resolution(x_pair[reached], per_pair, reached, centre[reached],
-                      rotor.radius[f, j][reached, None], cells, rotor.warned)
+    _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
+                      centre[reached], rotor.radius[f[reached], j[reached]], cells,
+                      rotor.warned)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
-        flat[reached], removed[reached], u_cell,
-        moment[reached][:, None])
+        flat[reached], removed[reached], u_cell, moment[reached][:, None])
     if track and model.wake_turbulence == "ishihara_qian":
         added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
                                rotor, f[reached], j[reached], kind[reached],
@@ -288,7 +292,7 @@ def rotor_cell_deficit(
     elif track:
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
                         axial_induction_i, overlap[reached], ambient, added_rule)
-    return result.reshape(u_initial.shape)
+    return result.reshape(u_initial.shape), (f[reached], j[reached])
 
 
 def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):
@@ -304,6 +308,14 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
         x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
+
+
+def _columns(values, names, shape):
+    """The kernel's table (shape..., names) of ``values`` (arrays or scalars by name)."""
+    table = np.empty((*shape, len(names)))
+    for k, name in enumerate(names):
+        table[..., k] = values[name]
+    return table
 
 
 #: A wake joins a rotor's combined convection velocity where its deficit on the rotor exceeds
@@ -371,17 +383,17 @@ def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
     return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 
-def _check_resolution(x, per_pair, reached, centre, radius_j, cells, warned):
+def _check_resolution(x, source_wake, centre, radius_j, cells, warned):
     """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
     if "rows" in warned:
         return
-    k_w, radius, ct, yaw = (per_pair[k][reached] for k in ("k_w", "radius", "ct", "yaw"))
+    k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
     width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
         stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
-    height = radius_j[:, 0] * (cells.row_z[-1] - cells.row_z[0])
+    height = radius_j * (cells.row_z[-1] - cells.row_z[0])
     shear = np.abs(centre[:, -1] - centre[:, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)
-    spacing = 2.0 * radius_j[:, 0] / cells.rows
+    spacing = 2.0 * radius_j / cells.rows
     if np.any(thickness < MIN_BAND_PER_ROW * spacing):
         warned.add("rows")
         ratio = float(np.min(thickness / spacing))

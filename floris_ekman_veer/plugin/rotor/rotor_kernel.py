@@ -23,18 +23,30 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
-from floris_ekman_veer.wake.fused import JIT, centre_offset, curl_polynomial, point_deficit
+from floris_ekman_veer.wake.fused import (
+    JIT,
+    WAKE_TABLE,
+    centre_offset,
+    centre_offset_bound,
+    curl_polynomial,
+    grown_centre_offset,
+    point_deficit,
+    time_growth,
+)
 
-#: The per-wake columns of the kernel's tables, one row per (wake, rotor within reach): the
-#: velocity model's (``kernel_table``: C(x), k_w x, 0.4 R sqrt(A*) |cos beta|, sin^2 beta, t_hat's
-#: prefactor (0: no curl), 1 if the polar angle is measured from the yaw-only centre, the
-#: radial shape exponent), the deflection model's (its ``kernel_table``: the centre's t_hat
-#: prefactor, R sqrt(A*), the image vortex's hub height, the veer and ground-image switches)
-#: and the solver's.
-WAKE_COLUMNS = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape")
+#: The kernel's tables. Per wake and rotor within reach: the velocity model's (its ``wake_table``,
+#: wake/fused.py WAKE_TABLE, of which the kernel reads the first seven: C(x), k_w x,
+#: 0.4 R sqrt(A*) |cos beta|, sin^2 beta, t_hat's prefactor (0: no curl), 1 if the polar angle
+#: is measured from the yaw-only centre, the radial shape exponent) and the solver's
+#: (PAIR_COLUMNS). Per condition (turbine i's, CONDITION_COLUMNS): the solver's and the
+#: deflection model's (its ``kernel_table``: the centre's t_hat prefactor, R sqrt(A*), the image
+#: vortex's hub height, the veer and ground-image switches).
+WAKE_COLUMNS = WAKE_TABLE[:7]
+PAIR_COLUMNS = ("x", "offset", "radius_j", "moment", "reach_squared", "overlap_edge",
+                "velocity_scale")
 CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
-PAIR_COLUMNS = ("x", "velocity_scale", "cos", "sin", "friction_velocity", "radius",
-                "offset", "radius_j", "hub_height", "moment", "reach_squared", "overlap_edge")
+CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
+                     *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
 #: numba's threading layer where the user has not chosen one: one that survives a fork
 #: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
@@ -47,40 +59,61 @@ _LAUNCH = threading.Lock()
 
 
 @numba.njit(parallel=True, **JIT)
-def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind, kind_u,
+def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kind, kind_u,
                kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
                block, track, row_scale, removed, overlap, reached):
     per_row = row_scale.shape[0] > 0
     for k in numba.prange(wake.shape[0]):
-        amplitude, kx, xi0, sin2b, strength, polar_veer, shape = wake[k]
-        (x, scale, cos_a, sin_a, u_star, radius, offset, radius_j, hub_height, moment,
-         reach_squared, overlap_edge) = pair[k]
-        strength_c, r_tube, image_height, veer, ground_image = centre_table[k]
+        amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
+        strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
+        x, offset, radius_j, moment, reach_squared, overlap_edge, scale = pair[k]
         f, kk = condition[k], kind[k]
+        (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
+         ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
+        # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
+        # only if the rotor is reached (the first and last rows', for the resolution check of
+        # plugin/rotor/rotor.py; the others are not used).
+        skipped_first = skipped_last = False
         for r in range(row_chord.size):
+            dz = kind_heights[kk, r] - hub_height
             u, v = kind_u[f, kk, r], kind_v[f, kk, r]
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
+            # No flow (at and below z0): no wake, no t_hat.
+            flowing = local_u > 0.0
+            speed = local_u if flowing else 1.0
+            growth = 0.0
             if compute_centre:
-                centre[k, r] = centre_offset(x, kind_heights[kk, r], local_u, local_v,
-                                             strength_c, r_tube, image_height, radius, u_star,
-                                             veer, ground_image)
+                if flowing:
+                    # Out of reach whatever the exact centre (wake/fused.py centre_offset_bound):
+                    # the row is skipped without the exponential.
+                    drift, bound = centre_offset_bound(
+                        x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        image_height, radius, u_star, veer, ground_image)
+                    nearest = max(abs(offset - drift) - bound - radius_j * row_chord[r], 0.0)
+                    if not nearest * nearest + dz * dz < reach_squared:
+                        skipped_first |= r == 0
+                        skipped_last |= r == row_chord.size - 1
+                        continue
+                    growth = time_growth(x, speed, radius, u_star)
+                    centre[k, r] = grown_centre_offset(
+                        growth, x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        image_height, veer, ground_image)
+                else:
+                    centre[k, r] = 0.0
             lateral = offset - centre[k, r]
-            dz = kind_heights[kk, r] - hub_height
             # Only the rows the wake reaches are integrated (plugin/rotor/rotor.py
             # NEGLIGIBLE_DEFICIT): the row's nearest point within reach.
             gap = max(abs(lateral) - radius_j * row_chord[r], 0.0) ** 2 + dz * dz
             if not gap < reach_squared:
                 continue
             reached[k] = True
-            # No flow (at and below z0): no wake.
-            flowing = local_u > 0.0
             ambient_u = u if flowing else 0.0
-            speed = local_u if flowing else 1.0
-            q0, q1, q2, q3, q4 = curl_polynomial(
-                strength * -np.expm1(-0.35 * (u_star / speed) * x / radius), CURL_ALPHA)
+            if not (compute_centre and flowing):
+                growth = time_growth(x, speed, radius, u_star)
+            q0, q1, q2, q3, q4 = curl_polynomial(strength * growth, CURL_ALPHA)
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
@@ -102,9 +135,74 @@ def _integrate(wake, pair, centre_table, compute_centre, centre, condition, kind
                 if track and du > overlap_edge and abs(dy + centre[k, r]) < reach:
                     area += weight[r, s]
         overlap[k] = area
+        if reached[k] and (skipped_first or skipped_last):
+            for r in (0, row_chord.size - 1):
+                if (r == 0 and skipped_first) or (r > 0 and skipped_last):
+                    u, v = kind_u[f, kk, r], kind_v[f, kk, r]
+                    centre[k, r] = centre_offset(x, kind_heights[kk, r], u * cos_a + v * sin_a,
+                                                 v * cos_a - u * sin_a, strength_c, r_tube,
+                                                 image_height, radius, u_star, veer,
+                                                 ground_image)
 
 
-def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, track,
+@numba.njit(**JIT)
+def _near_pairs(f, j, x, table, width_column, amplitude_column, centre_column, negligible,
+                points, rotor_y, rotor_z, rotor_radius, rotor_moment, y_i, hub_height,
+                overlap_edge, edge_factor, hub_speed, speed_fraction, keep, pair):
+    count = 0
+    for p in range(f.size):
+        fp, jp = f[p], j[p]
+        width, amplitude = table[p, width_column], table[p, amplitude_column]
+        reach_squared = 2.0 * width**2 * np.log(max(amplitude, negligible) / negligible)
+        offset = rotor_y[fp, jp] - y_i[fp]
+        radius_j = rotor_radius[fp, jp]
+        if points.shape[2] > 0:
+            top = bottom = points[fp, jp, 0]
+            for h in range(1, points.shape[2]):
+                top = max(top, points[fp, jp, h])
+                bottom = min(bottom, points[fp, jp, h])
+            margin = top - bottom + 0.25 * radius_j
+            lateral_gap = max(max(offset - top, bottom - offset) - margin - radius_j, 0.0)
+            vertical_gap = max(abs(rotor_z[fp, jp] - hub_height[fp]) - radius_j, 0.0)
+            if not lateral_gap**2 + vertical_gap**2 < reach_squared:
+                continue
+        keep[count] = p
+        edge = overlap_edge
+        if edge_factor > 0.0:
+            edge = edge_factor * table[p, centre_column] * hub_speed[fp] * speed_fraction[fp]
+        pair[count, 0] = x[p]
+        pair[count, 1] = offset
+        pair[count, 2] = radius_j
+        pair[count, 3] = rotor_moment[fp, jp]
+        pair[count, 4] = reach_squared
+        pair[count, 5] = edge
+        pair[count, 6] = hub_speed[fp] * speed_fraction[fp]
+        count += 1
+    return count
+
+
+def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overlap_edge,
+               edge_factor, hub_speed, speed_fraction):
+    """The rotors (f, j) downstream of a wake that it can reach, and the kernel's PAIR_COLUMNS
+    table of them, in one pass (plugin/rotor/rotor.py ``rotor_cell_deficit`` says why each
+    is dropped): each rotor's reach^2 = 2 sigma_max^2 ln(C / ``negligible``) from the velocity
+    model's ``table`` (WAKE_TABLE) and, with the wake's centre at the grid's point heights
+    ``points`` (pairs' (n_findex, n_turbines, n), or n = 0: no culling), the rotors beyond it
+    dropped. The overlap edge is ``overlap_edge``, or with ``edge_factor`` > 0 that times the
+    wake's centre deficit, U_h and the incoming fraction (per condition). Returns the kept
+    indices into the pairs and their table."""
+    keep = np.empty(f.size, dtype=np.int64)
+    pair = np.empty((f.size, len(PAIR_COLUMNS)))
+    # (contiguous index arrays: one compiled signature)
+    count = _near_pairs(
+        np.ascontiguousarray(f), np.ascontiguousarray(j), x, table, WAKE_TABLE.index("width_bound"), WAKE_TABLE.index("amplitude_bound"),
+        WAKE_TABLE.index("centre_deficit"), float(negligible), points, rotor.y, rotor.z,
+        rotor.radius, rotor.moment, y_i, hub_height, float(overlap_edge), float(edge_factor),
+        hub_speed, speed_fraction, keep, pair)
+    return keep[:count], pair[:count]
+
+
+def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
                    row_scale=None):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
@@ -112,10 +210,10 @@ def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, t
     unless ``track``), (pairs,) whether
     the wake reached a row of the rotor, and (pairs, rows) the wake's centre at the rows.
 
-    ``wake``, ``pair`` and ``centre_table`` (pairs, WAKE_COLUMNS, PAIR_COLUMNS, CENTRE_COLUMNS):
-    the tables, one row per rotor within reach; ``centre`` (pairs, rows) the wake's centre at
-    the rows, or None: the kernel evaluates it from ``centre_table`` (the ekman_veer
-    deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
+    ``wake`` (pairs, WAKE_TABLE) and ``pair`` (pairs, PAIR_COLUMNS): the tables, one row per
+    rotor within reach; ``per_condition`` (n_findex, CONDITION_COLUMNS); ``centre`` (pairs,
+    rows) the wake's centre at the rows, or None: the kernel evaluates it from the centre's
+    columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
     updated in place; ``row_scale`` (pairs, rows) or None: a factor of the pair's
@@ -130,7 +228,7 @@ def integrate_wake(wake, pair, centre_table, centre, flat, kind, rotor, wakes, t
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     with _LAUNCH:
         _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(centre_table), compute_centre, centre,
+                   np.ascontiguousarray(per_condition), compute_centre, centre,
                    flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
                    rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
                    cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,

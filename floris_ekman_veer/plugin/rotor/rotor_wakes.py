@@ -136,6 +136,8 @@ class RotorWakes:
         convection: the wakes kept at each rotor (``superposition`` "momentum_conserving"
             or "cumulative"), or None.
         superposition: the velocity model's ``wake_superposition``.
+        reached: the rotors (f, j) the latest wake reached (plugin/rotor/rotor.py), a superset
+            of those where its deficit is not 0, or None.
     """
 
     cells: RotorCells
@@ -147,6 +149,7 @@ class RotorWakes:
     turbulence_model: object = None
     convection: WakeConvection | None = None
     superposition: str = "combination_model"
+    reached: tuple | None = None
 
     @classmethod
     def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,

@@ -172,6 +172,7 @@ def crossflow_lookup(core):
     rotors: dict[int, tuple] = {}  # id(table) -> (table, {(hub, diameter, turbine index)})
 
     def add_farm(farm):
+        first.clear()
         for index, turbine in enumerate(farm.turbine_map):
             table = farm.turbine_power_thrust_tables[turbine.turbine_type]
             for t in [table] + [t for t in table.values() if isinstance(t, dict)]:
@@ -179,6 +180,7 @@ def crossflow_lookup(core):
                 rotors.setdefault(id(t), (t, set()))[1].add(
                     (float(turbine.hub_height), float(turbine.rotor_diameter), index))
 
+    first: dict = {}  # id(table) -> (hub, diameter, its first turbine), per set of farms
     add_farm(core.farm)
     cache: dict = {}
 
@@ -186,9 +188,12 @@ def crossflow_lookup(core):
         entry = rotors.get(id(power_thrust_table))
         if entry is None or entry[0] is not power_thrust_table:
             return None
-        # FLORIS allows one definition per turbine_type name: one hub height and diameter.
-        hub, diameter = next(iter(entry[1]))[:2]
-        turbine = min(index for _, _, index in entry[1])
+        rotor = first.get(id(power_thrust_table))
+        if rotor is None:
+            # FLORIS allows one definition per turbine_type name: one hub height and diameter.
+            rotor = first[id(power_thrust_table)] = (
+                *next(iter(entry[1]))[:2], min(index for _, _, index in entry[1]))
+        hub, diameter, turbine = rotor
         key = (hub, diameter, turbine, tuple(shape))
         if key not in cache:
             abl = solve(spec, flow_field.wind_speeds, flow_field.reference_wind_height)

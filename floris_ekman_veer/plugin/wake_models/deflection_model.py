@@ -24,7 +24,7 @@ from floris_ekman_veer.plugin.wake_models.wake_inputs import (
 )
 from floris_ekman_veer.wake.deficit import initial_radius, time_like_strength
 from floris_ekman_veer.wake.deflection import wake_centre_offset
-from floris_ekman_veer.wake.fused import centre_offsets
+from floris_ekman_veer.wake.fused import centre_points
 
 
 @define
@@ -83,32 +83,22 @@ class EkmanVeerVelocityDeflection(BaseModel):
         # integrates.
         rotor = ambient.rotor
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
-        dx = rotor.x - x_i[:, 0, 0]
-        per_condition = [np.broadcast_to(a, yaw.shape)[:, 0, 0, 0] for a in (
-            cos_a, sin_a, hub_height, radius, ct, yaw, hub_speed,
-            ambient.abl.friction_velocity)]
-
-        def kernel_table(f):
-            """The centre's per-wake factors for the rotor-cell kernel, conditions ``f``."""
-            _, _, hub, radius_f, ct_f, yaw_f, hub_speed_f, u_star = (a[f] for a in per_condition)
-            return {"strength": time_like_strength(u_star, hub_speed_f, ct_f, yaw_f),
-                    "r_tube": initial_radius(radius_f, ct_f, yaw_f), "image_height": hub,
-                    "veer": float(self.veer), "ground_image": float(self.ground_image)}
-
-        points = np.zeros(z[:, :, 0, :].shape)
-        f, j = np.nonzero(dx > 0.0)
-        if f.size:
-            # The compiled centre of the rotor-cell kernel (wake/fused.py centre_offset).
-            table = kernel_table(f)
-            cos_p, sin_p, _, radius_f, _, _, _, u_star = (a[f][:, None] for a in per_condition)
-            u = np.broadcast_to(ambient.u[:, :, 0, :], points.shape)[f, j]
-            v = np.broadcast_to(ambient.v[:, :, 0, :], points.shape)[f, j]
-            points[f, j] = centre_offsets(
-                dx[f, j][:, None], z[f, j, 0, :], u * cos_p + v * sin_p, v * cos_p - u * sin_p,
-                table["strength"][:, None], table["r_tube"][:, None],
-                table["image_height"][:, None], radius_f, u_star, self.veer, self.ground_image)
+        column = lambda a: np.broadcast_to(a, yaw.shape)[:, 0, 0, 0]  # noqa: E731
+        radius_f, ct_f, yaw_f, u_star = (column(a) for a in (
+            radius, ct, yaw, ambient.abl.friction_velocity))
+        # The centre's per-wake factors, one per condition.
+        table = {"strength": time_like_strength(u_star, column(hub_speed), ct_f, yaw_f),
+                 "r_tube": initial_radius(radius_f, ct_f, yaw_f),
+                 "image_height": column(hub_height), "veer": float(self.veer),
+                 "ground_image": float(self.ground_image)}
+        # The compiled centre of the rotor-cell kernel (wake/fused.py centre_offset).
+        points = centre_points(
+            rotor.x - x_i[:, 0, 0], z[:, :, 0, :], ambient.u[:, :, 0, :],
+            ambient.v[:, :, 0, :], column(cos_a), column(sin_a), table["strength"],
+            table["r_tube"], table["image_height"], radius_f, u_star, self.veer,
+            self.ground_image)
         field_ = np.broadcast_to(points[:, :, None, :], z.shape).view(RotorDeflection)
-        field_.kernel_table = kernel_table
+        field_.kernel_table = lambda: table
         return field_
 
     def _offset(self, dx, z, hub_height, radius, ct, yaw, hub_speed, local_u, local_v, u_star):
@@ -124,11 +114,11 @@ class EkmanVeerVelocityDeflection(BaseModel):
 
 
 class RotorDeflection(np.ndarray):
-    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``kernel_table(f)``:
-    the wake's factors of its centre (t_hat's prefactor, R sqrt(A*), the veer and ground-image
-    switches) for conditions ``f``, from which the rotor-cell kernel evaluates the centre at the
-    rows of the rotors the wake can reach (plugin/rotor/rotor_kernel.py, wake/fused.py
-    ``centre_offset``). Arithmetic on it gives plain arrays (FLORIS's own velocity models read
+    """The ekman_veer wake centre at FLORIS's turbine-grid points, carrying ``kernel_table()``:
+    the wake's factors of its centre (t_hat's prefactor, R sqrt(A*), the image vortex's hub
+    height, the veer and ground-image switches), one per condition, from which the rotor-cell
+    kernel evaluates the centre at the rows of the rotors the wake can reach
+    (plugin/rotor/rotor_kernel.py, wake/fused.py ``centre_offset``). Arithmetic on it gives plain arrays (FLORIS's own velocity models read
     it as the point field it is)."""
 
     kernel_table = None

@@ -83,7 +83,12 @@ from floris_ekman_veer.wake.deficit import (
     stream_tube_area_ratio,
 )
 from floris_ekman_veer.wake.deflection import veer_deflection
-from floris_ekman_veer.wake.fused import GAUSSIAN_SHAPE, wake_deficit_parameters
+from floris_ekman_veer.wake.fused import (
+    GAUSSIAN_SHAPE,
+    WAKE_TABLE,
+    wake_deficit_parameters,
+    wake_table,
+)
 from floris_ekman_veer.wake.gaussian2014 import bastankhah2014_deficit, bastankhah2014_wake
 from floris_ekman_veer.wake.near_wake import NEAR_WAKES, near_wake_shape
 from floris_ekman_veer.wake.superposition import cumulative_deficit, overlap_weight
@@ -158,17 +163,20 @@ class EkmanWakeModel(BaseModel):
         ``floris_turbulence`` its ambient TI_0. Both keep the paper's ambient I_u(z_h) and add
         the wake-added part: I^2 = I_u^2 + max(TI^2 - TI_0^2, 0), so an unwaked turbine gets the
         paper's k_w exactly, whatever TI_0 FLORIS was given
-        (docs/coupling.md#wake-expansion-in-farms).
+        (docs/coupling.md#wake-expansion-in-farms). The ambient I_u(z_h) is scaled by the
+        atmosphere's ``turbulence_factor`` where it has one (a site's measured turbulence,
+        docs/atmosphere.md#ambient-turbulence).
         """
         if self.wake_expansion == "ambient":
             return wake_expansion_rate(
                 abl.friction_velocity, abl.boundary_layer_height, hub_height, hub_speed,
                 A1=self.A1, B1=self.B1, alpha_prime=self.alpha_prime, floor=self.k_w_floor,
                 n=self.k_w_exponent, convective=abl.convective_variance,
+                turbulence_factor=abl.turbulence_factor,
             )
         ambient = streamwise_turbulence_intensity(
             hub_height, abl.friction_velocity, abl.boundary_layer_height, hub_speed, self.A1,
-            self.B1, abl.convective_variance,
+            self.B1, abl.convective_variance, abl.turbulence_factor,
         )
         added_squared = np.maximum(
             np.asarray(turbulence_intensity, dtype=float) ** 2 - floris_turbulence**2, 0.0
@@ -321,6 +329,17 @@ class EkmanWakeModel(BaseModel):
         per wake and rotor reached (1-D arrays or scalars); each model defines them."""
         raise NotImplementedError("EkmanWakeModel.kernel_table")
 
+    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> np.ndarray:
+        """(pairs, wake/fused.py ``WAKE_TABLE``): :meth:`kernel_table`'s columns, then
+        :meth:`width_bound`, :meth:`amplitude_bound` and :meth:`centre_deficit`, per wake and
+        rotor (1-D arrays ``x`` > 0, the rest per pair): what the rotor cells take of the model
+        (plugin/rotor/rotor.py) in one table."""
+        table = self.kernel_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed)
+        table = {**table, "width_bound": self.width_bound(x, k_w, radius, ct, yaw),
+                 "amplitude_bound": self.amplitude_bound(x, k_w, radius, ct, yaw),
+                 "centre_deficit": self.centre_deficit(x, k_w, radius, ct, yaw)}
+        return np.stack([np.broadcast_to(table[k], np.shape(x)) for k in WAKE_TABLE], axis=1)
+
     def amplitude_bound(self, x, k_w, radius, ct, yaw):
         """The largest deficit Delta u / U_h of the wake at x: C(x), Eq. (Cx)."""
         return max_deficit(x, k_w, radius, ct, yaw)
@@ -425,6 +444,12 @@ class EkmanVeerVelocityDeficit(EkmanWakeModel):
         table.setdefault("shape", GAUSSIAN_SHAPE)
         table["polar_veer"] = float(self.polar_angle_centre == "yaw_centre")
         return table
+
+    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> np.ndarray:
+        # kernel_table, width_bound and C(x) at once, compiled (wake/fused.py wake_table).
+        return wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=self.curl,
+                          near_wake=self.near_wake == "super_gaussian",
+                          polar_veer=float(self.polar_angle_centre == "yaw_centre"))
 
     def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0

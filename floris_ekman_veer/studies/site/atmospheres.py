@@ -1,9 +1,10 @@
 """Stage 5 of the site fit (pipeline.py): the atmospheres, per record kept FLORIS's inputs at
 the reference height (docs/measurements.md#from-the-fit-to-floris): the wind speed and direction
-of the fitted profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model), and
-the atmosphere block with one entry per record. Driven by those wind speeds, the block gives back
-the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere` carries them to FLORIS (a
-``TimeSeries``, :meth:`~SiteAtmosphere.apply`, annual energy), and
+of the fitted profile there, the turbulence intensity I_u of the fitted ABL (Eq. Iu_model) or the
+cups' measured one, and the atmosphere block with one entry per record (with the measured
+turbulence as its ``turbulence_factor``, the wake's ambient turbulence). Driven by those wind
+speeds, the block gives back the fitted ABLs (checked by stage 4). :class:`SiteAtmosphere`
+carries them to FLORIS (a ``TimeSeries``, :meth:`~SiteAtmosphere.apply`, annual energy), and
 :meth:`SiteAtmosphere.summary` reports the site (:class:`SiteSummary`).
 """
 
@@ -18,6 +19,7 @@ from floris.wind_data import TimeSeries
 
 import floris_ekman_veer.warnings as package_warnings
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.atmosphere.inputs.input_ranges import MAX_TURBULENCE_FACTOR
 from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
 from floris_ekman_veer.studies.energy.energy import energy_by_month, record_energy
 from floris_ekman_veer.studies.site.baseline import NeutralBaseline
@@ -135,7 +137,9 @@ class SiteAtmosphere:
             the reference height (the fitted profile's speed and meteorological direction; the
             measured TI where the cups log their standard deviations, else the fitted ABL's
             I_u: :func:`ambient_turbulence`).
-        atmosphere: the ``ekman_veer.atmosphere`` block, one entry per record.
+        atmosphere: the ``ekman_veer.atmosphere`` block, one entry per record; where the cups
+            log their standard deviations its ``turbulence_factor`` makes the wake's ambient
+            I_u the measured TI (:func:`turbulence_factors`).
         dropped: labels of the records left out (``on_misfit="drop"``).
         excluded: the records left out, one row each (index: the row in ``records``): ``time``,
             ``kind`` (one of :data:`EXCLUSION_KINDS`) and ``reason``, a sentence.
@@ -310,6 +314,24 @@ def ambient_turbulence(abl, reference_height, measured, rows):
     return np.where(np.isfinite(value), value * model / at_height, model)
 
 
+def turbulence_factors(abl, measured, rows):
+    """Per fitted record the atmosphere block's ``turbulence_factor``: the measured TI over the
+    fitted ABL's I_u at the cups' height, so that the wake's ambient I_u (Eq. Iu_model times
+    the factor, docs/atmosphere.md#ambient-turbulence) is the measured TI there and the
+    profile's I_u shape carries it to other hub heights; 1 (the model's I_u) where none is
+    measured, where the model's I_u there is 0 (a layer whose turbulence ends below the cups)
+    or where the ratio leaves the factor's range. None without measured turbulence."""
+    if measured is None:
+        return None
+    height, values = measured
+    at_height = np.asarray(abl.turbulence_intensity(height), float).reshape(-1)
+    value = np.asarray(values, float)[rows]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = value / at_height
+    usable = np.isfinite(factor) & (factor > 0) & (factor <= MAX_TURBULENCE_FACTOR)
+    return np.where(usable, factor, 1.0)
+
+
 def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: list,
                     reference_height: float, baseline: NeutralBaseline | None = None, *,
                     stability_input: str = "stability_parameter") -> SiteAtmosphere:
@@ -337,7 +359,8 @@ def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: lis
         wind_directions=fit.direction(np.array([z_ref]))[:, 0],
         turbulence_intensities=ambient_turbulence(abl, z_ref, record_fit.measured_turbulence,
                                                   record_fit.rows),
-        atmosphere=fit.atmosphere(stability_input),
+        atmosphere=_with_turbulence(fit.atmosphere(stability_input), turbulence_factors(
+            abl, record_fit.measured_turbulence, record_fit.rows)),
         dropped=list(table["time"]),
         excluded=table,
         rows=record_fit.rows,
@@ -347,6 +370,15 @@ def site_atmosphere(record_fit: RecordFit, instruments: Instruments, labels: lis
         flags=flags,
         baseline=baseline,
     )
+
+
+def _with_turbulence(block: dict, factors) -> dict:
+    """The atmosphere block with the records' ``turbulence_factor`` (a list, one per record; a
+    float for one record, as the block's other values), unchanged without one."""
+    if factors is None:
+        return block
+    single = not any(isinstance(v, list) for v in block.values())
+    return {**block, "turbulence_factor": float(factors[0]) if single else factors.tolist()}
 
 
 def warn_tops_below(abl: EkmanABL, labels: list, reference_height: float, turbulence) -> None:

@@ -24,8 +24,12 @@ IEC 61400-12-1 Annex B), per direction sector:
   applied, readings.py's :func:`~.readings.calibrated_cups`, else the generic transfer
   function's :data:`~.readings.CUP_CALIBRATION_GENERIC`);
 * the neutral turbulence intensity: the median of the cups' sigma_u / U at that cup, with its
-  standard error, beside the model's neutral I_u there (Eq. Iu_model) at the sector's z0; their
-  ratio is the terrain's excess turbulence (Wieringa 1993; Panofsky & Dutton 1984, ch. 7).
+  standard error, beside the model's neutral I_u there (Eq. Iu_model) at the sector's z0; and
+  the terrain's excess turbulence (Wieringa 1993; Panofsky & Dutton 1984, ch. 7): the median
+  over the same records of each one's measured TI over the model's neutral I_u at its own
+  speed and its sector's z0, with the ratio's robust relative scatter (the terrain's
+  uncertainty). The stability fit reads the measured TI only as its departure from it
+  (stability.py :func:`~.stability.turbulence_departure`).
 
 Sectors of :data:`SECTOR_WIDTH` deg (12, as a wind atlas's rose); a sector with fewer than
 :data:`BASELINE_MIN_RECORDS` strong-wind records takes those of a wider window about its centre
@@ -73,13 +77,18 @@ class NeutralBaseline:
             uncertainty as a factor), ``roughness_factor_calibration`` (the cups' calibration's),
             ``speed_ratio`` (the measured median shear ratio) and its
             ``speed_ratio_error``, ``neutral_ti`` and ``neutral_ti_error`` (NaN without the
-            cups' standard deviations), ``model_neutral_ti`` (the model's I_u at the sector's z0)
-            and ``source`` ("estimated", "given").
+            cups' standard deviations), ``model_neutral_ti`` (the model's I_u at the sector's z0),
+            ``terrain_turbulence_ratio`` and ``terrain_turbulence_scatter`` (the median of the
+            records' measured TI over the model's neutral I_u, and its relative scatter) and
+            ``source`` ("estimated", "given").
         heights: (lower, upper) cup heights [m] of the shear ratio (the turbulence's: the cup
             nearest the reference height).
         roughness_lengths, turbulence_intensities: per record of the records its sector's
             neutral roughness length [m] and neutral turbulence intensity (NaN: none measured).
         sector_of: per record its sector's centre [deg] (NaN: no direction).
+        terrain_turbulence_ratios, terrain_turbulence_scatters: per record its sector's
+            terrain excess turbulence and its relative scatter (the all-direction values where
+            it has no direction; 1 and NaN without the cups' standard deviations).
     """
 
     sectors: pd.DataFrame
@@ -87,6 +96,8 @@ class NeutralBaseline:
     roughness_lengths: np.ndarray
     turbulence_intensities: np.ndarray
     sector_of: np.ndarray
+    terrain_turbulence_ratios: np.ndarray | None = None
+    terrain_turbulence_scatters: np.ndarray | None = None
 
     def __str__(self) -> str:
         return (f"neutral baseline (records from {OFFSET_MIN_SPEED:g} m/s; shear between "
@@ -165,7 +176,7 @@ def neutral_baseline(instruments: Instruments, reference_height: float,
             f"site's neutral profile); the records have {np.count_nonzero(strong)}. Give the "
             "roughness length (a number [m] or {sector centre deg: z0 m})")
     centres = np.arange(0.0, 360.0, SECTOR_WIDTH)
-    rows = []
+    rows, windows = [], []
     for centre in centres:
         half = SECTOR_WIDTH / 2.0
         while True:
@@ -176,6 +187,7 @@ def neutral_baseline(instruments: Instruments, reference_height: float,
             half += SECTOR_WIDTH / 2.0
         if half >= 180.0:
             use = strong  # (every direction, and the records without one)
+        windows.append(use)
         shear, shear_error, kept = clipped_mean_and_error(ratio[use])
         ti, ti_error = median_and_error(intensity[use])
         rows.append({"centre_deg": centre, "half_width_deg": min(half, 180.0),
@@ -224,8 +236,47 @@ def neutral_baseline(instruments: Instruments, reference_height: float,
     else:
         z0 = table["roughness_length"].to_numpy()
         roughness = np.where(known, z0[at], float(np.exp(np.mean(np.log(z0)))))
+    excess, scatter, excess_all, scatter_all = _terrain_turbulence(
+        intensity, speeds[:, cup], float(cups[cup]), roughness, strong, windows, fixed)
+    table["terrain_turbulence_ratio"], table["terrain_turbulence_scatter"] = excess, scatter
     return NeutralBaseline(sectors=table, heights=heights, roughness_lengths=roughness,
-                           turbulence_intensities=turbulence, sector_of=sector)
+                           turbulence_intensities=turbulence, sector_of=sector,
+                           terrain_turbulence_ratios=np.where(known, excess[at], excess_all),
+                           terrain_turbulence_scatters=np.where(known, scatter[at], scatter_all))
+
+
+def _terrain_turbulence(intensity, speed, height, roughness, strong, windows, fixed):
+    """(per sector, its records ``windows``, the median of the strong-wind records' measured TI
+    over the model's neutral I_u at ``height``, each at its own speed there and roughness, and
+    its robust relative scatter; the same over every strong-wind record). Without measured TI:
+    1 and NaN. With fewer than :data:`BASELINE_MIN_RECORDS` strong-wind records (a short
+    record with a given roughness), the upper quartile of the speeds stands for them, in one
+    all-direction window."""
+    if np.count_nonzero(strong) < BASELINE_MIN_RECORDS:
+        moving = np.isfinite(speed) & (speed > 1.0)
+        if moving.any():
+            strong = moving & (speed >= np.quantile(speed[moving], 0.75))
+        windows = [strong] * len(windows)
+    ratio = np.full(intensity.size, np.nan)
+    pick = strong & np.isfinite(intensity)
+    if pick.any():
+        abl = EkmanABL.from_reference_wind(speed[pick], height, obukhov_length=np.inf,
+                                           **{**fixed, "roughness_length": roughness[pick]})
+        ratio[pick] = intensity[pick] / np.asarray(abl.turbulence_intensity(height),
+                                                   float).reshape(-1)
+    both = [_median_and_scatter(ratio[use]) for use in windows]
+    return (np.array([b[0] for b in both]), np.array([b[1] for b in both]),
+            *_median_and_scatter(ratio[strong]))
+
+
+def _median_and_scatter(ratio):
+    """The median of the ratios and their relative scatter (1.4826 MAD / median); 1 and NaN
+    without any."""
+    ratio = ratio[np.isfinite(ratio)]
+    if ratio.size == 0:
+        return 1.0, np.nan
+    median = float(np.median(ratio))
+    return median, float(1.4826 * np.median(np.abs(ratio - median)) / median)
 
 
 def clipped_mean_and_error(values):

@@ -211,7 +211,7 @@ def fit_site(records: pd.DataFrame, reference_height: float, *,
     record_fit = fit_records(instruments, columns, labels, z_ref, fit_inputs,
                              stability_input=stability_input, on_misfit=on_misfit,
                              records=records, site_type=site_type, longitude=longitude,
-                             time_zone=time_zone)
+                             time_zone=time_zone, baseline=baseline)
     # 5. the atmospheres
     site = site_atmosphere(record_fit, instruments, labels, z_ref, baseline,
                            stability_input=stability_input)

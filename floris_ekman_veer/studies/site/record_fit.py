@@ -12,6 +12,7 @@ import pandas as pd
 
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
 from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
+from floris_ekman_veer.studies.site.baseline import NeutralBaseline
 from floris_ekman_veer.studies.site.columns import MastColumns
 from floris_ekman_veer.studies.site.readings import (Instruments, fit_data, fit_heights,
                                                      measured_turbulence)
@@ -48,14 +49,16 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
                 stability_input: str = "stability_parameter",
                 on_misfit: str = "raise", records: pd.DataFrame | None = None,
                 site_type: str | None = None, longitude: float | None = None,
-                time_zone: str | None = None) -> RecordFit:
+                time_zone: str | None = None,
+                baseline: NeutralBaseline | None = None) -> RecordFit:
     """Every record's fit (module docstring). ``on_misfit="raise"``: ValueError naming the
     first record that cannot be fitted and why; ``"drop"``: such records are left out and
     named in ``excluded``. The cups' measured turbulence intensity (nearest the reference
     height) enters the fit as its departure from the site's neutral turbulence in its sector
-    unless a ``turbulence_intensity`` is given; the fit takes the weak prior on 1/L, an onshore
-    site's sun bound, and the temperatures' and a sonic's stability where ``records`` hold
-    them (stability.py, docs/measurements.md#reading-stability)."""
+    (the ``baseline``'s terrain excess, stage 3) unless a ``turbulence_intensity`` is given;
+    the fit takes the weak prior on 1/L, an onshore site's sun bound, and the temperatures'
+    and a sonic's stability where ``records`` hold them (stability.py,
+    docs/measurements.md#reading-stability)."""
     heights, speeds, directions, speed_columns = fit_heights(instruments, columns)
     excluded = screen_records(speed_columns, labels, heights, speeds, directions,
                               3 if fit_options_and_inputs.get("fit_roughness") else 2)
@@ -69,12 +72,11 @@ def fit_records(instruments: Instruments, columns: MastColumns, labels: list,
     # (a measured turbulence intensity is a pair (height, value), each one number or a column)
     turbulence = fit_inputs.pop("turbulence_intensity", None)
     measured = None
-    if turbulence is None and instruments.speed_std is not None:
+    if turbulence is None and instruments.speed_std is not None and baseline is not None:
         # the measured TI: the wake's input, and to the fit only its departure from the site's
         # neutral TI in its sector (docs/measurements.md#reading-stability)
         measured = measured_turbulence(instruments, reference_height)
-        vane = int(np.argmin(np.abs(instruments.vane_heights - reference_height)))
-        turbulence, noise, _ = turbulence_departure(measured, instruments, vane, fit_inputs)
+        turbulence, noise = turbulence_departure(measured, baseline)
         fit_inputs.setdefault("turbulence_noise", noise)
     fit_inputs.update(stability_options(fit_inputs, labels, instruments, records, site_type,
                                         longitude, time_zone))

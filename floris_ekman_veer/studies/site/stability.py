@@ -11,11 +11,10 @@ import re
 import numpy as np
 import pandas as pd
 
-from floris_ekman_veer.atmosphere.ekman import EkmanABL
-from floris_ekman_veer.atmosphere.fit.fit_inputs import FIT_OPTIONS
 from floris_ekman_veer.atmosphere.richardson import measured_richardson
 from floris_ekman_veer.atmosphere.fit.stability_data import DEFAULT_STABILITY_PRIOR
 from floris_ekman_veer.atmosphere.sunlight import SITE_TYPES, max_heat_flux, utc_times
+from floris_ekman_veer.studies.site.baseline import NeutralBaseline
 
 TEMPERATURE_COLUMN = re.compile(r"^temperature_(\d+(?:\.\d+)?)m$")
 PRESSURE_COLUMN = re.compile(r"^pressure(?:_(\d+(?:\.\d+)?)m)?$")
@@ -28,14 +27,6 @@ TEMPERATURE_NOISE = 0.05
 #: The noise of a sonic's 1/L relative to its value, and absolute [1/m] (the 10-minute
 #: flux's sampling error, about 20 %).
 SONIC_NOISE = (0.2, 0.001)
-#: The sector width [deg] and the least records of the site's neutral turbulence by sector;
-#: fewer in a sector: the site's all-sector value.
-TURBULENCE_SECTOR, TURBULENCE_MIN_RECORDS = 30.0, 30
-#: [m/s] The strong winds at the turbulence height whose turbulence is the site's neutral one
-#: (mechanical mixing: |z/L| small), as wind-resource practice takes it (IEC 61400-1's
-#: turbulence categories from winds of 10 m/s and more... here the speeds' upper quartile if
-#: fewer records are that strong).
-NEUTRAL_TURBULENCE_SPEED = 10.0
 #: The relative sampling error of a 10-minute or hourly turbulence intensity, in quadrature
 #: with the terrain's scatter in its sector.
 TURBULENCE_SAMPLING_NOISE = 0.1
@@ -123,60 +114,18 @@ def sonic_inverse_length(records, instruments):
     return inverse, np.hypot(relative * np.nan_to_num(inverse), absolute)
 
 
-def turbulence_departure(turbulence, instruments, direction_index, fixed):
-    """(``turbulence_intensity=(height, value)``, ``turbulence_noise``, the site's neutral TI
-    per sector as a table): the measured TI divided by its sector's terrain excess, the median
-    of measured over the model's neutral I_u at the same height, speed and roughness over the
-    strong-wind records (:data:`NEUTRAL_TURBULENCE_SPEED`) in its sector: the fit then reads
-    only its departure from the site's own neutral turbulence, with a noise of the sampling
-    error and the sector's scatter of that ratio (the terrain) in quadrature."""
+def turbulence_departure(turbulence, baseline: NeutralBaseline):
+    """(``turbulence_intensity=(height, value)``, ``turbulence_noise``): the measured TI divided
+    by its sector's terrain excess turbulence of the site's neutral baseline (baseline.py: the
+    median of the strong-wind records' measured TI over the model's neutral I_u), so that the
+    fit reads only its departure from the site's own neutral turbulence, with a noise of the
+    sampling error (:data:`TURBULENCE_SAMPLING_NOISE`) and the sectors' scatter of that ratio
+    (the terrain) in quadrature."""
     height, measured = turbulence
-    n = measured.size
-    k = int(np.argmin(np.abs(instruments.cup_heights - height)))
-    speed = instruments.speeds[:, k]
-    direction = (instruments.directions[:, direction_index] if instruments.directions is not None
-                 else np.full(n, np.nan))
-    ok = np.isfinite(measured) & np.isfinite(speed) & (speed > 1.0)
-    strong = ok & (speed >= min(NEUTRAL_TURBULENCE_SPEED, np.nanquantile(
-        np.where(ok, speed, np.nan), 0.75) if np.any(ok) else np.inf))
-    neutral_model = np.full(n, np.nan)
-    z0 = np.broadcast_to(fixed.get("roughness_length", 0.05), (n,))
-    others = {key: (np.asarray(v)[strong] if np.ndim(v) == 1 else v) for key, v in fixed.items()
-              if key not in FIT_OPTIONS and key != "roughness_length"}
-    if np.any(strong):
-        abl = EkmanABL.from_reference_wind(speed[strong], height, obukhov_length=np.inf,
-                                           roughness_length=z0[strong], **others)
-        neutral_model[strong] = np.asarray(abl.turbulence_intensity(height), float)
-    ratio = measured / neutral_model
-    # (NaN directions: sector -1, no sector's)
-    heading = np.mod(np.nan_to_num(direction), 360.0)
-    sector = np.where(np.isfinite(direction),
-                      np.round(heading / TURBULENCE_SECTOR).astype(int)
-                      % int(360.0 / TURBULENCE_SECTOR), -1)
-    overall = np.nanmedian(ratio[strong]) if np.any(strong) else 1.0
-    spread_all = _relative_spread(ratio[strong]) if np.any(strong) else 0.2
-    excess = np.full(n, overall)
-    spread = np.full(n, spread_all)
-    rows = []
-    for s in range(int(360.0 / TURBULENCE_SECTOR)):
-        here = strong & (sector == s)
-        use = np.sum(here) >= TURBULENCE_MIN_RECORDS
-        value = np.nanmedian(ratio[here]) if use else overall
-        scatter = _relative_spread(ratio[here]) if use else spread_all
-        excess[sector == s], spread[sector == s] = value, scatter
-        rows.append({"sector_deg": s * TURBULENCE_SECTOR, "records": int(np.sum(here)),
-                     "terrain_turbulence_ratio": value, "scatter": scatter})
-    noise = float(np.hypot(TURBULENCE_SAMPLING_NOISE, np.median(spread)))
-    return ((height, measured / excess), noise,
-            pd.DataFrame(rows).set_index("sector_deg"))
-
-
-def _relative_spread(ratio):
-    ratio = ratio[np.isfinite(ratio)]
-    if ratio.size < 3:
-        return 0.2
-    median = np.median(ratio)
-    return float(1.4826 * np.median(np.abs(ratio - median)) / median)
+    scatter = baseline.terrain_turbulence_scatters
+    spread = float(np.nanmedian(scatter)) if np.any(np.isfinite(scatter)) else 0.2
+    return ((height, measured / baseline.terrain_turbulence_ratios),
+            float(np.hypot(TURBULENCE_SAMPLING_NOISE, spread)))
 
 
 #: The fit's options this module gives, per record where they are arrays.

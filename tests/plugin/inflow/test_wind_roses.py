@@ -1,11 +1,14 @@
 """Every shipped input through FLORIS's own AEP workflow: a wind rose (and a time series) from 0
 to 360 deg and from cut-in to cut-out (docs/atmosphere.md#a-fixed-stability-across-wind-speeds).
 
-A fixed Obukhov length or stability parameter (inputs/farm_night.yaml, inputs/farm_sbl6.yaml) and
-a strong cooling rate (inputs/sbl6.yaml) imply a surface heat flux beyond -300 W/m^2 at the
+The shipped night (inputs/farm_night.yaml, the paper's SBL-3 cooling rate -0.25 K/h) stays inside
+the physical domain at every speed with no policy. The paper's SBL-6 cooling rate, -1 K/h
+(inputs/farm_sbl6.yaml, inputs/sbl6.yaml), implies a surface heat flux beyond -300 W/m^2 at the
 strongest winds; their atmosphere blocks say ``outside_domain: limit``, which carries those
 conditions with their stability limited toward neutral to the bound, named in validity_report's
-``stability_limited``. Without it the model refuses them naming every speed and what to give.
+``stability_limited``. A fixed Obukhov length (L = 100 m, farm_night's until issue 39) leaves the
+domain from 20 m/s: without the policy the model refuses those conditions naming every speed and
+what to give.
 """
 
 from __future__ import annotations
@@ -33,7 +36,7 @@ DIRECTIONS = np.arange(0.0, 360.0, 5.0)
 EXPECTED = (floris_ekman_veer.ModelSettingsWarning, floris_ekman_veer.ThrustLimitWarning,
             floris_ekman_veer.ShallowBoundaryLayerWarning)
 #: The speeds each input carries at the heat-flux bound (H < -300 W/m^2 at the given stability).
-LIMITED_FROM = {"farm_night": 20.0, "farm_sbl6": 20.0, "sbl6": 22.0}
+LIMITED_FROM = {"farm_sbl6": 21.0, "sbl6": 22.0}
 
 
 @contextlib.contextmanager
@@ -103,11 +106,13 @@ def test_a_time_series_runs_every_speed_and_direction(name):
 
 
 def night(policy=None):
+    """inputs/farm_night.yaml with a fixed Obukhov length L = 100 m instead of its cooling rate,
+    and the outside_domain ``policy`` (None: the default)."""
     config = load_yaml(str(floris_ekman_veer.example_input("farm_night")))
     atmosphere = config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
-    if policy is None:
-        del atmosphere["outside_domain"]
-    else:
+    del atmosphere["cooling_rate"]
+    atmosphere["obukhov_length"] = 100.0
+    if policy is not None:
         atmosphere["outside_domain"] = policy
     return config
 

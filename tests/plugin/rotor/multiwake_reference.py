@@ -28,6 +28,7 @@ from floris.utilities import load_yaml
 
 import floris_ekman_veer  # noqa: F401  (registers the models)
 from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
+from tests.conftest import table1_sbl6
 
 INPUTS = Path(__file__).resolve().parents[3] / "inputs"
 TURBINE_LIBRARY = Path(floris.__file__).parent / "turbine_library"
@@ -114,6 +115,8 @@ def farm_config(atmosphere: str = "SBL-6", turbine: str = "nrel_5MW", layout=((0
     block = load_yaml(INPUTS / ATMOSPHERES[atmosphere])["wake"]["wake_velocity_parameters"]
     config["wake"]["wake_velocity_parameters"]["ekman_veer"]["atmosphere"] = copy.deepcopy(
         block["ekman_veer"]["atmosphere"])
+    if atmosphere == "SBL-6":  # Table 1's state, h above the hub (tests.conftest.table1_sbl6)
+        config = table1_sbl6(config)
     config["farm"]["turbine_type"] = [turbine]
     definition = load_yaml(TURBINE_LIBRARY / f"{turbine}.yaml")
     diameter = float(definition["rotor_diameter"])

@@ -273,3 +273,30 @@ def test_cell_mean_by_height_is_row_cell_sums_bit_for_bit():
         expected = np.cbrt(mean) if moment == 3.0 else mean
         np.testing.assert_array_equal(cells_module.cell_mean(heights_u, index, moment, cells),
                                       expected)
+
+
+def test_centre_bound_holds_and_is_tight():
+    """The bound that lets the kernel skip a row's exact centre (wake/fused.py
+    centre_offset_bound) contains the compiled centre of Eq. (yc_xz) for every height, yaw
+    sign, speed, veer and ground image, and stays within a few per cent of it without the
+    image where t_hat's growth is far below 1 (the bound's 2a / (2 + a) is then tight)."""
+    from floris_ekman_veer.wake.fused import centre_offset, centre_offset_bound
+
+    rng = np.random.default_rng(8)
+    worst = 0.0
+    for _ in range(4000):
+        x = rng.uniform(5.0, 3000.0)
+        z, hub = rng.uniform(5.0, 250.0), rng.uniform(40.0, 150.0)
+        u, v = rng.uniform(0.5, 14.0), rng.uniform(-3.0, 3.0)
+        ct, yaw = rng.uniform(0.2, 0.95), rng.uniform(-0.5, 0.5)
+        strength = float(time_like_strength(rng.uniform(0.1, 0.6), 9.0, ct, yaw))
+        r_tube = float(initial_radius(60.0, ct, yaw))
+        u_star = rng.uniform(0.1, 0.6)
+        veer, image = float(rng.integers(2)), float(rng.integers(2))
+        exact = centre_offset(x, z, u, v, strength, r_tube, hub, 60.0, u_star, veer, image)
+        drift, bound = centre_offset_bound(x, z, u, v, strength, r_tube, hub, 60.0, u_star,
+                                           veer, image)
+        assert abs(exact - drift) <= bound
+        if not image and 0.35 * u_star / u * x / 60.0 < 0.05 and abs(exact - drift) > 1.0:
+            worst = max(worst, bound / abs(exact - drift))
+    assert 1.0 < worst < 1.05

@@ -25,6 +25,7 @@ from floris_ekman_veer.plugin.inflow.inflow import set_atmosphere
 from floris_ekman_veer.plugin.inflow.shallow import ShallowBoundaryLayerWarning
 
 from conftest import assert_as_plain_floris
+from tests.conftest import table1_sbl6
 
 from pathlib import Path
 
@@ -343,7 +344,7 @@ def test_flow_field_carries_the_veer_aware_thrust(veer, yaw, wind_direction):
     front's wake sampled with sample_flow_at_points (polar Gauss quadrature, 48 x 96) to 0.2 %.
     Before the full-flow solve ran the veer-aware rotor: 1.0 % (M-2, 270 deg) and 2.2 %
     (M-2, 275 deg), since its wake carried the cosine law's C_T."""
-    config = copy.deepcopy(load_yaml(FARM))
+    config = table1_sbl6(FARM)  # Table 1's SBL-6 state: h = 125 m, above the hub
     config["wake"]["wake_deflection_parameters"]["ekman_veer"]["veer"] = veer
     D, hub = 126.0, 90.0
     with warnings.catch_warnings():

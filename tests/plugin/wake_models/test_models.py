@@ -41,7 +41,7 @@ from floris_ekman_veer.plugin.wake_models.models import (
     Gaussian2014VelocityDeficit,
 )
 from floris_ekman_veer.wake.deficit import potential_core_length
-from tests.conftest import own_turbine
+from tests.conftest import TABLE1_SBL6_MU, own_turbine
 
 DEBUG = False
 
@@ -112,6 +112,11 @@ def yaw_wake_centre(abl, x, z, yaw_deg, ct, radius, hub_height, u_local):
 # Helpers
 
 
+#: The exclusive stability inputs of an atmosphere block (docs/atmosphere.md#input-ranges).
+STABILITY_INPUTS = {"stability_parameter", "cooling_rate", "surface_heat_flux", "sensible_heat_flux",
+                    "obukhov_length"}
+
+
 def config(case, *, veer=None, curl=None, atmosphere=None, **flow_field):
     """An input of inputs/<case>.yaml as a dict, with a few changes."""
     cfg = load_yaml(str(INPUTS / f"{case}.yaml"))
@@ -121,7 +126,11 @@ def config(case, *, veer=None, curl=None, atmosphere=None, **flow_field):
     if curl is not None:
         wake["wake_velocity_parameters"]["ekman_veer"]["curl"] = curl
     if atmosphere is not None:
-        wake["wake_velocity_parameters"]["ekman_veer"]["atmosphere"].update(atmosphere)
+        block = wake["wake_velocity_parameters"]["ekman_veer"]["atmosphere"]
+        if STABILITY_INPUTS & set(atmosphere):  # a stability given replaces the input's
+            for key in STABILITY_INPUTS:
+                block.pop(key, None)
+        block.update(atmosphere)
     cfg["flow_field"].update(flow_field)
     return cfg
 
@@ -623,7 +632,7 @@ def test_yawed_hub_height_wake_centre_at_10d(case, baseline):
 
 
 # ==============================================================================================
-# 4. FLORIS regression style: NREL 5 MW farms in the farm_sbl6 atmosphere
+# 4. FLORIS regression style: NREL 5 MW farms in Table 1's SBL-6 state (farm_sbl6's blocks)
 
 
 WIND_DIRECTIONS = [270.0, 270.0, 270.0, 280.0, 280.0, 280.0, 285.0, 285.0, 285.0]
@@ -635,8 +644,11 @@ from tests.regression_baselines import baseline_row, baseline_square, yawed_base
 
 
 def farm(layout, wind_directions=WIND_DIRECTIONS, wind_speeds=WIND_SPEEDS, yaw=None):
-    cfg = config("farm_sbl6", wind_directions=list(wind_directions),
-                 wind_speeds=list(wind_speeds),
+    # Table 1's SBL-6 state (mu = 148.49, h = 110-144 m at 8-10 m/s: a veered rotor layer with
+    # the hub inside the ABL); the input's -1 K/h puts h at 71-92 m there, below the hub, where
+    # the rotor sees the unveered geostrophic wind (tests.conftest.table1_sbl6).
+    cfg = config("farm_sbl6", atmosphere={"stability_parameter": TABLE1_SBL6_MU},
+                 wind_directions=list(wind_directions), wind_speeds=list(wind_speeds),
                  turbulence_intensities=[0.06] * len(wind_speeds))
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = list(layout[0]), list(layout[1])
     # The baselines pin the paper's model: its k_w and its Gaussian inside the potential core,

@@ -101,7 +101,7 @@ SCRIPT = textwrap.dedent(
             # Per-condition atmosphere lists are cut with the conditions.
             day_night = FlorisModel(farm)
             atmosphere = inflow.atmosphere_of(day_night.core).sliced(slice(None))
-            atmosphere["stability_parameter"] = [0.0, 148.49] * 3 + [60.0]
+            atmosphere["cooling_rate"] = [0.0, -1.0] * 3 + [-0.375]
             inflow.set_atmosphere(day_night, atmosphere, **conditions)
             day_night.run()
             par_day_night = ParFlorisModel(day_night, interface="dask", client=client)
@@ -153,7 +153,7 @@ SCRIPT = textwrap.dedent(
             series = TimeSeries(np.array([266.0, 274.0]), np.array([8.0, 10.0]),
                                 turbulence_intensities=0.06)
             classes = {"night": {"atmosphere": atmosphere},
-                       "day": {"atmosphere": dict(atmosphere, stability_parameter=0.0)}}
+                       "day": {"atmosphere": dict(atmosphere, cooling_rate=0.0)}}
             years = [annual_energy(model, series, classes, YawOptimizationSR,
                                    records=["night", "day"], models=["ekman_veer"],
                                    progress=False, minimum_yaw_angle=-20.0,
@@ -170,7 +170,7 @@ SCRIPT = textwrap.dedent(
             client_started = time.perf_counter()
             series = TimeSeries(np.array([266.0, 274.0, 95.0]), np.array([8.0, 10.0, 9.0]),
                                 turbulence_intensities=0.06)
-            per_record = dict(atmosphere, stability_parameter=[148.49, 0.0, 60.0])
+            per_record = dict(atmosphere, cooling_rate=[-1.0, 0.0, -0.375])
             labels = [f"record {k}" for k in range(3)]
             studies = [record_energy(row, series, per_record, labels, YawOptimizationSR,
                                      models=["ekman_veer"], chunk_size=2, progress=False,

@@ -283,6 +283,42 @@ def test_the_cups_turbulence_is_the_wakes_input_and_only_its_departure_the_fits(
     np.testing.assert_allclose(without.turbulence_intensities,
                                np.asarray(without.abl.turbulence_intensity(80.0), float),
                                rtol=1e-12)
+    # The wake's input (docs/atmosphere.md#ambient-turbulence): the block's turbulence_factor
+    # makes the ekman_veer wake's ambient I_u at 80 m the measured TI, so its k_w is
+    # [floor^n + (alpha' TI_measured)^n]^(1/n); without the std columns the block has none and
+    # the wake keeps the model's I_u.
+    assert "turbulence_factor" not in without.atmosphere
+    factor = np.asarray(with_std.atmosphere["turbulence_factor"])
+    assert np.median(factor[given]) == pytest.approx(TERRAIN_TURBULENCE, rel=0.05)
+    for site, ambient in ((with_std, np.where(given, measured, np.nan)), (without, None)):
+        k_w, floris_ti, model_ti = _wake_expansion_at_80m(site)
+        if ambient is None:
+            ambient = model_ti
+        np.testing.assert_allclose(floris_ti[given], ambient[given], rtol=1e-12)
+        np.testing.assert_allclose(
+            k_w[given], (0.021**6 + (0.33 * ambient[given]) ** 6) ** (1 / 6), rtol=1e-12)
+
+
+def _wake_expansion_at_80m(site):
+    """(k_w of the ekman_veer wake of a rotor at 80 m, the ambient I_u the wake takes there, the
+    fitted ABL's I_u there) per record of ``site``, as FLORIS solves the site's block."""
+    from floris import FlorisModel
+
+    from floris_ekman_veer.plugin.inflow.atmosphere_block import atmosphere_of
+    from floris_ekman_veer.plugin.inflow.solve_cache import solve
+
+    fmodel = FlorisModel(floris_ekman_veer.example_input("farm_night"))
+    fmodel.set(reference_wind_height=80.0)
+    site.apply(fmodel)
+    abl = solve(atmosphere_of(fmodel.core), site.wind_speeds, 80.0)
+    n = len(site.labels)
+    speed = site.wind_speeds.reshape(n, 1, 1, 1)
+    ambient = np.asarray(abl.turbulence_intensity(80.0, reference_height=80.0)).reshape(-1)
+    k_w = fmodel.core.wake.velocity_model.expansion_rate(
+        abl, np.full((n, 1, 1, 1), 80.0), speed, ambient.reshape(n, 1, 1, 1),
+        ambient.reshape(n, 1, 1, 1))
+    return (np.asarray(k_w).reshape(-1), ambient,
+            np.asarray(site.abl.turbulence_intensity(80.0), float).reshape(-1))
 
 
 @pytest.mark.parametrize("reference_height, match", [
