@@ -67,7 +67,11 @@ def overlap_weight(sigma_squared_new, sigma_squared_old, distance_squared):
     """lambda_ni of Bastankhah et al. (2021, Eq. 4.9, the module docstring): the share of an
     upstream wake i's centre deficit that wake n's momentum balance meets."""
     total = sigma_squared_new + sigma_squared_old
-    return 2.0 * sigma_squared_old / total * np.exp(-distance_squared / (2.0 * total))
+    # Wakes more than sqrt(2 * 40) combined widths apart share nothing (lambda < 1e-17): 0, not
+    # an exp that underflows (and a product that does).
+    exponent = distance_squared / (2.0 * total)
+    return np.where(exponent < 40.0,
+                    2.0 * sigma_squared_old / total * np.exp(-np.minimum(exponent, 40.0)), 0.0)
 
 
 def cumulative_deficit(single_deficit, ambient_speed, incoming_speed, upstream, core_deficit):
