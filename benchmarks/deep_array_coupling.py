@@ -46,8 +46,11 @@ CRESPO_HERNANDEZ = {
     "1996-": {"constant": 0.73, "ai": 0.8325, "initial": -0.0325, "downstream": -0.32},
 }
 SCALE = {"free stream": "free_stream", "incoming": "incoming"}
+SUPERPOSITION = {"sosfs": "combination_model", "fls": "combination_model",
+                 "zong": "momentum_conserving", "cumulative": "cumulative"}
 #: (added turbulence, overlap, Crespo-Hernandez, deficit scale, superposition); the first is
-#: FLORIS's gauss coupling, "quadrature, radius, FLORIS, incoming, fls" the package's default.
+#: FLORIS's gauss coupling, "quadrature, radius, FLORIS, incoming, cumulative" the package's
+#: default (before issue 40: "quadrature, radius, FLORIS, incoming, fls").
 COUPLINGS = (
     ("max", "velocity", "FLORIS", "free stream", "sosfs"),
     ("max", "velocity", "FLORIS", "free stream", "fls"),
@@ -90,9 +93,8 @@ def setup(turbulence: str, overlap: str, constants: str, scale: str, superpositi
     else:
         velocity["turbulence_overlap"] = OVERLAP[overlap]
         crespo_hernandez = CRESPO_HERNANDEZ[constants]
-    if superposition in ("zong", "cumulative"):
-        velocity["wake_superposition"] = ("momentum_conserving" if superposition == "zong"
-                                          else superposition)
+    # (every row names its superposition: the default is the cumulative wake)
+    velocity["wake_superposition"] = SUPERPOSITION[superposition]
     summed = superposition in ("zong", "cumulative")
     return (f"{turbulence}, {overlap}, {constants}, {scale}, {superposition}",
             ({**strings, "combination_model": "fls" if summed else superposition},

@@ -496,9 +496,10 @@ def test_quick_start_example_converts_floris_defaults_and_shows_what_veer_change
         gch = quick_start.powers(quick_start.veer_input(gch=True), yaw_first=20.0)
     yawed = quick_start.powers(quick_start.veer_input(), yaw_first=20.0)
     np.testing.assert_array_equal(gch[:, 0], yawed[:, 0])
-    # GCH's additions act behind the yawed rotor, mostly on the last turbine (+3 % and +4.5 %)
+    # GCH's additions act behind the yawed rotor, mostly on the last turbine (+1.60 % and +1.54 %
+    # with the cumulative wake; +3 % and +4.5 % on the plain sum, which recovered less)
     np.testing.assert_allclose(gch[:, 1], yawed[:, 1], rtol=1e-5)
-    assert np.all(gch[:, 2] / yawed[:, 2] - 1.0 > 0.02)
+    assert np.all(gch[:, 2] / yawed[:, 2] - 1.0 > 0.012)
 
 
 DASK_SCRIPT = '''

@@ -280,13 +280,15 @@ def farm_coupling_beyond_paper(core) -> bool:
     paper's single-wake validation: more than one turbine and the ekman_veer or bastankhah2014
     velocity model with the upstream wakes' added turbulence in k_w (``wake_expansion`` other
     than ``ambient``, in either ``wake_turbulence`` form), the incoming-speed deficits or a
-    published superposition (``wake_superposition`` momentum_conserving or cumulative)
+    published superposition (``wake_superposition`` momentum_conserving or cumulative, which act
+    on FLORIS's ``fls``; with another combination each wake is left to it)
     (docs/coupling.md#wakes-deep-in-an-array)."""
     velocity = getattr(core.wake, "velocity_model", None)
     if core.farm.n_turbines < 2 or not hasattr(velocity, "deficit_velocity"):
         return False
+    summed = core.wake.model_strings.get("combination_model") == "fls"
     return (velocity.wake_expansion != "ambient" or velocity.deficit_velocity == "incoming"
-            or velocity.wake_superposition != "combination_model")
+            or (velocity.wake_superposition != "combination_model" and summed))
 
 
 def validity_summary(report: pd.DataFrame, label: str = "") -> str:

@@ -32,7 +32,7 @@ from floris_ekman_veer.wake.superposition import (
 class WakeConvection:
     """Per rotor (flat index condition * n_turbines + turbine): the wakes that reached it,
     (pairs, n_turbines, points) their s_i = U_c,i u_c,i [m^2/s^2] (Zong & Porte-Agel, one point)
-    or C_i [m/s] (Bastankhah et al., at each of the rotor's grid points), sigma_i^2 [m^2] and
+    or C_i [m/s] (Bastankhah et al., at each of the rotor's sub-point rows), sigma_i^2 [m^2] and
     centre (y, z) [m] at the rotor's plane, their count, and for Zong & Porte-Agel the sums
     sum_ij s_i s_j G_ij and sum_i s_i 2 pi sigma_i^2 and U_c [m/s] (wake/superposition.py)."""
 

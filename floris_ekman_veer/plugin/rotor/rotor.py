@@ -27,7 +27,7 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
 from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
-from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 from floris_ekman_veer.wake.fused import WAKE_TABLE
 from floris_ekman_veer.wake.superposition import cumulative_deficit
 
@@ -225,23 +225,30 @@ def reached_rotor_cell_deficit(
     per_pair.update(speed_fraction=speed_fraction[f], cos=column(cos_a)[f],
                     sin=column(sin_a)[f], offset=pair[:, PAIR_COLUMNS.index("offset")])
     convecting = wakes.superposition == "momentum_conserving"
+    row_scale = None
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
-        # wakes kept at each rotor (plugin/rotor/convection.py), at each of its grid points (the
-        # veer-sheared centres differ with height, as on FLORIS's other grids); the kernel's
-        # deficit is the model's shape scaled to the rotor's mean C_n, and the wakes are summed.
+        # wakes kept at each rotor (plugin/rotor/convection.py), at each of the kernel's sub-point
+        # rows: the veer-sheared centres differ with height, and FLORIS's other grids evaluate
+        # C_n point by point, so the kernel scales the model's shape row by row to C_n at the
+        # row's height; the wakes are summed. The centres at the rows: the deflection's at the
+        # grid's point heights, interpolated (rotor_cells.row_interpolation), for every wake.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
         width_squared = (table[:, WAKE_TABLE.index("kx")]
                          + table[:, WAKE_TABLE.index("xi0")])[:, None] ** 2
-        centre_y = y_i[f, 0, 0, 0][:, None] + deflection_field_i[f, j].reshape(f.size, -1)
+        row_centre = centre if centre is not None else np.sum(
+            deflection_field_i[f, j, 0, :, None] * row_interpolation(cells.n, cells.row_z),
+            axis=1)
+        centre_y = y_i[f, 0, 0, 0][:, None] + row_centre
         centre_z = np.broadcast_to(hub_height_i[f, 0, 0, 0][:, None], centre_y.shape)
         incoming_speed = (per_pair["hub_speed"] * per_pair["speed_fraction"])[:, None]
         deficit = cumulative_deficit(
             single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
             wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
-            2.0 * axial_induction(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
-        pair[:, scale] = deficit.mean(axis=1) / np.where(single > 0.0, single, 1.0)
+            model.core_deficit(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
+        pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
+        row_scale = deficit
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * deficit.mean(axis=1)
     if convecting:
@@ -255,7 +262,7 @@ def reached_rotor_cell_deficit(
         pair[:, edge] = pair[:, edge] * wake_convection
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
-        kind, rotor, wakes, track)
+        kind, rotor, wakes, track, row_scale)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE

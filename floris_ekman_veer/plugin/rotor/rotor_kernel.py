@@ -61,7 +61,8 @@ _LAUNCH = threading.Lock()
 @numba.njit(parallel=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kind, kind_u,
                kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
-               block, track, removed, overlap, reached):
+               block, track, row_scale, removed, overlap, reached):
+    per_row = row_scale.shape[0] > 0
     for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
         strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
@@ -116,10 +117,12 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
+            # The cumulative wake's amplitude at the row's height (plugin/rotor/rotor.py).
+            row_amplitude = scale * row_scale[k, r] if per_row else scale
             for s in range(width[r]):
                 dy = lateral + radius_j * sub_y[r, s]
                 du = point_deficit(dy, dz, dy + polar_shift, amplitude, kx, xi0, sin2b,
-                                   q0, q1, q2, q3, q4, shape) * scale
+                                   q0, q1, q2, q3, q4, shape) * row_amplitude
                 old = np.float64(combined[index, s]) if rule else 0.0
                 new = superposed(rule, old, du)
                 removed[k, cell[r, s]] += removed_moment(weight[r, s], ambient_u, old, new,
@@ -199,7 +202,8 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     return keep[:count], pair[:count]
 
 
-def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track):
+def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
+                   row_scale=None):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -212,7 +216,8 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
-    updated in place.
+    updated in place; ``row_scale`` (pairs, rows) or None: a factor of the pair's
+    ``velocity_scale`` per row (the cumulative wake's C_n at the row's height).
     """
     cells = wakes.cells
     n_pairs = flat.size
@@ -227,5 +232,7 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
                    flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
                    rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
                    cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,
-                   flat * cells.rows, bool(track), removed, overlap, reached)
+                   flat * cells.rows, bool(track),
+                   np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale),
+                   removed, overlap, reached)
     return removed, overlap, reached, centre

@@ -173,9 +173,9 @@ class RotorWakes:
             # by it alone, as input_checks.warn_deficit_superposition says.)
             if superposition == "momentum_conserving":
                 rule = "momentum_conserving"
-            # (the cumulative wake keeps its upstream wakes at each grid point of a rotor)
+            # (the cumulative wake keeps its upstream wakes at each sub-point row of a rotor)
             convection = WakeConvection.start(
-                pairs, n_turbines, cells.n**2 if superposition == "cumulative" else 1)
+                pairs, n_turbines, cells.rows if superposition == "cumulative" else 1)
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
         combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),

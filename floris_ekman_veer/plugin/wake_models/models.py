@@ -135,14 +135,15 @@ class EkmanWakeModel(BaseModel):
     #: & Qian (2018, wake/added_turbulence.py) averaged over the rotor, its ring-shaped profile
     #: its own overlap (docs/coupling.md#wakes-deep-in-an-array).
     wake_turbulence: str = choice_field("crespo_hernandez", WAKE_TURBULENCES)
-    #: How the wakes superpose (docs/coupling.md#wakes-deep-in-an-array): "combination_model"
-    #: (the default), FLORIS's combination model point-wise with C(x) scaled by
-    #: ``deficit_velocity``; "cumulative", the cumulative wake of Bastankhah et al. (2021,
-    #: wake/superposition.py): each wake's centre deficit carries its rotor's thrust through the
-    #: upstream wakes there, the deficits summed (with FLORIS's ``fls``; with another
-    #: combination each wake is combined by it alone); "momentum_conserving", Zong & Porte-Agel
-    #: (2020, plugin/rotor/convection.py; turbine grid only), with ``fls``.
-    wake_superposition: str = choice_field("combination_model", WAKE_SUPERPOSITIONS)
+    #: How the wakes superpose (docs/coupling.md#wakes-deep-in-an-array): "cumulative" (the
+    #: default), the cumulative wake of Bastankhah et al. (2021, wake/superposition.py): each
+    #: wake's centre deficit carries its rotor's thrust through the upstream wakes there, at
+    #: each height of the rotor, the deficits summed (with FLORIS's ``fls``; with another
+    #: combination each wake is combined by it alone); "combination_model", FLORIS's
+    #: combination model point-wise with C(x) scaled by ``deficit_velocity``;
+    #: "momentum_conserving", Zong & Porte-Agel (2020, plugin/rotor/convection.py; turbine grid
+    #: only), with ``fls``.
+    wake_superposition: str = choice_field("cumulative", WAKE_SUPERPOSITIONS)
     max_thrust_coefficient: float = number_field(GLAUERT_THRUST_COEFFICIENT, *THRUST_LIMIT_RANGE)
     #: Conditions with a rotor top above h: "warn" (counted in a ShallowBoundaryLayerWarning)
     #: or "raise"; read by the inflow hook when the model is built (plugin/inflow/shallow.py).
@@ -312,7 +313,7 @@ class EkmanWakeModel(BaseModel):
         overlap = sum((overlap_weight(width_squared, w, (centre_y - y) ** 2 + (centre_z - z) ** 2)
                        * c for c, w, y, z in upstream), np.zeros_like(single))
         deficit = cumulative_deficit(single, wake.hub_speed, incoming_speed, overlap,
-                                     2.0 * axial_induction(wake.ct, wake.yaw) * incoming_speed)
+                                     self.core_deficit(wake.ct, wake.yaw) * incoming_speed)
         deficit = np.where(wake.dx > 0.0, deficit, 0.0)
         upstream.append((deficit, width_squared, centre_y, centre_z))
         return deficit / np.where(single > 0.0, single, 1.0)
@@ -348,6 +349,11 @@ class EkmanWakeModel(BaseModel):
     def centre_deficit(self, x, k_w, radius, ct, yaw):
         """Delta u / U_h at the wake's centre at x: C(x), Eq. (Cx)."""
         return max_deficit(x, k_w, radius, ct, yaw)
+
+    def core_deficit(self, ct, yaw):
+        """The potential core's deficit 2a / U_n, the cumulative wake's bound
+        (wake/superposition.py): a of Eq. (ind_factor) behind the yawed rotor."""
+        return 2.0 * axial_induction(ct, yaw)
 
     def width_bound(self, x, k_w, radius, ct, yaw):
         """An upper bound of the wake width sigma(theta, x) over all polar angles [m]."""
@@ -497,6 +503,11 @@ class Gaussian2014VelocityDeficit(EkmanWakeModel):
     def centre_deficit(self, x, k_w, radius, ct, yaw):
         k_star = k_w if self.k_star is None else self.k_star
         return bastankhah2014_deficit(x, 0.0, 0.0, ct=ct, diameter=2.0 * radius, k_star=k_star)
+
+    def core_deficit(self, ct, yaw):
+        # ct is already the rotor-normal loading (wake_thrust_coefficient): 2a = 1 - sqrt(1 - ct),
+        # the Gaussian's own cap, with no second cos^2(yaw).
+        return 2.0 * axial_induction(ct, 0.0)
 
     def width_bound(self, x, k_w, radius, ct, yaw):
         k_star = k_w if self.k_star is None else self.k_star

@@ -129,8 +129,11 @@ def test_dispatch_picks_the_solver_for_the_package_models_on_turbine_grids(monke
     cubature = copy.deepcopy(sbl6)
     cubature["solver"] = {"type": "turbine_cubature_grid", "turbine_grid_points": 3}
     point_wise = copy.deepcopy(cubature)
+    # (the cumulative wake's thrust needs the rotors' incoming speeds: the point-wise settings
+    # sum the wakes FLORIS's way)
     point_wise["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
-        wake_expansion="local_turbulence", deficit_velocity="free_stream")
+        wake_expansion="local_turbulence", deficit_velocity="free_stream",
+        wake_superposition="combination_model")
     for config in (gauss, gch, point_wise):
         assert _solver_calls(config, monkeypatch) == 0
     # With the defaults the cubature grid's wakes take the rotor states of a turbine-grid solve

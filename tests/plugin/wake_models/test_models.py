@@ -870,7 +870,9 @@ def test_local_turbulence_adds_only_the_wake_added_turbulence():
 
 def test_array_coupling_is_the_default_and_adds_what_a_second_wake_brings():
     """The farm input's defaults (docs/coupling.md#wakes-deep-in-an-array): array_turbulence,
-    incoming, the wakes summed. A row of four NREL 5 MW at 7 D, neutral, 8 m/s: turbine 2 stands
+    incoming, the cumulative wake summed by fls (the variants here with the plain sum,
+    ``wake_superposition: combination_model``: the cumulative wake carries the thrust with the
+    incoming speed whatever ``deficit_velocity`` says). A row of four NREL 5 MW at 7 D, neutral, 8 m/s: turbine 2 stands
     in one wake from an unwaked rotor, so every coupling gives it the same power (fraction 1,
     and one wake's added turbulence is the same summed or maximal); turbine 3's wake source,
     turbine 2, is waked: scaled with its incoming speed, turbine 3 gets more power than with the
@@ -880,13 +882,15 @@ def test_array_coupling_is_the_default_and_adds_what_a_second_wake_brings():
                  turbulence_intensities=[0.06])
     cfg["farm"]["layout_x"], cfg["farm"]["layout_y"] = [0.0, 882.0, 1764.0, 2646.0], [0.0] * 4
     default = FlorisModel(cfg).core.wake.velocity_model
-    assert (default.wake_expansion, default.deficit_velocity) == ("array_turbulence", "incoming")
+    assert (default.wake_expansion, default.deficit_velocity, default.wake_superposition) == (
+        "array_turbulence", "incoming", "cumulative")
     assert cfg["wake"]["model_strings"]["combination_model"] == "fls"
     powers = {}
     for expansion in ("local_turbulence", "array_turbulence"):
         for scale in ("free_stream", "incoming"):
             cfg["wake"]["wake_velocity_parameters"]["ekman_veer"].update(
-                wake_expansion=expansion, deficit_velocity=scale)
+                wake_expansion=expansion, deficit_velocity=scale,
+                wake_superposition="combination_model")
             fmodel = FlorisModel(cfg)
             fmodel.run()
             powers[expansion, scale] = fmodel.get_turbine_powers()[0]
