@@ -1,9 +1,7 @@
 """The wakes kept at each rotor during one solve, for the momentum-conserving superposition of
-Zong & Porte-Agel (2020) and the cumulative wake of Bastankhah et al. (2021) on the rotor cells
-(``wake_superposition: momentum_conserving`` or ``cumulative``, wake/superposition.py,
-docs/coupling.md#wakes-deep-in-an-array). For the cumulative wake each rotor keeps the upstream
-wakes' centre deficits C_i, widths and centres at its plane, and a new wake's C_n follows from
-their overlap with it (``upstream``); its deficits are then summed (FLORIS's ``fls``).
+Zong & Porte-Agel (2020) on the rotor cells (``wake_superposition: momentum_conserving``,
+wake/superposition.py, docs/coupling.md#wakes-deep-in-an-array); the cumulative wake of
+Bastankhah et al. (2021) keeps its own (plugin/rotor/upstream_wakes.py).
 
 The rotor cells superpose wakes point-wise at their sub-points (plugin/rotor/rotor_wakes.py);
 Zong & Porte-Agel's weights U_c,i / U_c need the combined wake's convection velocity U_c, a
@@ -12,7 +10,10 @@ deficit u_c,i, width sigma_i, centre at the rotor's plane) is kept per rotor, so
 integrals are the Gaussians' closed forms; the sub-points hold sum_i U_c,i u_i (the kernel's rule
 "momentum_conserving", a sum) and the combined wake there is that sum over U_c. Each wake step
 updates U_c of the rotors it reaches and recomputes their cells' removed moment from the
-sub-points (every sub-point's combined wake changes with U_c). Numpy; no FLORIS import.
+sub-points (every sub-point's combined wake changes with U_c). Numpy; no FLORIS import. The tables
+are dense, (rotors, n_turbines) per quantity: one value per kept wake (the Gaussian's centre, not
+per row), an option beyond the default whose cost (turbines^2 per condition) is that of its
+updates of every reached rotor's moments anyway (``removed_moments``).
 """
 
 from __future__ import annotations
@@ -24,17 +25,15 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells
 from floris_ekman_veer.wake.superposition import (
     convection_velocity,
     gaussian_product_integral,
-    overlap_weight,
 )
 
 
 @attrs.define(eq=False)
 class WakeConvection:
-    """Per rotor (flat index condition * n_turbines + turbine): the wakes that reached it,
-    (pairs, n_turbines, points) their s_i = U_c,i u_c,i [m^2/s^2] (Zong & Porte-Agel, one point)
-    or C_i [m/s] (Bastankhah et al., at each of the rotor's sub-point rows), sigma_i^2 [m^2] and
-    centre (y, z) [m] at the rotor's plane, their count, and for Zong & Porte-Agel the sums
-    sum_ij s_i s_j G_ij and sum_i s_i 2 pi sigma_i^2 and U_c [m/s] (wake/superposition.py)."""
+    """Per rotor (flat index condition * n_turbines + turbine): the wakes that joined it,
+    (pairs, n_turbines, 1) their s_i = U_c,i u_c,i [m^2/s^2], sigma_i^2 [m^2] and centre (y, z)
+    [m] at the rotor's plane, their count, the sums sum_ij s_i s_j G_ij and
+    sum_i s_i 2 pi sigma_i^2 and U_c [m/s] (wake/superposition.py)."""
 
     strength: np.ndarray
     width_squared: np.ndarray
@@ -46,8 +45,8 @@ class WakeConvection:
     velocity: np.ndarray
 
     @classmethod
-    def start(cls, pairs: int, n_turbines: int, points: int = 1) -> WakeConvection:
-        table = lambda: np.zeros((pairs, n_turbines, points))  # noqa: E731
+    def start(cls, pairs: int, n_turbines: int) -> WakeConvection:
+        table = lambda: np.zeros((pairs, n_turbines, 1))  # noqa: E731
         return cls(table(), table(), table(), table(), np.zeros(pairs, dtype=int),
                    np.zeros(pairs), np.zeros(pairs), np.zeros(pairs))
 
@@ -68,20 +67,9 @@ class WakeConvection:
             ambient_speed, self.momentum[pair] / self.deficit[pair])
         return self.velocity[pair]
 
-    def upstream(self, pair, width_squared, centre_y, centre_z):
-        """sum_i lambda_ni C_i [m/s] at rotors ``pair`` of a new wake (sigma_n^2 and centre,
-        (pairs, points)) over the wakes kept there, at each point (Bastankhah et al. 2021;
-        ``strength`` holds their C_i)."""
-        old = (np.arange(self.strength.shape[1]) < self.count[pair][:, None])[:, :, None]
-        distance_squared = ((self.centre_y[pair] - centre_y[:, None]) ** 2
-                            + (self.centre_z[pair] - centre_z[:, None]) ** 2)
-        weight = overlap_weight(width_squared[:, None], self.width_squared[pair],
-                                distance_squared)
-        return np.sum(np.where(old, weight * self.strength[pair], 0.0), axis=1)
-
     def keep(self, pair, strength, width_squared, centre_y, centre_z):
-        """Keep one wake (its C_i or s_i, sigma^2, centre; (pairs, points)) at rotors
-        ``pair`` (each once)."""
+        """Keep one wake (its s_i, sigma^2, centre; (pairs, 1)) at rotors ``pair`` (each
+        once)."""
         slot = self.count[pair]
         for table, value in ((self.strength, strength), (self.width_squared, width_squared),
                              (self.centre_y, centre_y), (self.centre_z, centre_z)):

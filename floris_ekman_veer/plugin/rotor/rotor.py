@@ -29,7 +29,6 @@ from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401 
 from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
 from floris_ekman_veer.wake.fused import WAKE_TABLE
-from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -150,6 +149,9 @@ def reached_rotor_cell_deficit(
         # Turbine i among the rotors, per condition.
         source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
                            axis=1)
+        if cumulative:
+            # No later wake reaches turbine i (the solver steps downstream): free its kept wakes.
+            wakes.convection.release(np.arange(n_findex) * n_turbines + source)
     # U_i / U_i,0 of turbine i: its wake's C(x) scales with the speed it stands in
     # (docs/coupling.md#wakes-deep-in-an-array); 1 for an unwaked rotor.
     speed_fraction = 1.0
@@ -228,25 +230,22 @@ def reached_rotor_cell_deficit(
     row_scale = None
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
-        # wakes kept at each rotor (plugin/rotor/convection.py), at each of the kernel's sub-point
-        # rows: the veer-sheared centres differ with height, and FLORIS's other grids evaluate
-        # C_n point by point, so the kernel scales the model's shape row by row to C_n at the
-        # row's height; the wakes are summed. The centres at the rows: the deflection's at the
-        # grid's point heights, interpolated (rotor_cells.row_interpolation), for every wake.
+        # wakes kept at each rotor (plugin/rotor/upstream_wakes.py), at each of the kernel's
+        # sub-point rows: the veer-sheared centres differ with height, and FLORIS's other grids
+        # evaluate C_n point by point, so the kernel scales the model's shape row by row to C_n
+        # at the row's height; the wakes are summed. The centres at the rows: the deflection's
+        # at the grid's point heights, interpolated (rotor_cells.row_interpolation), for every
+        # wake.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
         width_squared = (table[:, WAKE_TABLE.index("kx")]
-                         + table[:, WAKE_TABLE.index("xi0")])[:, None] ** 2
-        row_centre = centre if centre is not None else np.sum(
-            deflection_field_i[f, j, 0, :, None] * row_interpolation(cells.n, cells.row_z),
-            axis=1)
-        centre_y = y_i[f, 0, 0, 0][:, None] + row_centre
-        centre_z = np.broadcast_to(hub_height_i[f, 0, 0, 0][:, None], centre_y.shape)
-        incoming_speed = (per_pair["hub_speed"] * per_pair["speed_fraction"])[:, None]
-        deficit = cumulative_deficit(
-            single[:, None], per_pair["hub_speed"][:, None], incoming_speed,
-            wakes.convection.upstream(flat, width_squared, centre_y, centre_z),
-            model.core_deficit(per_pair["ct"], per_pair["yaw"])[:, None] * incoming_speed)
+                         + table[:, WAKE_TABLE.index("xi0")]) ** 2
+        offsets = deflection_field_i[f, j, 0, :]
+        lateral, height = y_i[f, 0, 0, 0], hub_height_i[f, 0, 0, 0]
+        incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
+        deficit = wakes.convection.deficits(
+            flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
+            incoming_speed, model.core_deficit(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         row_scale = deficit
         if track and model.turbulence_overlap == "wake_radius":
@@ -267,9 +266,8 @@ def reached_rotor_cell_deficit(
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE
     if cumulative:
-        wakes.convection.keep(flat[reached], deficit[reached],
-                              np.broadcast_to(width_squared, deficit.shape)[reached],
-                              centre_y[reached], centre_z[reached])
+        wakes.convection.keep(flat[reached], deficit[reached], width_squared[reached],
+                              lateral[reached], offsets[reached], height[reached])
     if convecting:
         removed = _momentum_conserving(
             wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,

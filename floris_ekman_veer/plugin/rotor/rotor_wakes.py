@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.convection import WakeConvection
+from floris_ekman_veer.plugin.rotor.upstream_wakes import UpstreamWakes
 from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells
 from floris_ekman_veer.wake.fused import JIT
 
@@ -133,8 +134,9 @@ class RotorWakes:
         turbulence: (n_findex, n_turbines) turbulence intensity at each rotor, starting at the
             ambient one.
         turbulence_model: FLORIS's wake-added turbulence model, or None.
-        convection: the wakes kept at each rotor (``superposition`` "momentum_conserving"
-            or "cumulative"), or None.
+        convection: the wakes kept at each rotor (``superposition`` "momentum_conserving":
+            plugin/rotor/convection.py; "cumulative": plugin/rotor/upstream_wakes.py), or
+            None.
         superposition: the velocity model's ``wake_superposition``.
         reached: the rotors (f, j) the latest wake reached (plugin/rotor/rotor.py), a superset
             of those where its deficit is not 0, or None.
@@ -147,7 +149,7 @@ class RotorWakes:
     wake: np.ndarray
     turbulence: np.ndarray
     turbulence_model: object = None
-    convection: WakeConvection | None = None
+    convection: WakeConvection | UpstreamWakes | None = None
     superposition: str = "combination_model"
     reached: tuple | None = None
 
@@ -174,8 +176,8 @@ class RotorWakes:
             if superposition == "momentum_conserving":
                 rule = "momentum_conserving"
             # (the cumulative wake keeps its upstream wakes at each sub-point row of a rotor)
-            convection = WakeConvection.start(
-                pairs, n_turbines, cells.rows if superposition == "cumulative" else 1)
+            convection = (UpstreamWakes.start(pairs, cells) if superposition == "cumulative"
+                          else WakeConvection.start(pairs, n_turbines))
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
         combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),

@@ -1,0 +1,262 @@
+"""The upstream wakes kept at each rotor during one solve for the cumulative wake of Bastankhah
+et al. (2021) on the rotor cells (``wake_superposition: cumulative``, wake/superposition.py,
+docs/coupling.md#wakes-deep-in-an-array), and its centre deficits C_n in one compiled pass.
+
+A new wake n reaching rotor j takes C_n = a - sqrt(a^2 - K U_n^2), a = U_0 - sum_i lambda_ni C_i,
+over the wakes i that reached rotor j before it, at each of the kernel's sub-point rows (the
+veer-sheared centres differ with height). A rotor keeps only the wakes that reached it, so the
+store is sparse: an append-only pool of entries, one per (wake, rotor) reached, linked per rotor
+in the order of arrival (``head``/``tail``/``following``), each holding what varies per row, C_i
+at the rows, and once per entry what does not: sigma_i^2, the centre's height and the wake
+centre's lateral offset at FLORIS's n grid-point heights (the rows' centres are their linear
+interpolation, rotor_cells.row_interpolation, the same arithmetic as for the new wake). A rotor's
+entries are returned to the pool when it becomes the source of a wake: the solver steps the
+turbines downstream, so no later wake reaches it. The memory is that of the wakes kept at the
+rotors still ahead of the sweep, not turbines^2 x rows per condition; the work is that of the
+pairs of wakes that meet at a rotor. The sum runs over the kept wakes in their order of arrival,
+the order of wake/superposition.py's numpy form (the tests' reference), and the compiled
+arithmetic is that form's, so the deficits agree with it to round-off.
+"""
+
+from __future__ import annotations
+
+import math
+
+import attrs
+import numba
+import numpy as np
+
+from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation
+from floris_ekman_veer.wake.fused import JIT
+
+#: Wakes whose centres are more than sqrt(2 * 40) combined widths apart share nothing
+#: (wake/superposition.py ``overlap_weight``: lambda is 0 there, not an exp that underflows).
+OVERLAP_EXPONENT_LIMIT = 40.0
+
+#: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
+GROWTH = 1.25
+
+
+@numba.njit(**JIT)
+def _row_centres(lateral, offsets, interpolation, centre):
+    """y at the rows of a wake's centre into ``centre``: its lateral position plus its offsets
+    at the n grid-point heights interpolated to the rows, summed over the points in order (as
+    numpy's sum over them)."""
+    for r in range(centre.size):
+        centre[r] = 0.0
+    for k in range(offsets.size):
+        for r in range(centre.size):
+            centre[r] += offsets[k] * interpolation[k, r]
+    for r in range(centre.size):
+        centre[r] = lateral + centre[r]
+
+
+#: exp(x) for -OVERLAP_EXPONENT_LIMIT <= x <= 0 as exp(x / 2^EXP_HALVINGS)^(2^EXP_HALVINGS), the
+#: inner exp by its Taylor polynomial (EXP_TAYLOR, truncation below 1e-19 on [-40 / 64, 0]):
+#: arithmetic only, so the compiled loop over the rows runs in SIMD lanes (math.exp is a scalar
+#: libm call that numba's loops cannot vectorise). Its relative error, within about
+#: 2^EXP_HALVINGS units in the last place (3e-14), is far below what the results are held to
+#: (1e-12, tests/plugin/rotor/test_upstream_wakes.py).
+EXP_HALVINGS = 6
+EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(18)])
+
+
+@numba.njit(**JIT)
+def _overlap_exp(x):
+    """exp(x) on [-OVERLAP_EXPONENT_LIMIT, 0] (EXP_HALVINGS)."""
+    y = x * (1.0 / 2**EXP_HALVINGS)
+    value = EXP_TAYLOR[-1]
+    for term in range(EXP_TAYLOR.size - 2, -1, -1):
+        value = value * y + EXP_TAYLOR[term]
+    for _ in range(EXP_HALVINGS):
+        value = value * value
+    return value
+
+
+@numba.njit(**JIT)
+def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
+                         incoming, core, interpolation, head, following, kept_deficit,
+                         kept_width_squared, kept_lateral, kept_offsets, kept_height, deficit):
+    """C_n [m/s] at every row of the new wakes (k, one per rotor ``rotor[k]``) into ``deficit``
+    (k, rows): the upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their
+    order of arrival (Bastankhah et al. 2021, Eq. 4.9), then Eq. 4.10 with the potential core's
+    bound (wake/superposition.py ``overlap_weight``, ``cumulative_deficit``: the same operations
+    in the same order, exp to round-off, ``_overlap_exp``). An entry whose centre lies more than
+    the overlap's limit away at every row adds nothing (lambda is 0 there) and is passed over
+    from its gaps at the grid-point heights, of which the rows' are the interpolation."""
+    rows = deficit.shape[1]
+    n = interpolation.shape[0]
+    new_centre = np.empty(rows)
+    new_points = np.empty(n)
+    old_centre = np.empty(rows)
+    weight = np.empty(rows)
+    for k in range(rotor.size):
+        _row_centres(lateral[k], offsets[k], interpolation, new_centre)
+        for q in range(n):
+            new_points[q] = lateral[k] + offsets[k, q]
+        upstream = deficit[k]
+        for r in range(rows):
+            upstream[r] = 0.0
+        entry = head[rotor[k]]
+        while entry >= 0:
+            old_width_squared = kept_width_squared[entry]
+            total = width_squared[k] + old_width_squared
+            height_squared = (kept_height[entry] - height[k]) ** 2
+            # The least gap over the rows: 0 where the gaps at the points change sign.
+            low, high = np.inf, -np.inf
+            for q in range(n):
+                gap = (kept_lateral[entry] + kept_offsets[entry, q]) - new_points[q]
+                low, high = min(low, gap), max(high, gap)
+            least = max(low, -high, 0.0)
+            # (a margin for the rows' round-off)
+            if (least * least + height_squared) / (2.0 * total) \
+                    <= (1.0 + 1e-9) * OVERLAP_EXPONENT_LIMIT:
+                share = 2.0 * old_width_squared / total
+                _row_centres(kept_lateral[entry], kept_offsets[entry], interpolation,
+                             old_centre)
+                for r in range(rows):
+                    gap = old_centre[r] - new_centre[r]
+                    exponent = (gap * gap + height_squared) / (2.0 * total)
+                    lam = share * _overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
+                    weight[r] = lam if exponent < OVERLAP_EXPONENT_LIMIT else 0.0
+                for r in range(rows):
+                    upstream[r] += weight[r] * kept_deficit[entry, r]
+            entry = following[entry]
+        momentum = 1.0 - (1.0 - single[k]) ** 2
+        for r in range(rows):
+            a = ambient[k] - upstream[r]
+            root = a**2 - momentum * incoming[k] ** 2
+            value = a - math.sqrt(max(root, 0.0))
+            upstream[r] = value if root > 0.0 and value <= core[k] else core[k]
+
+
+@numba.njit(**JIT)
+def _keep(rotor, deficit, width_squared, lateral, offsets, height, head, tail, following,
+          count, free, kept_deficit, kept_width_squared, kept_lateral, kept_offsets,
+          kept_height):
+    """Append one entry per rotor ``rotor[k]`` (each once) at the end of its list, taken from
+    the free list ``free[0]`` or the unused end of the pool ``free[1]`` (the caller made room)."""
+    for k in range(rotor.size):
+        entry = free[0]
+        if entry >= 0:
+            free[0] = following[entry]
+        else:
+            entry = free[1]
+            free[1] += 1
+        kept_deficit[entry] = deficit[k]
+        kept_width_squared[entry] = width_squared[k]
+        kept_lateral[entry] = lateral[k]
+        kept_offsets[entry] = offsets[k]
+        kept_height[entry] = height[k]
+        following[entry] = -1
+        j = rotor[k]
+        if tail[j] >= 0:
+            following[tail[j]] = entry
+        else:
+            head[j] = entry
+        tail[j] = entry
+        count[j] += 1
+    free[2] += rotor.size
+
+
+@numba.njit(**JIT)
+def _release(rotor, head, tail, following, count, free):
+    """Return the entries of rotors ``rotor`` to the free list (the rotors' lists emptied)."""
+    for j in rotor:
+        if head[j] >= 0:
+            following[tail[j]] = free[0]
+            free[0] = head[j]
+            head[j] = -1
+            tail[j] = -1
+            free[2] -= count[j]
+            count[j] = 0
+
+
+@attrs.define(eq=False)
+class UpstreamWakes:
+    """The pool of kept wakes (the module docstring), per rotor (flat index condition *
+    n_turbines + turbine): ``head``/``tail`` its first and last entry (-1: none), ``following``
+    the next entry of an entry's rotor (or of the free list), ``count`` its entries, ``free``
+    [first free entry (-1: none), first never-used entry, entries in use]; per entry its C_i at the rows [m/s]
+    (``deficit``, (capacity, rows)), sigma_i^2 [m^2], lateral position [m], offsets at the n
+    grid-point heights [m] ((capacity, n)) and centre height [m]; ``interpolation`` (n, rows)
+    rotor_cells.row_interpolation."""
+
+    head: np.ndarray
+    tail: np.ndarray
+    following: np.ndarray
+    count: np.ndarray
+    free: np.ndarray
+    deficit: np.ndarray
+    width_squared: np.ndarray
+    lateral: np.ndarray
+    offsets: np.ndarray
+    height: np.ndarray
+    interpolation: np.ndarray
+
+    @classmethod
+    def start(cls, rotors: int, cells, capacity: int | None = None) -> UpstreamWakes:
+        """An empty pool for ``rotors`` rotors on ``cells`` (RotorCells), room for ``capacity``
+        entries (default: one per rotor; it grows as needed)."""
+        capacity = max(int(rotors if capacity is None else capacity), 1)
+        interpolation = np.ascontiguousarray(row_interpolation(cells.n, cells.row_z))
+        n, rows = interpolation.shape
+        empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
+        return cls(empty(), empty(), np.full(capacity, -1, dtype=np.int64),
+                   np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0], dtype=np.int64),
+                   np.zeros((capacity, rows)),
+                   np.zeros(capacity), np.zeros(capacity), np.zeros((capacity, n)),
+                   np.zeros(capacity), interpolation)
+
+    @property
+    def capacity(self) -> int:
+        return self.following.size
+
+    @property
+    def in_use(self) -> int:
+        """Entries kept at the rotors now."""
+        return int(self.free[2])
+
+    def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
+                 incoming, core) -> np.ndarray:
+        """(k, rows) C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices): their
+        sigma_n^2, lateral position and offsets at the grid-point heights ((k, n)), centre
+        height, the model's C(x) / U_h of the wake alone, U_0, U_n and the core bound 2a U_n
+        [m/s] (wake/superposition.py ``cumulative_deficit``; all (k,) but ``offsets``)."""
+        vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
+            np.asarray(a, dtype=float), np.shape(rotor)))
+        deficit = np.empty((np.size(rotor), self.interpolation.shape[1]))
+        _cumulative_deficits(
+            np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
+            np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
+            vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
+            self.following, self.deficit, self.width_squared, self.lateral, self.offsets,
+            self.height, deficit)
+        return deficit
+
+    def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
+        """Keep one new wake at each rotor of ``rotor`` (flat indices, each once): its C_n at
+        the rows ((k, rows)), sigma_n^2, lateral position, offsets ((k, n)) and height."""
+        rotor = np.ascontiguousarray(rotor, dtype=np.int64)
+        if rotor.size > self.capacity - self.in_use:
+            self._grow(self.in_use + rotor.size)
+        vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
+            np.asarray(a, dtype=float), rotor.shape))
+        _keep(rotor, np.ascontiguousarray(deficit, dtype=float), vector(width_squared),
+              vector(lateral), np.ascontiguousarray(offsets, dtype=float), vector(height),
+              self.head, self.tail, self.following, self.count, self.free, self.deficit,
+              self.width_squared, self.lateral, self.offsets, self.height)
+
+    def release(self, rotor) -> None:
+        """Free the entries kept at rotors ``rotor`` (flat indices): no later wake reaches a
+        rotor once it is a wake's source."""
+        _release(np.ascontiguousarray(rotor, dtype=np.int64), self.head, self.tail,
+                 self.following, self.count, self.free)
+
+    def _grow(self, needed: int) -> None:
+        """Room for ``needed`` entries in use, in place (ndarray.resize: the pool's arrays are
+        referenced here only, and a reallocation keeps no second copy alive)."""
+        capacity = max(int(GROWTH * self.capacity), needed)
+        for name in ("deficit", "width_squared", "lateral", "offsets", "height", "following"):
+            table = getattr(self, name)
+            table.resize((capacity, *table.shape[1:]), refcheck=False)
