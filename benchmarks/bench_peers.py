@@ -10,7 +10,10 @@ benchmarks/bench_models.py: direction uniform in [0, 360) deg, 7-12 m/s at 90 m,
 turbine yawed uniformly in [-20, 20] deg). Contenders:
 
     gauss            FLORIS gauss velocity and deflection, no GCH terms (the reference);
-    M-1              ekman_veer velocity and deflection (veer, curl, yaw), the shipped input;
+    M-1              ekman_veer velocity and deflection (veer, curl, yaw), the shipped input
+                     (the cumulative wake of Bastankhah et al. 2021, the default);
+    M-1 summed       the same with ``wake_superposition: combination_model`` (the wakes summed:
+                     what the cumulative default costs on top, docs/performance.md);
     empirical_gauss  FLORIS's empirical Gaussian (velocity, deflection, wake-induced mixing);
     GCH              FLORIS gauss with GCH's terms on;
     cc               FLORIS's cumulative-curl model (its own sums, gauss deflection);
@@ -62,7 +65,7 @@ import numba  # noqa: E402
 import numexpr  # noqa: E402
 from floris.utilities import load_yaml  # noqa: E402
 
-FLORIS_CONTENDERS = ("gauss", "M-1", "empirical_gauss", "GCH", "cc")
+FLORIS_CONTENDERS = ("gauss", "M-1", "M-1 summed", "empirical_gauss", "GCH", "cc")
 PYWAKE_CONTENDERS = ("PyWake 3x3", "PyWake centre")
 FOXES_CONTENDERS = ("foxes grid9", "foxes centre")
 #: FLORIS's own models other than gauss/GCH: model strings on the farm input.
@@ -79,19 +82,24 @@ WARM_UP_SIDE = 10
 
 def floris_model(name: str, directions, speeds, yaw):
     """A FlorisModel of one FLORIS contender, set for the conditions."""
-    if name not in OTHER_FLORIS:
+    if name not in OTHER_FLORIS and name != "M-1 summed":
         return bench_models.build(name, directions, speeds, yaw)
     side = int(round(np.sqrt(yaw.shape[1])))
     from floris import FlorisModel
 
-    config = bench_models.configuration("gauss", side)
-    config["wake"]["model_strings"].update(OTHER_FLORIS[name])
-    # FLORIS's default parameters of the models (the farm input holds gauss's).
-    defaults = FlorisModel.get_defaults()["wake"]
-    for block in ("wake_velocity_parameters", "wake_deflection_parameters",
-                  "wake_turbulence_parameters"):
-        for model, parameters in defaults[block].items():
-            config["wake"][block].setdefault(model, parameters)
+    if name == "M-1 summed":
+        config = bench_models.configuration("M-1", side)
+        config["wake"]["wake_velocity_parameters"]["ekman_veer"][
+            "wake_superposition"] = "combination_model"
+    else:
+        config = bench_models.configuration("gauss", side)
+        config["wake"]["model_strings"].update(OTHER_FLORIS[name])
+        # FLORIS's default parameters of the models (the farm input holds gauss's).
+        defaults = FlorisModel.get_defaults()["wake"]
+        for block in ("wake_velocity_parameters", "wake_deflection_parameters",
+                      "wake_turbulence_parameters"):
+            for model, parameters in defaults[block].items():
+                config["wake"][block].setdefault(model, parameters)
     fmodel = FlorisModel(config)
     fmodel.set(wind_directions=directions, wind_speeds=speeds,
                turbulence_intensities=np.full(len(directions), 0.06), yaw_angles=yaw)
