@@ -39,6 +39,10 @@ from __future__ import annotations
 
 import numpy as np
 
+#: Wakes more than sqrt(2 * OVERLAP_EXPONENT_LIMIT) combined widths apart share nothing in
+#: :func:`overlap_weight` (lambda < 1e-17): 0, not an exp that underflows (and a product that does).
+OVERLAP_EXPONENT_LIMIT = 40.0
+
 
 def gaussian_product_integral(sigma_squared_a, sigma_squared_b, distance_squared):
     """int g_a g_b dA over the cross-plane of two unit Gaussians exp(-r^2 / (2 sigma^2)) whose
@@ -67,11 +71,10 @@ def overlap_weight(sigma_squared_new, sigma_squared_old, distance_squared):
     """lambda_ni of Bastankhah et al. (2021, Eq. 4.9, the module docstring): the share of an
     upstream wake i's centre deficit that wake n's momentum balance meets."""
     total = sigma_squared_new + sigma_squared_old
-    # Wakes more than sqrt(2 * 40) combined widths apart share nothing (lambda < 1e-17): 0, not
-    # an exp that underflows (and a product that does).
     exponent = distance_squared / (2.0 * total)
-    return np.where(exponent < 40.0,
-                    2.0 * sigma_squared_old / total * np.exp(-np.minimum(exponent, 40.0)), 0.0)
+    return np.where(exponent < OVERLAP_EXPONENT_LIMIT,
+                    2.0 * sigma_squared_old / total
+                    * np.exp(-np.minimum(exponent, OVERLAP_EXPONENT_LIMIT)), 0.0)
 
 
 def cumulative_deficit(single_deficit, ambient_speed, incoming_speed, upstream, core_deficit):

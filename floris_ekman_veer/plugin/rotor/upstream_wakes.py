@@ -5,7 +5,7 @@ docs/coupling.md#wakes-deep-in-an-array), and its centre deficits C_n in one com
 A new wake n reaching rotor j takes C_n = a - sqrt(a^2 - K U_n^2), a = U_0 - sum_i lambda_ni C_i,
 over the wakes i that reached rotor j before it, at each of the kernel's sub-point rows (the
 veer-sheared centres differ with height). A rotor keeps only the wakes that reached it, so the
-store is sparse: an append-only pool of entries, one per (wake, rotor) reached, linked per rotor
+store is sparse: a pool of entries, one per (wake, rotor) reached, linked per rotor
 in the order of arrival (``head``/``tail``/``following``), each holding what varies per row, C_i
 at the rows, and once per entry what does not: sigma_i^2, the centre's height and the wake
 centre's lateral offset at FLORIS's n grid-point heights (the rows' centres are their linear
@@ -28,10 +28,7 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation
 from floris_ekman_veer.wake.fused import JIT
-
-#: Wakes whose centres are more than sqrt(2 * 40) combined widths apart share nothing
-#: (wake/superposition.py ``overlap_weight``: lambda is 0 there, not an exp that underflows).
-OVERLAP_EXPONENT_LIMIT = 40.0
+from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
 GROWTH = 1.25
@@ -51,26 +48,25 @@ def _row_centres(lateral, offsets, interpolation, centre):
         centre[r] = lateral + centre[r]
 
 
-#: exp(x) for -OVERLAP_EXPONENT_LIMIT <= x <= 0 as exp(x / 2^EXP_HALVINGS)^(2^EXP_HALVINGS), the
-#: inner exp by its Taylor polynomial (EXP_TAYLOR, truncation below 1e-19 on [-40 / 64, 0]):
-#: arithmetic only, so the compiled loop over the rows runs in SIMD lanes (math.exp is a scalar
-#: libm call that numba's loops cannot vectorise). Its relative error, within about
-#: 2^EXP_HALVINGS units in the last place (3e-14), is far below what the results are held to
-#: (1e-12, tests/plugin/rotor/test_upstream_wakes.py).
-EXP_HALVINGS = 6
-EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(18)])
+#: exp(x) for -OVERLAP_EXPONENT_LIMIT <= x <= 0 as exp(-m / EXP_STEPS) (a table, numpy's exp)
+#: times exp(y) on -1 / EXP_STEPS < y <= 0 by its Taylor polynomial (EXP_TAYLOR, truncation below
+#: 1e-18): arithmetic and a table look-up only, so that the compiled loop over the rows can run
+#: in SIMD lanes (math.exp is a scalar libm call). Within 2 units in the last place of numpy's exp
+#: (tests/plugin/rotor/test_upstream_wakes.py).
+EXP_STEPS = 8
+EXP_TABLE = np.exp(-np.arange(int(OVERLAP_EXPONENT_LIMIT) * EXP_STEPS + 2) / EXP_STEPS)
+EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(12)])
 
 
 @numba.njit(**JIT)
-def _overlap_exp(x):
-    """exp(x) on [-OVERLAP_EXPONENT_LIMIT, 0] (EXP_HALVINGS)."""
-    y = x * (1.0 / 2**EXP_HALVINGS)
+def overlap_exp(x):
+    """exp(x) on [-OVERLAP_EXPONENT_LIMIT, 0] (EXP_STEPS)."""
+    step = math.floor(-x * EXP_STEPS)
+    y = x + step * (1.0 / EXP_STEPS)
     value = EXP_TAYLOR[-1]
     for term in range(EXP_TAYLOR.size - 2, -1, -1):
         value = value * y + EXP_TAYLOR[term]
-    for _ in range(EXP_HALVINGS):
-        value = value * value
-    return value
+    return EXP_TABLE[int(step)] * value
 
 
 @numba.njit(**JIT)
@@ -81,7 +77,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     (k, rows): the upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their
     order of arrival (Bastankhah et al. 2021, Eq. 4.9), then Eq. 4.10 with the potential core's
     bound (wake/superposition.py ``overlap_weight``, ``cumulative_deficit``: the same operations
-    in the same order, exp to round-off, ``_overlap_exp``). An entry whose centre lies more than
+    in the same order, exp to round-off, ``overlap_exp``). An entry whose centre lies more than
     the overlap's limit away at every row adds nothing (lambda is 0 there) and is passed over
     from its gaps at the grid-point heights, of which the rows' are the interpolation."""
     rows = deficit.shape[1]
@@ -117,7 +113,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 for r in range(rows):
                     gap = old_centre[r] - new_centre[r]
                     exponent = (gap * gap + height_squared) / (2.0 * total)
-                    lam = share * _overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
+                    lam = share * overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
                     weight[r] = lam if exponent < OVERLAP_EXPONENT_LIMIT else 0.0
                 for r in range(rows):
                     upstream[r] += weight[r] * kept_deficit[entry, r]
