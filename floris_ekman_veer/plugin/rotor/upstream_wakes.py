@@ -33,6 +33,11 @@ from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
 GROWTH = 1.25
 
+#: A rotor's entries lie in blocks of this many consecutive entries (its first block holds its
+#: first BLOCK wakes, and so on), so that the sum over them reads the pool in runs, not entry by
+#: entry across it; a rotor's last block is part empty (on average BLOCK / 2 entries).
+BLOCK = 8
+
 
 @numba.njit(**JIT)
 def _row_centres(lateral, offsets, interpolation, centre):
@@ -71,7 +76,7 @@ def overlap_exp(x):
 
 @numba.njit(**JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
-                         incoming, core, interpolation, head, following, kept_deficit,
+                         incoming, core, interpolation, head, following, count, kept_deficit,
                          kept_width_squared, kept_lateral, kept_offsets, kept_height, deficit):
     """C_n [m/s] at every row of the new wakes (k, one per rotor ``rotor[k]``) into ``deficit``
     (k, rows): the upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their
@@ -93,31 +98,34 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
         upstream = deficit[k]
         for r in range(rows):
             upstream[r] = 0.0
-        entry = head[rotor[k]]
-        while entry >= 0:
-            old_width_squared = kept_width_squared[entry]
-            total = width_squared[k] + old_width_squared
-            height_squared = (kept_height[entry] - height[k]) ** 2
-            # The least gap over the rows: 0 where the gaps at the points change sign.
-            low, high = np.inf, -np.inf
-            for q in range(n):
-                gap = (kept_lateral[entry] + kept_offsets[entry, q]) - new_points[q]
-                low, high = min(low, gap), max(high, gap)
-            least = max(low, -high, 0.0)
-            # (a margin for the rows' round-off)
-            if (least * least + height_squared) / (2.0 * total) \
-                    <= (1.0 + 1e-9) * OVERLAP_EXPONENT_LIMIT:
-                share = 2.0 * old_width_squared / total
-                _row_centres(kept_lateral[entry], kept_offsets[entry], interpolation,
-                             old_centre)
-                for r in range(rows):
-                    gap = old_centre[r] - new_centre[r]
-                    exponent = (gap * gap + height_squared) / (2.0 * total)
-                    lam = share * overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
-                    weight[r] = lam if exponent < OVERLAP_EXPONENT_LIMIT else 0.0
-                for r in range(rows):
-                    upstream[r] += weight[r] * kept_deficit[entry, r]
-            entry = following[entry]
+        block = head[rotor[k]]
+        remaining = count[rotor[k]]
+        while block >= 0:
+            for entry in range(block * BLOCK, block * BLOCK + min(BLOCK, remaining)):
+                old_width_squared = kept_width_squared[entry]
+                total = width_squared[k] + old_width_squared
+                height_squared = (kept_height[entry] - height[k]) ** 2
+                # The least gap over the rows: 0 where the gaps at the points change sign.
+                low, high = np.inf, -np.inf
+                for q in range(n):
+                    gap = (kept_lateral[entry] + kept_offsets[entry, q]) - new_points[q]
+                    low, high = min(low, gap), max(high, gap)
+                least = max(low, -high, 0.0)
+                # (a margin for the rows' round-off)
+                if (least * least + height_squared) / (2.0 * total) \
+                        <= (1.0 + 1e-9) * OVERLAP_EXPONENT_LIMIT:
+                    share = 2.0 * old_width_squared / total
+                    _row_centres(kept_lateral[entry], kept_offsets[entry], interpolation,
+                                 old_centre)
+                    for r in range(rows):
+                        gap = old_centre[r] - new_centre[r]
+                        exponent = (gap * gap + height_squared) / (2.0 * total)
+                        lam = share * overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
+                        weight[r] = lam if exponent < OVERLAP_EXPONENT_LIMIT else 0.0
+                    for r in range(rows):
+                        upstream[r] += weight[r] * kept_deficit[entry, r]
+            remaining -= BLOCK
+            block = following[block]
         momentum = 1.0 - (1.0 - single[k]) ** 2
         for r in range(rows):
             a = ambient[k] - upstream[r]
@@ -130,34 +138,39 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
 def _keep(rotor, deficit, width_squared, lateral, offsets, height, head, tail, following,
           count, free, kept_deficit, kept_width_squared, kept_lateral, kept_offsets,
           kept_height):
-    """Append one entry per rotor ``rotor[k]`` (each once) at the end of its list, taken from
-    the free list ``free[0]`` or the unused end of the pool ``free[1]`` (the caller made room)."""
+    """Append one entry per rotor ``rotor[k]`` (each once) at the end of its list: in its last
+    block, or in a new one taken from the free list ``free[0]`` or the unused end of the pool
+    ``free[1]`` (the caller made room)."""
     for k in range(rotor.size):
-        entry = free[0]
-        if entry >= 0:
-            free[0] = following[entry]
-        else:
-            entry = free[1]
-            free[1] += 1
+        j = rotor[k]
+        slot = count[j] % BLOCK
+        if slot == 0:
+            block = free[0]
+            if block >= 0:
+                free[0] = following[block]
+            else:
+                block = free[1]
+                free[1] += 1
+            following[block] = -1
+            if tail[j] >= 0:
+                following[tail[j]] = block
+            else:
+                head[j] = block
+            tail[j] = block
+            free[3] += 1
+        entry = tail[j] * BLOCK + slot
         kept_deficit[entry] = deficit[k]
         kept_width_squared[entry] = width_squared[k]
         kept_lateral[entry] = lateral[k]
         kept_offsets[entry] = offsets[k]
         kept_height[entry] = height[k]
-        following[entry] = -1
-        j = rotor[k]
-        if tail[j] >= 0:
-            following[tail[j]] = entry
-        else:
-            head[j] = entry
-        tail[j] = entry
         count[j] += 1
     free[2] += rotor.size
 
 
 @numba.njit(**JIT)
 def _release(rotor, head, tail, following, count, free):
-    """Return the entries of rotors ``rotor`` to the free list (the rotors' lists emptied)."""
+    """Return the blocks of rotors ``rotor`` to the free list (the rotors' lists emptied)."""
     for j in rotor:
         if head[j] >= 0:
             following[tail[j]] = free[0]
@@ -165,17 +178,20 @@ def _release(rotor, head, tail, following, count, free):
             head[j] = -1
             tail[j] = -1
             free[2] -= count[j]
+            free[3] -= (count[j] + BLOCK - 1) // BLOCK
             count[j] = 0
 
 
 @attrs.define(eq=False)
 class UpstreamWakes:
-    """The pool of kept wakes (the module docstring), per rotor (flat index condition *
-    n_turbines + turbine): ``head``/``tail`` its first and last entry (-1: none), ``following``
-    the next entry of an entry's rotor (or of the free list), ``count`` its entries, ``free``
-    [first free entry (-1: none), first never-used entry, entries in use]; per entry its C_i at the rows [m/s]
-    (``deficit``, (capacity, rows)), sigma_i^2 [m^2], lateral position [m], offsets at the n
-    grid-point heights [m] ((capacity, n)) and centre height [m]; ``interpolation`` (n, rows)
+    """The pool of kept wakes (the module docstring) in blocks of BLOCK entries, per rotor (flat
+    index condition * n_turbines + turbine): ``head``/``tail`` its first and last block (-1:
+    none), ``count`` its entries (the first ``count`` of its blocks' slots, in order of
+    arrival); ``following`` the next block of a block's rotor (or of the free list); ``free``
+    [first free block (-1: none), first never-used block, entries in use, blocks in use]; per
+    entry (block * BLOCK + slot) its C_i at the rows [m/s] (``deficit``, (capacity, rows)),
+    sigma_i^2 [m^2], lateral position [m], offsets at the n grid-point heights [m]
+    ((capacity, n)) and centre height [m]; ``interpolation`` (n, rows)
     rotor_cells.row_interpolation."""
 
     head: np.ndarray
@@ -194,24 +210,29 @@ class UpstreamWakes:
     def start(cls, rotors: int, cells, capacity: int | None = None) -> UpstreamWakes:
         """An empty pool for ``rotors`` rotors on ``cells`` (RotorCells), room for ``capacity``
         entries (default: one per rotor; it grows as needed)."""
-        capacity = max(int(rotors if capacity is None else capacity), 1)
+        blocks = -(-max(int(rotors if capacity is None else capacity), 1) // BLOCK)
         interpolation = np.ascontiguousarray(row_interpolation(cells.n, cells.row_z))
         n, rows = interpolation.shape
+        entries = blocks * BLOCK
         empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
-        return cls(empty(), empty(), np.full(capacity, -1, dtype=np.int64),
-                   np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0], dtype=np.int64),
-                   np.zeros((capacity, rows)),
-                   np.zeros(capacity), np.zeros(capacity), np.zeros((capacity, n)),
-                   np.zeros(capacity), interpolation)
+        return cls(empty(), empty(), np.full(blocks, -1, dtype=np.int64),
+                   np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0, 0], dtype=np.int64),
+                   np.zeros((entries, rows)), np.zeros(entries), np.zeros(entries),
+                   np.zeros((entries, n)), np.zeros(entries), interpolation)
 
     @property
     def capacity(self) -> int:
-        return self.following.size
+        """Entries the pool holds."""
+        return self.following.size * BLOCK
 
     @property
     def in_use(self) -> int:
         """Entries kept at the rotors now."""
         return int(self.free[2])
+
+    @property
+    def blocks_in_use(self) -> int:
+        return int(self.free[3])
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
                  incoming, core) -> np.ndarray:
@@ -226,16 +247,17 @@ class UpstreamWakes:
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
-            self.following, self.deficit, self.width_squared, self.lateral, self.offsets,
-            self.height, deficit)
+            self.following, self.count, self.deficit, self.width_squared, self.lateral,
+            self.offsets, self.height, deficit)
         return deficit
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
         """Keep one new wake at each rotor of ``rotor`` (flat indices, each once): its C_n at
         the rows ((k, rows)), sigma_n^2, lateral position, offsets ((k, n)) and height."""
         rotor = np.ascontiguousarray(rotor, dtype=np.int64)
-        if rotor.size > self.capacity - self.in_use:
-            self._grow(self.in_use + rotor.size)
+        new_blocks = np.count_nonzero(self.count[rotor] % BLOCK == 0)
+        if self.blocks_in_use + new_blocks > self.following.size:
+            self._grow(self.blocks_in_use + new_blocks)
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), rotor.shape))
         _keep(rotor, np.ascontiguousarray(deficit, dtype=float), vector(width_squared),
@@ -249,10 +271,11 @@ class UpstreamWakes:
         _release(np.ascontiguousarray(rotor, dtype=np.int64), self.head, self.tail,
                  self.following, self.count, self.free)
 
-    def _grow(self, needed: int) -> None:
-        """Room for ``needed`` entries in use, in place (ndarray.resize: the pool's arrays are
+    def _grow(self, blocks: int) -> None:
+        """Room for ``blocks`` blocks in use, in place (ndarray.resize: the pool's arrays are
         referenced here only, and a reallocation keeps no second copy alive)."""
-        capacity = max(int(GROWTH * self.capacity), needed)
-        for name in ("deficit", "width_squared", "lateral", "offsets", "height", "following"):
+        blocks = max(int(GROWTH * self.following.size), blocks)
+        for name in ("deficit", "width_squared", "lateral", "offsets", "height"):
             table = getattr(self, name)
-            table.resize((capacity, *table.shape[1:]), refcheck=False)
+            table.resize((blocks * BLOCK, *table.shape[1:]), refcheck=False)
+        self.following.resize(blocks, refcheck=False)

@@ -15,7 +15,12 @@ from hypothesis import strategies as st
 
 from benchmarks import bench_models
 from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation, rotor_cells
-from floris_ekman_veer.plugin.rotor.upstream_wakes import UpstreamWakes, overlap_exp
+from floris_ekman_veer.plugin.rotor.upstream_wakes import (
+    BLOCK,
+    GROWTH,
+    UpstreamWakes,
+    overlap_exp,
+)
 from floris_ekman_veer.wake.superposition import (
     OVERLAP_EXPONENT_LIMIT,
     cumulative_deficit,
@@ -79,12 +84,13 @@ def _wakes(rng, rotor, diameter=126.0):
        steps=st.integers(1, 30))
 def test_store_matches_the_dense_reference(seed, rotors, steps):
     """Random arrivals (each step a random set of rotors, in random order, each once), random
-    releases, a pool that starts with room for one entry and grows: every step's C_n at every
-    row equals the dense reference's to 1e-12 relative; the entries in use are those the
-    reference holds, and freed ones are reused before the pool grows."""
+    releases, a pool that starts with room for one block and grows: every step's C_n at every
+    row equals the dense reference's to 1e-12 relative; the entries and blocks in use are those
+    the reference holds, and freed blocks are taken again before the pool grows."""
     rng = np.random.default_rng(seed)
     store = UpstreamWakes.start(rotors, CELLS, capacity=1)
     reference = DenseReference(rotors, CELLS)
+    most = 0
     for _ in range(steps):
         rotor = rng.permutation(rotors)[: rng.integers(1, rotors + 1)]
         wakes = _wakes(rng, rotor)
@@ -94,11 +100,14 @@ def test_store_matches_the_dense_reference(seed, rotors, steps):
         kept = rng.random(rotor.size) < 0.8  # the rotors the kernel reached
         keep_args = (rotor[kept], got[kept], *(w[kept] for w in wakes[:4]))
         reference.keep(*keep_args)
-        in_use, capacity = store.in_use, store.capacity
+        in_use = store.in_use
         store.keep(*keep_args)
         assert store.in_use == in_use + np.count_nonzero(kept)
-        if in_use + np.count_nonzero(kept) <= capacity:
-            assert store.capacity == capacity
+        blocks = sum(-(-len(k) // BLOCK) for k in reference.kept)
+        assert store.blocks_in_use == blocks
+        most = max(most, blocks)
+        # Freed blocks are taken again before the pool grows.
+        assert store.capacity <= BLOCK * max(GROWTH * most + 1, 1)
         released = rng.permutation(rotors)[: rng.integers(0, 3)]
         reference.release(released)
         store.release(released)
