@@ -31,7 +31,7 @@ from floris_ekman_veer.wake.fused import JIT
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
-GROWTH = 1.25
+GROWTH = 1.0625
 
 #: A rotor's entries lie in blocks of this many consecutive entries (its first block holds its
 #: first BLOCK wakes, and so on), so that the sum over them reads the pool in runs, not entry by
