@@ -230,12 +230,12 @@ def reached_rotor_cell_deficit(
     row_scale = None
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
-        # wakes kept at each rotor (plugin/rotor/upstream_wakes.py), at each of the kernel's
-        # sub-point rows: the veer-sheared centres differ with height, and FLORIS's other grids
-        # evaluate C_n point by point, so the kernel scales the model's shape row by row to C_n
-        # at the row's height; the wakes are summed. The centres at the rows: the deflection's
-        # at the grid's point heights, interpolated (rotor_cells.row_interpolation), for every
-        # wake.
+        # wakes kept at each rotor (plugin/rotor/upstream_wakes.py), evaluated where the
+        # deflection's centre is, at the grid's point heights (the veer-sheared centres differ
+        # with height), and interpolated to the kernel's sub-point rows as the centre is
+        # (rotor_cells.row_interpolation); the kernel scales the model's shape row by row to
+        # C_n at the row's height; the wakes are summed. FLORIS's other grids evaluate C_n
+        # point by point.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
         width_squared = (table[:, WAKE_TABLE.index("kx")]
@@ -243,13 +243,12 @@ def reached_rotor_cell_deficit(
         offsets = deflection_field_i[f, j, 0, :]
         lateral, height = y_i[f, 0, 0, 0], hub_height_i[f, 0, 0, 0]
         incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
-        deficit = wakes.convection.deficits(
+        deficit, row_scale = wakes.convection.deficits(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
             incoming_speed, model.core_deficit(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
-        row_scale = deficit
         if track and model.turbulence_overlap == "wake_radius":
-            pair[:, edge] = np.exp(-2.0) * deficit.mean(axis=1)
+            pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.

@@ -175,7 +175,7 @@ class RotorWakes:
             # by it alone, as input_checks.warn_deficit_superposition says.)
             if superposition == "momentum_conserving":
                 rule = "momentum_conserving"
-            # (the cumulative wake keeps its upstream wakes at each sub-point row of a rotor)
+            # (the cumulative wake keeps its upstream wakes at the grid-point heights of a rotor)
             convection = (UpstreamWakes.start(pairs, cells) if superposition == "cumulative"
                           else WakeConvection.start(pairs, n_turbines))
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'

@@ -3,19 +3,20 @@ et al. (2021) on the rotor cells (``wake_superposition: cumulative``, wake/super
 docs/coupling.md#wakes-deep-in-an-array), and its centre deficits C_n in one compiled pass.
 
 A new wake n reaching rotor j takes C_n = a - sqrt(a^2 - K U_n^2), a = U_0 - sum_i lambda_ni C_i,
-over the wakes i that reached rotor j before it, at each of the kernel's sub-point rows (the
-veer-sheared centres differ with height). A rotor keeps only the wakes that reached it, so the
-store is sparse: a pool of entries, one per (wake, rotor) reached, linked per rotor
-in the order of arrival (``head``/``tail``/``following``), each holding what varies per row, C_i
-at the rows, and once per entry what does not: sigma_i^2, the centre's height and the wake
-centre's lateral offset at FLORIS's n grid-point heights (the rows' centres are their linear
-interpolation, rotor_cells.row_interpolation, the same arithmetic as for the new wake). A rotor's
-entries are returned to the pool when it becomes the source of a wake: the solver steps the
-turbines downstream, so no later wake reaches it. The memory is that of the wakes kept at the
-rotors still ahead of the sweep, not turbines^2 x rows per condition; the work is that of the
-pairs of wakes that meet at a rotor. The sum runs over the kept wakes in their order of arrival,
-the order of wake/superposition.py's numpy form (the tests' reference), and the compiled
-arithmetic is that form's, so the deficits agree with it to round-off.
+over the wakes i that reached rotor j before it. C_n is evaluated where the deflection's centre
+is, at FLORIS's n grid-point heights of the rotor (the veer-sheared centres differ with height),
+and interpolated to the kernel's sub-point rows as the centre is (rotor_cells.row_interpolation):
+n sums per wake and rotor, not one per row (docs/coupling.md#wakes-deep-in-an-array). A rotor
+keeps only the wakes that reached it, so the store is sparse: a pool of entries, one per
+(wake, rotor) reached, linked per rotor in the order of arrival (``head``/``tail``/``following``),
+each holding C_i and the centre's lateral offset at the n grid-point heights, sigma_i^2, the
+centre's height and lateral position. A rotor's entries are returned to the pool when it becomes
+the source of a wake: the solver steps the turbines downstream, so no later wake reaches it. The
+memory is that of the wakes kept at the rotors still ahead of the sweep, not turbines^2 x rows
+per condition; the work is that of the pairs of wakes that meet at a rotor. The sum runs over
+the kept wakes in their order of arrival, the order of wake/superposition.py's numpy form (the
+tests' reference), and the compiled arithmetic is that form's, so the deficits agree with it to
+round-off.
 """
 
 from __future__ import annotations
@@ -40,23 +41,21 @@ BLOCK = 8
 
 
 @numba.njit(**JIT)
-def _row_centres(lateral, offsets, interpolation, centre):
-    """y at the rows of a wake's centre into ``centre``: its lateral position plus its offsets
-    at the n grid-point heights interpolated to the rows, summed over the points in order (as
-    numpy's sum over them)."""
-    for r in range(centre.size):
-        centre[r] = 0.0
-    for k in range(offsets.size):
-        for r in range(centre.size):
-            centre[r] += offsets[k] * interpolation[k, r]
-    for r in range(centre.size):
-        centre[r] = lateral + centre[r]
+def _to_rows(values, interpolation, rows):
+    """``values`` at the n grid-point heights interpolated to the rows into ``rows``
+    (rotor_cells.row_interpolation (n, rows)), summed over the points in order (as numpy's sum
+    over them): at a row on a point's height, that point's value exactly."""
+    for r in range(rows.size):
+        rows[r] = 0.0
+    for k in range(values.size):
+        for r in range(rows.size):
+            rows[r] += values[k] * interpolation[k, r]
 
 
 #: exp(x) for -OVERLAP_EXPONENT_LIMIT <= x <= 0 as exp(-m / EXP_STEPS) (a table, numpy's exp)
 #: times exp(y) on -1 / EXP_STEPS < y <= 0 by its Taylor polynomial (EXP_TAYLOR, truncation below
-#: 1e-18): arithmetic and a table look-up only, so that the compiled loop over the rows can run
-#: in SIMD lanes (math.exp is a scalar libm call). Within 2 units in the last place of numpy's exp
+#: 1e-18): arithmetic and a table look-up only (math.exp is a libm call, measured 2-4 x
+#: slower). Within 2 units in the last place of numpy's exp
 #: (tests/plugin/rotor/test_upstream_wakes.py).
 EXP_STEPS = 8
 EXP_TABLE = np.exp(-np.arange(int(OVERLAP_EXPONENT_LIMIT) * EXP_STEPS + 2) / EXP_STEPS)
@@ -77,27 +76,25 @@ def overlap_exp(x):
 @numba.njit(**JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, head, following, count, kept_deficit,
-                         kept_width_squared, kept_lateral, kept_offsets, kept_height, deficit):
-    """C_n [m/s] at every row of the new wakes (k, one per rotor ``rotor[k]``) into ``deficit``
-    (k, rows): the upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their
-    order of arrival (Bastankhah et al. 2021, Eq. 4.9), then Eq. 4.10 with the potential core's
-    bound (wake/superposition.py ``overlap_weight``, ``cumulative_deficit``: the same operations
-    in the same order, exp to round-off, ``overlap_exp``). An entry whose centre lies more than
-    the overlap's limit away at every row adds nothing (lambda is 0 there) and is passed over
-    from its gaps at the grid-point heights, of which the rows' are the interpolation."""
-    rows = deficit.shape[1]
-    n = interpolation.shape[0]
-    new_centre = np.empty(rows)
+                         kept_width_squared, kept_lateral, kept_offsets, kept_height, deficit,
+                         row_deficit):
+    """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the n grid-point heights
+    into ``deficit`` (k, n) and interpolated to the rows into ``row_deficit`` (k, rows): the
+    upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their order of
+    arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with the centres there, then
+    Eq. 4.10 with the potential core's bound (wake/superposition.py ``overlap_weight``,
+    ``cumulative_deficit``: the same operations in the same order, exp to round-off,
+    ``overlap_exp``), then the rows' values as the centre's, sum_q C_n(z_q) interpolation[q, r]
+    (rotor_cells.row_interpolation, summed over the points in order)."""
+    n = deficit.shape[1]
+    rows = row_deficit.shape[1]
     new_points = np.empty(n)
-    old_centre = np.empty(rows)
-    weight = np.empty(rows)
     for k in range(rotor.size):
-        _row_centres(lateral[k], offsets[k], interpolation, new_centre)
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
         upstream = deficit[k]
-        for r in range(rows):
-            upstream[r] = 0.0
+        for q in range(n):
+            upstream[q] = 0.0
         block = head[rotor[k]]
         remaining = count[rotor[k]]
         while block >= 0:
@@ -105,33 +102,21 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 old_width_squared = kept_width_squared[entry]
                 total = width_squared[k] + old_width_squared
                 height_squared = (kept_height[entry] - height[k]) ** 2
-                # The least gap over the rows: 0 where the gaps at the points change sign.
-                low, high = np.inf, -np.inf
+                share = 2.0 * old_width_squared / total
                 for q in range(n):
                     gap = (kept_lateral[entry] + kept_offsets[entry, q]) - new_points[q]
-                    low, high = min(low, gap), max(high, gap)
-                least = max(low, -high, 0.0)
-                # (a margin for the rows' round-off)
-                if (least * least + height_squared) / (2.0 * total) \
-                        <= (1.0 + 1e-9) * OVERLAP_EXPONENT_LIMIT:
-                    share = 2.0 * old_width_squared / total
-                    _row_centres(kept_lateral[entry], kept_offsets[entry], interpolation,
-                                 old_centre)
-                    for r in range(rows):
-                        gap = old_centre[r] - new_centre[r]
-                        exponent = (gap * gap + height_squared) / (2.0 * total)
-                        lam = share * overlap_exp(-min(exponent, OVERLAP_EXPONENT_LIMIT))
-                        weight[r] = lam if exponent < OVERLAP_EXPONENT_LIMIT else 0.0
-                    for r in range(rows):
-                        upstream[r] += weight[r] * kept_deficit[entry, r]
+                    exponent = (gap * gap + height_squared) / (2.0 * total)
+                    if exponent < OVERLAP_EXPONENT_LIMIT:
+                        upstream[q] += share * overlap_exp(-exponent) * kept_deficit[entry, q]
             remaining -= BLOCK
             block = following[block]
         momentum = 1.0 - (1.0 - single[k]) ** 2
-        for r in range(rows):
-            a = ambient[k] - upstream[r]
+        for q in range(n):
+            a = ambient[k] - upstream[q]
             root = a**2 - momentum * incoming[k] ** 2
             value = a - math.sqrt(max(root, 0.0))
-            upstream[r] = value if root > 0.0 and value <= core[k] else core[k]
+            upstream[q] = value if root > 0.0 and value <= core[k] else core[k]
+        _to_rows(upstream, interpolation, row_deficit[k])
 
 
 @numba.njit(**JIT)
@@ -189,7 +174,8 @@ class UpstreamWakes:
     none), ``count`` its entries (the first ``count`` of its blocks' slots, in order of
     arrival); ``following`` the next block of a block's rotor (or of the free list); ``free``
     [first free block (-1: none), first never-used block, entries in use, blocks in use]; per
-    entry (block * BLOCK + slot) its C_i at the rows [m/s] (``deficit``, (capacity, rows)),
+    entry (block * BLOCK + slot) its C_i at the n grid-point heights [m/s] (``deficit``,
+    (capacity, n)),
     sigma_i^2 [m^2], lateral position [m], offsets at the n grid-point heights [m]
     ((capacity, n)) and centre height [m]; ``interpolation`` (n, rows)
     rotor_cells.row_interpolation."""
@@ -212,12 +198,12 @@ class UpstreamWakes:
         entries (default: one per rotor; it grows as needed)."""
         blocks = -(-max(int(rotors if capacity is None else capacity), 1) // BLOCK)
         interpolation = np.ascontiguousarray(row_interpolation(cells.n, cells.row_z))
-        n, rows = interpolation.shape
+        n = interpolation.shape[0]
         entries = blocks * BLOCK
         empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
         return cls(empty(), empty(), np.full(blocks, -1, dtype=np.int64),
                    np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0, 0], dtype=np.int64),
-                   np.zeros((entries, rows)), np.zeros(entries), np.zeros(entries),
+                   np.zeros((entries, n)), np.zeros(entries), np.zeros(entries),
                    np.zeros((entries, n)), np.zeros(entries), interpolation)
 
     @property
@@ -235,25 +221,29 @@ class UpstreamWakes:
         return int(self.free[3])
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
-                 incoming, core) -> np.ndarray:
-        """(k, rows) C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices): their
-        sigma_n^2, lateral position and offsets at the grid-point heights ((k, n)), centre
-        height, the model's C(x) / U_h of the wake alone, U_0, U_n and the core bound 2a U_n
-        [m/s] (wake/superposition.py ``cumulative_deficit``; all (k,) but ``offsets``)."""
+                 incoming, core) -> tuple[np.ndarray, np.ndarray]:
+        """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the n grid-point
+        heights (k, n) and interpolated to the rows (k, rows): their sigma_n^2, lateral position
+        and offsets at the grid-point heights ((k, n)), centre height, the model's C(x) / U_h of
+        the wake alone, U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py
+        ``cumulative_deficit``; all (k,) but ``offsets``)."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), np.shape(rotor)))
-        deficit = np.empty((np.size(rotor), self.interpolation.shape[1]))
+        n, rows = self.interpolation.shape
+        deficit = np.empty((np.size(rotor), n))
+        row_deficit = np.empty((np.size(rotor), rows))
         _cumulative_deficits(
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
             self.following, self.count, self.deficit, self.width_squared, self.lateral,
-            self.offsets, self.height, deficit)
-        return deficit
+            self.offsets, self.height, deficit, row_deficit)
+        return deficit, row_deficit
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
         """Keep one new wake at each rotor of ``rotor`` (flat indices, each once): its C_n at
-        the rows ((k, rows)), sigma_n^2, lateral position, offsets ((k, n)) and height."""
+        the grid-point heights ((k, n)), sigma_n^2, lateral position, offsets ((k, n)) and
+        height."""
         rotor = np.ascontiguousarray(rotor, dtype=np.int64)
         new_blocks = np.count_nonzero(self.count[rotor] % BLOCK == 0)
         if self.blocks_in_use + new_blocks > self.following.size:
