@@ -75,20 +75,20 @@ def overlap_exp(x):
 
 @numba.njit(**JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
-                         incoming, core, interpolation, head, following, count, kept_deficit,
-                         kept_width_squared, kept_lateral, kept_offsets, kept_height, deficit,
+                         incoming, core, interpolation, head, following, count, kept, deficit,
                          row_deficit):
     """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the n grid-point heights
     into ``deficit`` (k, n) and interpolated to the rows into ``row_deficit`` (k, rows): the
-    upstream sum sum_i lambda_ni C_i over the kept entries of the rotor in their order of
-    arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with the centres there, then
-    Eq. 4.10 with the potential core's bound (wake/superposition.py ``overlap_weight``,
-    ``cumulative_deficit``: the same operations in the same order, exp to round-off,
-    ``overlap_exp``), then the rows' values as the centre's, sum_q C_n(z_q) interpolation[q, r]
-    (rotor_cells.row_interpolation, summed over the points in order)."""
+    upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
+    docstring) in their order of arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with
+    the centres there, then Eq. 4.10 with the potential core's bound (wake/superposition.py
+    ``overlap_weight``, ``cumulative_deficit``; exp to round-off, ``overlap_exp``), then the
+    rows' values as the centre's, sum_q C_n(z_q) interpolation[q, r] (rotor_cells.
+    row_interpolation, summed over the points in order). An entry whose overlap exponent is
+    beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no exp."""
     n = deficit.shape[1]
-    rows = row_deficit.shape[1]
     new_points = np.empty(n)
+    exponent = np.empty(n)
     for k in range(rotor.size):
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
@@ -99,15 +99,21 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
         remaining = count[rotor[k]]
         while block >= 0:
             for entry in range(block * BLOCK, block * BLOCK + min(BLOCK, remaining)):
-                old_width_squared = kept_width_squared[entry]
+                record = kept[entry]
+                old_width_squared = record[2 * n]
                 total = width_squared[k] + old_width_squared
-                height_squared = (kept_height[entry] - height[k]) ** 2
+                height_squared = (record[2 * n + 1] - height[k]) ** 2
+                least = np.inf
+                for q in range(n):
+                    gap = record[n + q] - new_points[q]
+                    exponent[q] = (gap * gap + height_squared) / (2.0 * total)
+                    least = min(least, exponent[q])
+                if least >= OVERLAP_EXPONENT_LIMIT:
+                    continue
                 share = 2.0 * old_width_squared / total
                 for q in range(n):
-                    gap = (kept_lateral[entry] + kept_offsets[entry, q]) - new_points[q]
-                    exponent = (gap * gap + height_squared) / (2.0 * total)
-                    if exponent < OVERLAP_EXPONENT_LIMIT:
-                        upstream[q] += share * overlap_exp(-exponent) * kept_deficit[entry, q]
+                    if exponent[q] < OVERLAP_EXPONENT_LIMIT:
+                        upstream[q] += share * overlap_exp(-exponent[q]) * record[q]
             remaining -= BLOCK
             block = following[block]
         momentum = 1.0 - (1.0 - single[k]) ** 2
@@ -121,11 +127,11 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
 
 @numba.njit(**JIT)
 def _keep(rotor, deficit, width_squared, lateral, offsets, height, head, tail, following,
-          count, free, kept_deficit, kept_width_squared, kept_lateral, kept_offsets,
-          kept_height):
+          count, free, kept):
     """Append one entry per rotor ``rotor[k]`` (each once) at the end of its list: in its last
     block, or in a new one taken from the free list ``free[0]`` or the unused end of the pool
     ``free[1]`` (the caller made room)."""
+    n = deficit.shape[1]
     for k in range(rotor.size):
         j = rotor[k]
         slot = count[j] % BLOCK
@@ -143,12 +149,12 @@ def _keep(rotor, deficit, width_squared, lateral, offsets, height, head, tail, f
                 head[j] = block
             tail[j] = block
             free[3] += 1
-        entry = tail[j] * BLOCK + slot
-        kept_deficit[entry] = deficit[k]
-        kept_width_squared[entry] = width_squared[k]
-        kept_lateral[entry] = lateral[k]
-        kept_offsets[entry] = offsets[k]
-        kept_height[entry] = height[k]
+        record = kept[tail[j] * BLOCK + slot]
+        for q in range(n):
+            record[q] = deficit[k, q]
+            record[n + q] = lateral[k] + offsets[k, q]
+        record[2 * n] = width_squared[k]
+        record[2 * n + 1] = height[k]
         count[j] += 1
     free[2] += rotor.size
 
@@ -174,10 +180,9 @@ class UpstreamWakes:
     none), ``count`` its entries (the first ``count`` of its blocks' slots, in order of
     arrival); ``following`` the next block of a block's rotor (or of the free list); ``free``
     [first free block (-1: none), first never-used block, entries in use, blocks in use]; per
-    entry (block * BLOCK + slot) its C_i at the n grid-point heights [m/s] (``deficit``,
-    (capacity, n)),
-    sigma_i^2 [m^2], lateral position [m], offsets at the n grid-point heights [m]
-    ((capacity, n)) and centre height [m]; ``interpolation`` (n, rows)
+    entry (block * BLOCK + slot) one record of ``kept`` (capacity, 2 n + 2), read together by
+    the sum: its C_i at the n grid-point heights [m/s], the centre's y there [m], sigma_i^2
+    [m^2] and the centre's height [m]; ``interpolation`` (n, rows)
     rotor_cells.row_interpolation."""
 
     head: np.ndarray
@@ -185,11 +190,7 @@ class UpstreamWakes:
     following: np.ndarray
     count: np.ndarray
     free: np.ndarray
-    deficit: np.ndarray
-    width_squared: np.ndarray
-    lateral: np.ndarray
-    offsets: np.ndarray
-    height: np.ndarray
+    kept: np.ndarray
     interpolation: np.ndarray
 
     @classmethod
@@ -203,8 +204,7 @@ class UpstreamWakes:
         empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
         return cls(empty(), empty(), np.full(blocks, -1, dtype=np.int64),
                    np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0, 0], dtype=np.int64),
-                   np.zeros((entries, n)), np.zeros(entries), np.zeros(entries),
-                   np.zeros((entries, n)), np.zeros(entries), interpolation)
+                   np.zeros((entries, 2 * n + 2)), interpolation)
 
     @property
     def capacity(self) -> int:
@@ -236,8 +236,7 @@ class UpstreamWakes:
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
-            self.following, self.count, self.deficit, self.width_squared, self.lateral,
-            self.offsets, self.height, deficit, row_deficit)
+            self.following, self.count, self.kept, deficit, row_deficit)
         return deficit, row_deficit
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
@@ -252,8 +251,7 @@ class UpstreamWakes:
             np.asarray(a, dtype=float), rotor.shape))
         _keep(rotor, np.ascontiguousarray(deficit, dtype=float), vector(width_squared),
               vector(lateral), np.ascontiguousarray(offsets, dtype=float), vector(height),
-              self.head, self.tail, self.following, self.count, self.free, self.deficit,
-              self.width_squared, self.lateral, self.offsets, self.height)
+              self.head, self.tail, self.following, self.count, self.free, self.kept)
 
     def release(self, rotor) -> None:
         """Free the entries kept at rotors ``rotor`` (flat indices): no later wake reaches a
@@ -262,10 +260,8 @@ class UpstreamWakes:
                  self.following, self.count, self.free)
 
     def _grow(self, blocks: int) -> None:
-        """Room for ``blocks`` blocks in use, in place (ndarray.resize: the pool's arrays are
+        """Room for ``blocks`` blocks in use, in place (ndarray.resize: the pool's table is
         referenced here only, and a reallocation keeps no second copy alive)."""
         blocks = max(int(GROWTH * self.following.size), blocks)
-        for name in ("deficit", "width_squared", "lateral", "offsets", "height"):
-            table = getattr(self, name)
-            table.resize((blocks * BLOCK, *table.shape[1:]), refcheck=False)
+        self.kept.resize((blocks * BLOCK, self.kept.shape[1]), refcheck=False)
         self.following.resize(blocks, refcheck=False)

@@ -188,7 +188,7 @@ def test_the_rows_take_c_n_exactly_at_the_grid_heights_and_linearly_between():
 
 
 def testoverlap_exp_is_numpys_to_round_off():
-    """The vectorisable exp on [-40, 0] within 2 units in the last place of numpy's."""
+    """The table exp on [-OVERLAP_EXPONENT_LIMIT, 0] within 2 units in the last place of numpy's."""
     x = np.concatenate([np.linspace(-OVERLAP_EXPONENT_LIMIT, 0.0, 20001),
                         -np.geomspace(1e-12, 1.0, 101)])
     got = np.array([overlap_exp(v) for v in x])
