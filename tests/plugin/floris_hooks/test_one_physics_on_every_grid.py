@@ -9,11 +9,13 @@ Measured (4 NREL 5 MW 5 D apart in SBL-4 at 11 m/s, wind along the row), cubatur
 grid in power (per turbine; farm) and points sampled over the rotors over the turbine velocities,
 before the states were handed: 0 / -0.8 / -17.3 / -29.0 %; -8.7 %, and 0 / 0.02 / -5.8 / -10.0 %;
 now: 0 / -0.8 / -0.5 / -0.6 %; -0.4 %, and 0 / 0.02 / 0.02 / 0.02 %.
-The cumulative wake (Bastankhah et al. 2021) evaluates its centre deficit C_n at the heights of
-the turbine grid's sub-point rows as the other grids do at their points (veer-sheared centres
-differ with height); with one rotor-mean C_n per wake and rotor, cubature over turbine grid was
-+2.75 % at turbine 3 of the zig-zag row, now +0.26 % (zig-zag -0.005 / -0.61 / +0.26 / -0.05 %,
-aligned -0.005 / -0.83 / -0.06 / +0.37 %).
+The cumulative wake (Bastankhah et al. 2021) evaluates its centre deficit C_n on the turbine
+grid where the deflection's centre is, at the grid's point heights, interpolated to the sub-point
+rows as the centre is, and the other grids at their points (veer-sheared centres differ with
+height); with one rotor-mean C_n per wake and rotor, cubature over turbine grid was +2.75 % at
+turbine 3 of the zig-zag row, +0.26 % with C_n at each of the 24 rows, now +0.23 % (zig-zag
+-0.005 / -0.61 / +0.23 / -0.26 %, aligned -0.005 / -0.83 / -0.26 / +0.007 %; at the rows:
+-0.005 / -0.61 / +0.26 / -0.05 % and -0.005 / -0.83 / -0.06 / +0.37 %).
 """
 
 from __future__ import annotations
