@@ -5,12 +5,13 @@ docs/coupling.md#wakes-deep-in-an-array), and its centre deficits C_n in one com
 A new wake n reaching rotor j takes C_n = a - sqrt(a^2 - K U_n^2), a = U_0 - sum_i lambda_ni C_i,
 over the wakes i that reached rotor j before it, at each of the kernel's sub-point rows (the
 veer-sheared centres differ with height). A rotor keeps only the wakes that reached it, so the
-store is sparse: a pool of entries, one per (wake, rotor) reached, linked per rotor
-in the order of arrival (``head``/``tail``/``following``), each holding what varies per row, C_i
-at the rows, and once per entry what does not: sigma_i^2, the centre's height and the wake
-centre's lateral offset at FLORIS's n grid-point heights (the rows' centres are their linear
-interpolation, rotor_cells.row_interpolation, the same arithmetic as for the new wake). A rotor's
-entries are returned to the pool when it becomes the source of a wake: the solver steps the
+store is sparse: a pool of entries, one per (wake, rotor) reached, in blocks of BLOCK
+consecutive entries linked per rotor in the order of arrival (``head``/``tail``/``following``),
+each entry holding what varies per row, C_i at the rows, and once what does not: sigma_i^2, the
+centre's height and the wake centre's lateral offset at FLORIS's n grid-point heights (the rows'
+centres are their linear interpolation, rotor_cells.row_interpolation, the same arithmetic as for
+the new wake). A rotor's
+blocks are returned to the pool when it becomes the source of a wake: the solver steps the
 turbines downstream, so no later wake reaches it. The memory is that of the wakes kept at the
 rotors still ahead of the sweep, not turbines^2 x rows per condition; the work is that of the
 pairs of wakes that meet at a rotor. The sum runs over the kept wakes in their order of arrival,
