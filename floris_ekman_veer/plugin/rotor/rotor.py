@@ -24,9 +24,12 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     integrate_wake,
     near_pairs,
 )
-from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
+from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY, crespo_hernandez_parameters
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
-from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
+from floris_ekman_veer.wake.added_turbulence import (
+    crespo_hernandez_overlap,
+    ishihara_qian_added_turbulence,
+)
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
 from floris_ekman_veer.wake.fused import WAKE_TABLE
 from floris_ekman_veer.wake.superposition import cumulative_deficit
@@ -296,10 +299,16 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     x_j, x_source = ambient.rotor.x[f, j], column(x_i)
     diameter = 2.0 * column(radius_i)
     ambient_turbulence = column(ambient.floris_turbulence)
-    added = wakes.turbulence_model.function(
-        ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
-    added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
-        x_j <= x_source + 15.0 * diameter)
+    parameters = crespo_hernandez_parameters(wakes.turbulence_model)
+    if parameters is not None:
+        # FLORIS's formula compiled, the same bits (wake/added_turbulence.py).
+        added = crespo_hernandez_overlap(ambient_turbulence, x_j[:, None], x_source, diameter,
+                                         column(axial_induction_i), overlap, parameters)[:, 0]
+    else:
+        added = wakes.turbulence_model.function(
+            ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
+        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0)
+    added = added * (x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
 
 

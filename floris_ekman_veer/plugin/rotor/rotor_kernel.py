@@ -24,13 +24,15 @@ import numpy as np
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
 from floris_ekman_veer.wake.fused import (
+    GAUSSIAN_SHAPE,
     JIT,
     WAKE_TABLE,
     centre_offset,
     centre_offset_bound,
     curl_polynomial,
     grown_centre_offset,
-    point_deficit,
+    point_exponent,
+    shaped_deficit,
     time_growth,
 )
 
@@ -70,6 +72,7 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
         (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
          ground_image) = per_condition[f]
         reach = 4.0 * radius
+        exponents = np.empty(sub_y.shape[1])
         area = 0.0
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
@@ -116,10 +119,22 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
+            # The row's exponents first, then its deficits, then the superposition in the
+            # sub-points' order: short loops the compiler vectorises (wake/fused.py
+            # point_exponent) or pipelines.
             for s in range(width[r]):
                 dy = lateral + radius_j * sub_y[r, s]
-                du = point_deficit(dy, dz, dy + polar_shift, amplitude, kx, xi0, sin2b,
-                                   q0, q1, q2, q3, q4, shape) * scale
+                exponents[s] = point_exponent(dy, dz, dy + polar_shift, kx, xi0, sin2b,
+                                              q0, q1, q2, q3, q4)
+            if shape == GAUSSIAN_SHAPE:  # (the branch out of the loop)
+                for s in range(width[r]):
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, GAUSSIAN_SHAPE)
+            else:
+                for s in range(width[r]):
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, shape)
+            for s in range(width[r]):
+                dy = lateral + radius_j * sub_y[r, s]
+                du = exponents[s] * scale
                 old = np.float64(combined[index, s]) if rule else 0.0
                 new = superposed(rule, old, du)
                 removed[k, cell[r, s]] += removed_moment(weight[r, s], ambient_u, old, new,
