@@ -51,7 +51,8 @@ def crespo_hernandez(ambient_turbulence, x, x_source, diameter, axial_induction,
 
 @numba.njit(**JIT)
 def _crespo_hernandez_overlap(ambient_turbulence, x, x_source, diameter, axial_induction,
-                              overlap, constant, ai, initial, downstream, out):
+                              overlap, y, y_source, lateral, constant, ai, initial, downstream,
+                              out):
     for p in range(x.shape[0]):
         for m in range(x.shape[1]):
             added = crespo_hernandez(ambient_turbulence[p], x[p, m], x_source[p], diameter[p],
@@ -61,22 +62,32 @@ def _crespo_hernandez_overlap(ambient_turbulence, x, x_source, diameter, axial_i
                 added = 0.0
             elif added == -np.inf:
                 added = -np.finfo(np.float64).max
-            out[p, m] = overlap[p] * added
+            # FLORIS's solver's factors, in its order (each 1 or 0).
+            added = overlap[p] * added * (1.0 if x[p, m] > x_source[p] else 0.0)
+            if lateral:
+                added = added * (1.0 if abs(y_source[p] - y[p, m]) < 2 * diameter[p] else 0.0)
+            out[p, m] = added * (1.0 if x[p, m] <= 15 * diameter[p] + x_source[p] else 0.0)
 
 
 def crespo_hernandez_overlap(ambient_turbulence, x, x_source, diameter, axial_induction,
-                             overlap, parameters):
-    """``overlap`` times :func:`crespo_hernandez` of wakes at points (NaN and +inf as 0, as
-    FLORIS's solver counts them): per wake and rotor (pairs,) the ambient turbulence, the
-    source's x, diameter and axial induction, and the rotor's overlap; ``x`` (pairs, points)
-    the rotor's points; ``parameters`` FLORIS's (constant, ai, initial, downstream). Returns
-    (pairs, points)."""
+                             overlap, parameters, y=None, y_source=None):
+    """The wake-added turbulence of wakes at points as FLORIS's sequential solver weights it:
+    ``overlap`` times :func:`crespo_hernandez` (NaN and +inf as 0), downstream of the source,
+    within 2 D of it laterally (with the points' ``y`` (pairs, points) and the sources'
+    ``y_source``) and within 15 D downstream; per wake and rotor (pairs,) the ambient
+    turbulence, the source's x, diameter and axial induction, and the rotor's overlap; ``x``
+    (pairs, points) the rotor's points; ``parameters`` FLORIS's (constant, ai, initial,
+    downstream). Returns (pairs, points)."""
     x = np.ascontiguousarray(x, dtype=float)
     out = np.empty(x.shape)
     per_pair = [np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (
         ambient_turbulence, x_source, diameter, axial_induction, overlap)]
-    _crespo_hernandez_overlap(per_pair[0], x, *per_pair[1:], *(float(v) for v in parameters),
-                              out)
+    lateral = y is not None
+    y = np.ascontiguousarray(y, dtype=float) if lateral else x
+    y_source = (np.ascontiguousarray(y_source, dtype=float).reshape(-1) if lateral
+                else per_pair[1])
+    _crespo_hernandez_overlap(per_pair[0], x, *per_pair[1:], y, y_source, lateral,
+                              *(float(v) for v in parameters), out)
     return out
 
 

@@ -356,14 +356,18 @@ def super_gaussian_order(centre_deficit, loading, width_squared):
 @numba.njit(**JIT)
 def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, near_wake,
                 polar_veer, out):
-    # The factors of the wake alone (its rotor's k_w, R, ct, yaw), evaluated again only where
-    # they change from one pair to the next (the pairs come wake by wake: one per condition).
-    kw = r = c_t = beta = np.nan
-    cos_b = sin_b = root = area = r_tube = induction = core = width0 = cos_cubed = np.nan
+    # The factors of the wake alone (its rotor's k_w, R, ct, yaw, U_h, u*), evaluated again only
+    # where they change from one pair to the next (the pairs come wake by wake: one per
+    # condition).
+    kw = r = c_t = beta = speed = u_star = np.nan
+    cos_b = root = induction = core = width0 = cos_cubed = np.nan
+    xi0 = sin2b = strength = bound0 = np.nan
     for k in range(x.size):
         xk = x[k]
-        if not (k_w[k] == kw and radius[k] == r and ct[k] == c_t and yaw[k] == beta):
+        if not (k_w[k] == kw and radius[k] == r and ct[k] == c_t and yaw[k] == beta
+                and hub_speed[k] == speed and friction_velocity[k] == u_star):
             kw, r, c_t, beta = k_w[k], radius[k], ct[k], yaw[k]
+            speed, u_star = hub_speed[k], friction_velocity[k]
             cos_b, sin_b = np.cos(beta), np.sin(beta)
             # Momentum theory of the yawed rotor, Eqs. (A_star), (ind_factor) (wake/deficit.py).
             root = np.sqrt(1.0 - c_t * (cos_b * cos_b))
@@ -375,6 +379,12 @@ def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, nea
                     + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * kw)
             width0 = WIDTH_FACTOR * r_tube
             cos_cubed = cos_b**3.0
+            xi0 = WIDTH_FACTOR * r_tube * abs(cos_b)
+            sin2b = sin_b**2
+            # t_hat's prefactor, Eq. (that) (0: no curl, xi_hat = 1).
+            strength = (-1.44 * (speed / u_star) / np.sqrt(area)
+                        * (c_t * (cos_b * cos_b) * sin_b)) if curl else 0.0
+            bound0 = WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)
         # C(x), Eq. (Cx).
         x_decay = max(xk, core)
         q = c_t * cos_cubed * r**2 / (2.0 * ((kw * x_decay + width0)
@@ -392,14 +402,12 @@ def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, nea
                 factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
         out[k, 0] = amplitude
         out[k, 1] = kw * xk * factor
-        out[k, 2] = WIDTH_FACTOR * r_tube * abs(cos_b) * factor
-        out[k, 3] = sin_b**2
-        # t_hat's prefactor, Eq. (that) (0: no curl, xi_hat = 1).
-        out[k, 4] = (-1.44 * (hub_speed[k] / friction_velocity[k]) / np.sqrt(area)
-                     * (c_t * (cos_b * cos_b) * sin_b)) if curl else 0.0
+        out[k, 2] = xi0 * factor
+        out[k, 3] = sin2b
+        out[k, 4] = strength
         out[k, 5] = polar_veer
         out[k, 6] = order
-        out[k, 7] = (kw * xk + WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)) * factor
+        out[k, 7] = (kw * xk + bound0) * factor
         out[k, 8] = amplitude
         out[k, 9] = amplitude
 

@@ -168,20 +168,22 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         x_source, diameter = per_pair(x_i), per_pair(rotor_diameter_i)
         ambient = ambient_turbulence_intensities[f, 0]
         if crespo_parameters is not None:
-            # FLORIS's Crespo-Hernandez compiled, the same bits (wake/added_turbulence.py).
-            weighted = crespo_hernandez_overlap(
+            # FLORIS's Crespo-Hernandez and the factors below compiled, the same bits
+            # (wake/added_turbulence.py).
+            ti_added = crespo_hernandez_overlap(
                 ambient, x.reshape(f.size, -1), x_source, diameter, per_pair(axial_induction_i),
-                area_overlap, crespo_parameters).reshape(x.shape)
+                area_overlap, crespo_parameters, grid.y_sorted[f, j].reshape(f.size, -1),
+                per_pair(y_i)).reshape(x.shape)
         else:
-            weighted = area_overlap * np.nan_to_num(model_manager.turbulence_model.function(
-                ambient, x, x_source, diameter, per_pair(axial_induction_i),
-            ), posinf=0.0)
-        ti_added = (
-            weighted
-            * (x > x_source)
-            * (np.abs(per_pair(y_i) - grid.y_sorted[f, j]) < 2 * diameter)
-            * (x <= 15 * diameter + x_source)
-        )
+            ti_added = (
+                area_overlap
+                * np.nan_to_num(model_manager.turbulence_model.function(
+                    ambient, x, x_source, diameter, per_pair(axial_induction_i),
+                ), posinf=0.0)
+                * (x > x_source)
+                * (np.abs(per_pair(y_i) - grid.y_sorted[f, j]) < 2 * diameter)
+                * (x <= 15 * diameter + x_source)
+            )
         turbine_turbulence_intensity[f, j] = np.maximum(
             np.sqrt(ti_added**2 + ambient**2), turbine_turbulence_intensity[f, j])
 

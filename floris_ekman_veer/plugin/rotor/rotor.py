@@ -24,7 +24,10 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     integrate_wake,
     near_pairs,
 )
-from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY, crespo_hernandez_parameters
+from floris_ekman_veer.plugin.rotor.rotor_wakes import (
+    WAKE_OVERLAP_VELOCITY,
+    crespo_hernandez_parameters,
+)
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
 from floris_ekman_veer.wake.added_turbulence import (
     crespo_hernandez_overlap,
@@ -271,9 +274,7 @@ def reached_rotor_cell_deficit(
             wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
-    _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
-                      centre[reached], rotor.radius[f[reached], j[reached]], cells,
-                      rotor.warned)
+    _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell, moment[reached][:, None])
@@ -301,14 +302,14 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     ambient_turbulence = column(ambient.floris_turbulence)
     parameters = crespo_hernandez_parameters(wakes.turbulence_model)
     if parameters is not None:
-        # FLORIS's formula compiled, the same bits (wake/added_turbulence.py).
+        # FLORIS's formula compiled, the same bits (wake/added_turbulence.py; x_j > x_source).
         added = crespo_hernandez_overlap(ambient_turbulence, x_j[:, None], x_source, diameter,
                                          column(axial_induction_i), overlap, parameters)[:, 0]
     else:
         added = wakes.turbulence_model.function(
             ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
-        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0)
-    added = added * (x_j <= x_source + 15.0 * diameter)
+        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
+            x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
 
 
@@ -385,13 +386,19 @@ def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
     return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 
-def _check_resolution(x, source_wake, centre, radius_j, cells, warned):
-    """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
+def _check_resolution(x, f, j, reached, source_wake, centre, rotor):
+    """Warn once per run when a wake band is thinner than the cells' sub-row spacing: at the
+    rotors (f, j)[reached], x behind the wake's rotor, the wake's quantities per condition
+    ``source_wake`` and its ``centre`` at the rows (pairs, rows)."""
+    warned, cells = rotor.warned, rotor.cells
     if "rows" in warned:
         return
     k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
-    width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
-        stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
+    # The wake's width k_w x + 0.4 R sqrt(A*) cos(yaw): its second term once per condition.
+    initial_width = WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
+    f, j, centre = f[reached], j[reached], centre[reached]
+    width = k_w[f] * x[reached] + initial_width[f]
+    radius_j = rotor.radius[f, j]
     height = radius_j * (cells.row_z[-1] - cells.row_z[0])
     shear = np.abs(centre[:, -1] - centre[:, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)
