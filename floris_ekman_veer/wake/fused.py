@@ -293,6 +293,11 @@ def deficit_on_rows(dy, dz, parameters):
 WAKE_TABLE = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape",
               "width_bound", "amplitude_bound", "centre_deficit")
 
+#: The ``shape`` of a near-wake pair whose order :func:`wake_table` left for later
+#: (``bound_only``): its ``width_bound`` holds for every order (the rotor's reach is bounded
+#: before the order's root is solved; the rotors kept get their exact table).
+DEFERRED_ORDER = 0.0
+
 
 @numba.njit(**JIT)
 def _digamma(x):
@@ -355,7 +360,7 @@ def super_gaussian_order(centre_deficit, loading, width_squared):
 
 @numba.njit(**JIT)
 def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, near_wake,
-                polar_veer, out):
+                polar_veer, bound_only, out):
     # The factors of the wake alone (its rotor's k_w, R, ct, yaw, U_h, u*), evaluated again only
     # where they change from one pair to the next (the pairs come wake by wake: one per
     # condition).
@@ -397,9 +402,16 @@ def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, nea
         if near_wake and x_wake < core:
             width_squared = ((kw * x_wake + width0) * (kw * x_wake + width0 * cos_b)
                              / (2.0 * r) ** 2)
-            order = super_gaussian_order(2.0 * induction, c_t * cos_cubed, width_squared)
-            if order != GAUSSIAN_ORDER:
-                factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
+            if bound_only:
+                # m = (2 w^2)^(1/n - 1/2) with n >= 2 is at most 1 / sqrt(2 w^2) below
+                # 2 w^2 = 1, at most 1 above (widened by the round-off).
+                order = DEFERRED_ORDER
+                factor = (1.0 + 1e-12) * (1.0 / np.sqrt(2.0 * width_squared)
+                                          if 2.0 * width_squared < 1.0 else 1.0)
+            else:
+                order = super_gaussian_order(2.0 * induction, c_t * cos_cubed, width_squared)
+                if order != GAUSSIAN_ORDER:
+                    factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
         out[k, 0] = amplitude
         out[k, 1] = kw * xk * factor
         out[k, 2] = xi0 * factor
@@ -413,7 +425,7 @@ def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, nea
 
 
 def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
-               near_wake=True, polar_veer=0.0):
+               near_wake=True, polar_veer=0.0, bound_only=False):
     """The per-wake factors of Eq. (du_model) for the rotor-cell kernel and the wake's reach,
     (pairs, :data:`WAKE_TABLE`), compiled, one row per wake and rotor: the same numbers as
     :func:`wake_deficit_parameters` with wake/near_wake.py's ``near_wake_shape`` (with
@@ -421,9 +433,12 @@ def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
     0.4 R sqrt(A*) (1 + alpha), times the near wake's width factor; ``amplitude_bound`` and
     ``centre_deficit``: C(x)), in one pass (tests/physics/test_near_wake.py compares them).
     Arguments: 1-D arrays of the pairs (``x`` > 0 the distance behind the rotor; the
-    thrust coefficient ``ct`` within momentum theory, as the velocity model limits it)."""
+    thrust coefficient ``ct`` within momentum theory, as the velocity model limits it).
+    ``bound_only``: a near-wake pair's order is not solved (``shape`` DEFERRED_ORDER) and its
+    ``width_bound`` is the bound over every order: the table to choose the rotors a wake
+    reaches by, cheaply, before their exact table."""
     arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), np.shape(x)))
               for a in (x, k_w, radius, ct, yaw, friction_velocity, hub_speed)]
     out = np.empty((arrays[0].size, len(WAKE_TABLE)))
-    _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), out)
+    _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), bool(bound_only), out)
     return out

@@ -34,7 +34,7 @@ from floris_ekman_veer.wake.added_turbulence import (
     ishihara_qian_added_turbulence,
 )
 from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
-from floris_ekman_veer.wake.fused import WAKE_TABLE
+from floris_ekman_veer.wake.fused import DEFERRED_ORDER, WAKE_TABLE
 from floris_ekman_veer.wake.superposition import cumulative_deficit
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
@@ -183,7 +183,9 @@ def reached_rotor_cell_deficit(
     x_pair = dx[f, j]
     # The velocity model's table (plugin/rotor/rotor_kernel.py): the deficit's factors that
     # depend on the wake only, its width and amplitude bounds and its centre deficit.
-    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+    # (Where a near wake's order is costly, first a bound of its width: the rotors kept below
+    # get their exact table.)
+    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()), bound_only=True)
     centre_table = getattr(deflection_field_i, "kernel_table", None)
     # The rotors the wake reaches, with the deficit C(x) exp(-gap^2 / (2 sigma^2)) below
     # NEGLIGIBLE_DEFICIT beyond gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT) (sigma the widest
@@ -200,10 +202,14 @@ def reached_rotor_cell_deficit(
         # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
         # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
         edge_factor = np.exp(-2.0)
-    near, pair = near_pairs(
-        f, j, x_pair, table, points, rotor, column(y_i), column(hub_height_i),
-        NEGLIGIBLE_DEFICIT, WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"],
-        speed_fraction)
+    reach = (points, rotor, column(y_i), column(hub_height_i), NEGLIGIBLE_DEFICIT,
+             WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"], speed_fraction)
+    near, pair = near_pairs(f, j, x_pair, table, *reach)
+    if np.any(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER):
+        # The exact table of the rotors the bound kept, and those it reaches (a subset).
+        f, j, x_pair = f[near], j[near], x_pair[near]
+        table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+        near, pair = near_pairs(f, j, x_pair, table, *reach)
     if near.size == 0:
         return result.reshape(u_initial.shape), _NONE
     f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
