@@ -186,6 +186,15 @@ def _centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radi
                     radius[f], friction_velocity[f], veer, ground_image)
 
 
+def _contiguous(value, shape) -> np.ndarray:
+    """``value`` as a contiguous float array of ``shape`` (broadcast; as it is if it already
+    is one)."""
+    value = np.asarray(value, dtype=float)
+    if value.shape != shape:
+        value = np.broadcast_to(value, shape)
+    return np.ascontiguousarray(value)
+
+
 def centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radius,
                   friction_velocity, veer=True, ground_image=True):
     """:func:`centre_offset` of one wake at the points of every rotor downstream of it (0
@@ -195,9 +204,8 @@ def centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radiu
     ``sin_a``); the wake's factors per condition (n_findex,). Returns (n_findex, n_turbines,
     heights)."""
     arrays = [np.ascontiguousarray(a, dtype=float) for a in (dx, z, u, v)]
-    per_condition = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), dx.shape[:1]))
-                     for a in (cos_a, sin_a, strength, r_tube, hub_height, radius,
-                               friction_velocity)]
+    per_condition = [_contiguous(a, dx.shape[:1]) for a in (
+        cos_a, sin_a, strength, r_tube, hub_height, radius, friction_velocity)]
     points = np.zeros(arrays[1].shape)
     _centre_points(*arrays, *per_condition, float(veer), float(ground_image), points)
     return points
@@ -437,7 +445,7 @@ def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
     ``bound_only``: a near-wake pair's order is not solved (``shape`` DEFERRED_ORDER) and its
     ``width_bound`` is the bound over every order: the table to choose the rotors a wake
     reaches by, cheaply, before their exact table."""
-    arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), np.shape(x)))
+    arrays = [_contiguous(a, np.shape(x))
               for a in (x, k_w, radius, ct, yaw, friction_velocity, hub_speed)]
     out = np.empty((arrays[0].size, len(WAKE_TABLE)))
     _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), bool(bound_only), out)

@@ -43,7 +43,7 @@ from floris_ekman_veer.plugin.floris_hooks import patching
 from floris_ekman_veer.plugin.inflow import inflow
 from floris_ekman_veer.plugin.inflow.ambient import is_rotor_grid
 from floris_ekman_veer.plugin.rotor import turbine_states
-from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE
+from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE, condition_column
 from floris_ekman_veer.plugin.rotor.rotor_wakes import crespo_hernandez_parameters
 from floris_ekman_veer.plugin.wake_models.models import EkmanWakeModel
 from floris_ekman_veer.wake.added_turbulence import crespo_hernandez_overlap
@@ -164,7 +164,7 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
             continue
         f, j, area_overlap = f[hit], j[hit], area_overlap[hit, None, None]
         x = grid.x_sorted[f, j]
-        per_pair = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0]  # noqa: E731
+        per_pair = lambda a: condition_column(a, n_findex)[f, None, None]  # noqa: E731
         x_source, diameter = per_pair(x_i), per_pair(rotor_diameter_i)
         ambient = ambient_turbulence_intensities[f, 0]
         if crespo_parameters is not None:

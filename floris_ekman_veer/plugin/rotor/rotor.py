@@ -108,6 +108,14 @@ def rotor_cell_deficit(
     return result
 
 
+def condition_column(value, n_findex) -> np.ndarray:
+    """(n_findex,) of a per-condition value FLORIS hands as (n_findex, 1, 1, 1) (a view), or
+    of a scalar (broadcast)."""
+    if np.shape(value) == (n_findex, 1, 1, 1):
+        return np.asarray(value)[:, 0, 0, 0]
+    return np.broadcast_to(value, (n_findex, 1, 1, 1))[:, 0, 0, 0]
+
+
 #: No rotor reached: (f, j) empty.
 _NONE = (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp))
 
@@ -176,7 +184,7 @@ def reached_rotor_cell_deficit(
     k_w = model.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                               ambient.floris_turbulence)
     # Turbine i's quantities, one per condition; the wake's factors per rotor downstream.
-    column = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[:, 0, 0, 0]  # noqa: E731
+    column = lambda a: condition_column(a, n_findex)  # noqa: E731
     source_wake = {"k_w": k_w, "radius": radius_i, "ct": ct, "yaw": yaw,
                    "friction_velocity": abl.friction_velocity, "hub_speed": hub_speed}
     source_wake = {k: column(v) for k, v in source_wake.items()}
@@ -302,7 +310,7 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
     the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it,
     combined by ``rule`` (RotorWakes.add_turbulence)."""
-    column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+    column = lambda a: condition_column(a, x_i.shape[0])[f]  # noqa: E731
     x_j, x_source = ambient.rotor.x[f, j], column(x_i)
     diameter = 2.0 * column(radius_i)
     ambient_turbulence = column(ambient.floris_turbulence)
