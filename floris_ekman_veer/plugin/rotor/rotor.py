@@ -273,9 +273,12 @@ def reached_rotor_cell_deficit(
         wake_convection = pair[:, scale] - 0.5 * centre_speed
         pair[:, scale] = pair[:, scale] * wake_convection
         pair[:, edge] = pair[:, edge] * wake_convection
+    # (The momentum-conserving superposition and Ishihara & Qian's turbulence read the
+    # wake's centre at every row of the rotors reached.)
+    ishihara_qian = track and model.wake_turbulence == "ishihara_qian"
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
-        kind, rotor, wakes, track)
+        kind, rotor, wakes, track, every_row=convecting or ishihara_qian)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE
@@ -292,7 +295,7 @@ def reached_rotor_cell_deficit(
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell, moment[reached][:, None])
-    if track and model.wake_turbulence == "ishihara_qian":
+    if ishihara_qian:
         added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
                                rotor, f[reached], j[reached], kind[reached],
                                hub_height_i[f[reached], 0, 0, 0],

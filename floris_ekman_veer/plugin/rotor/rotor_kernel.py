@@ -61,9 +61,9 @@ _LAUNCH = threading.Lock()
 
 
 @numba.njit(parallel=True, **JIT)
-def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kind, kind_u,
-               kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
-               block, track, removed, overlap, reached):
+def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
+               kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
+               combined, block, track, removed, overlap, reached):
     for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
         strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
@@ -76,7 +76,8 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
         area = 0.0
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
-        # plugin/rotor/rotor.py; the others are not used).
+        # plugin/rotor/rotor.py), or at every row where the caller reads them all
+        # (``every_row``: the bound is not used).
         skipped_first = skipped_last = False
         for r in range(row_chord.size):
             dz = kind_heights[kk, r] - hub_height
@@ -95,7 +96,7 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
                         x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
                         image_height, radius, u_star, veer, ground_image)
                     nearest = max(abs(offset - drift) - bound - radius_j * row_chord[r], 0.0)
-                    if not nearest * nearest + dz * dz < reach_squared:
+                    if not (every_row or nearest * nearest + dz * dz < reach_squared):
                         skipped_first |= r == 0
                         skipped_last |= r == row_chord.size - 1
                         continue
@@ -214,7 +215,8 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     return keep[:count], pair[:count]
 
 
-def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track):
+def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
+                   every_row=False):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -227,7 +229,9 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
-    updated in place.
+    updated in place. The centre the kernel evaluates is exact at every row of the rotors
+    reached with ``every_row``; without, at their first and last rows and those it reaches (0
+    at the rows a bound of the centre put out of reach).
     """
     cells = wakes.cells
     n_pairs = flat.size
@@ -238,7 +242,7 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     with _LAUNCH:
         _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(per_condition), compute_centre, centre,
+                   np.ascontiguousarray(per_condition), compute_centre, bool(every_row), centre,
                    flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
                    rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
                    cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,
