@@ -213,14 +213,13 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
     original = rotor_module.integrate_wake
     checked = []
 
-    def checking(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                 every_row=False):
+    def checking(*arguments, every_row=False):
+        wake, pair, per_condition, centre, flat, kind, rotor, wakes = arguments[:8]
         assert every_row and centre is None
         combined = wakes.combined.copy()
-        bounded = original(wake, pair, per_condition, None, flat, kind, rotor, wakes, track)
+        bounded = original(*arguments)
         wakes.combined[...] = combined
-        result = original(wake, pair, per_condition, None, flat, kind, rotor, wakes, track,
-                          every_row=True)
+        result = original(*arguments, every_row=True)
         for a, b in zip(bounded[:3], result[:3], strict=True):
             np.testing.assert_array_equal(a, b)
         reached = result[2]
