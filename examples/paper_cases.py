@@ -424,14 +424,17 @@ def report(written, start: float) -> None:
     print(f"Done in {time.perf_counter() - start:.1f} s")
 
 
-def arguments(doc: str, argv=None, gallery: bool = True) -> argparse.Namespace:
-    """The examples' command line: --output DIR (created) and, for some, --gallery DIR."""
+def arguments(doc: str, argv=None, gallery: bool = True, flags=()) -> argparse.Namespace:
+    """The examples' command line: --output DIR (created) and, for some, --gallery DIR; each
+    of ``flags``, (name, help) pairs, an on/off option of the script."""
     parser = argparse.ArgumentParser(description=doc.split("\n")[0])
     parser.add_argument("--output", type=Path, default=Path("output"),
                         help="directory for the figures (default ./output)")
     if gallery:
         parser.add_argument("--gallery", type=Path, default=None,
                             help="also write the README gallery's small PNGs to this directory")
+    for name, text in flags:
+        parser.add_argument(name, action="store_true", help=text)
     args = parser.parse_args(argv)
     args.output.mkdir(parents=True, exist_ok=True)
     if gallery and args.gallery is not None:

@@ -1,6 +1,6 @@
 """Validation against measured wakes and farms: the package's and FLORIS's models side by side.
 
-    python examples/validate.py [--output DIR] [--gallery DIR]
+    python examples/validate.py [--output DIR] [--gallery DIR] [--site-measured-turbulence]
 
 Runs every case of ``floris_ekman_veer.studies.validation`` (six single wakes, Horns Rev 1 and
 Lillgrund's rows B and D, data shipped in floris_ekman_veer/studies/validation/data/, DTU PyWake's
@@ -8,7 +8,10 @@ validation data, MIT licence) through its public API with the paper's M-1 (and t
 couplings of it for comparison), M-2, M-3 and FLORIS's gauss, GCH, cc, TurbOPark-Gauss and
 empirical Gauss on the same Ekman inflow, for two atmospheres per case: the paper's pure ABL
 with the site's roughness ("site") and the neutral ABL whose I_u(z_h) is the measured turbulence
-intensity ("matched", docs/validation.md#the-atmosphere-of-a-case). A farm's rows are averaged
+intensity ("matched", docs/validation.md#the-atmosphere-of-a-case); with
+``--site-measured-turbulence`` also a third reading, the site's roughness with the measured
+turbulence in the wake as ``fit_site`` gives it (the atmosphere block's ``turbulence_factor``),
+whose tables follow the two others'. A farm's rows are averaged
 over the measured direction bin (+-3 deg) and, in the "averaged" columns, over the
 wind-direction uncertainty with FLORIS's UncertainFlorisModel (Horns Rev: per-turbine sigma of
 van der Laan et al.; Lillgrund: 3.3 deg).
@@ -40,6 +43,7 @@ from paper_cases import arguments, report  # noqa: E402
 
 from floris_ekman_veer.studies.validation.atmospheres import (  # noqa: E402
     ATMOSPHERES,
+    SITE_MEASURED_TURBULENCE,
     atmosphere,
     hub_turbulence,
     wake_scales,
@@ -216,37 +220,38 @@ def efficiency_table(effs):
     return markdown(["model"] + readings, table)
 
 
-def atmosphere_table():
+def atmosphere_table(readings=ATMOSPHERES):
     """Per case: the measured I_u, and for each atmosphere z0, I_u(z_h), k_w and x0/D."""
     rows = []
     for case in list(SINGLE_WAKE_CASES.values()) + list(FARM_CASES.values()):
         ct = case.thrust_coefficient  # a farm's: its turbine's at the case's wind speed
         row = [case.name, f"{case.streamwise_turbulence:.3f}"]
-        for reading in ATMOSPHERES:
-            z0 = atmosphere(case, reading)["roughness_length"]
-            k_w, x0 = wake_scales(case, z0, ct)
-            row += [f"{z0:.3g}", f"{hub_turbulence(case, z0):.3f}", f"{k_w:.4f}", f"{x0:.2f}"]
+        for reading in readings:
+            block = atmosphere(case, reading)
+            k_w, x0 = wake_scales(case, block, ct)
+            row += [f"{block['roughness_length']:.3g}", f"{hub_turbulence(case, block):.3f}",
+                    f"{k_w:.4f}", f"{x0:.2f}"]
         rows.append(row)
     header = ["case", "measured I_u(z_h)"]
-    for reading in ATMOSPHERES:
+    for reading in readings:
         header += [f"{reading} z0 [m]", f"{reading} I_u(z_h)", f"{reading} k_w", f"{reading} x0/D"]
     return markdown(header, rows)
 
 
-def tables(errors, rows, effs) -> str:
+def tables(errors, rows, effs, readings=ATMOSPHERES) -> str:
     parts = ["# Validation tables (examples/validate.py)", "",
-             "## Atmospheres", "", atmosphere_table(), ""]
-    for reading in ATMOSPHERES:
+             "## Atmospheres", "", atmosphere_table(readings), ""]
+    for reading in readings:
         for reference in ("measured", "les"):
             parts += [f"## Single wakes, {reading} atmosphere, against the {LABEL[reference]} arcs: "
                       "RMSE (bias) of U/U0", "", case_table(errors, reading, reference), ""]
-    for reading in ATMOSPHERES:
+    for reading in readings:
         parts += [f"## Single wakes by downstream distance, {reading} atmosphere", "",
                   distance_table(errors, reading), ""]
     for case in dict.fromkeys(rows["case"]):
         parts += [f"## {case}, P_i/P_1 over the waked positions: RMSE (bias)", "",
                   rows_error_table(rows, case), ""]
-        for reading in ATMOSPHERES:
+        for reading in readings:
             parts += [f"## {case} by position, {reading} atmosphere, direction-averaged", "",
                       rows_table(rows, case, reading), ""]
     parts += ["## Horns Rev 1 farm efficiency against the LES: RMSE (bias)", "",
@@ -375,13 +380,16 @@ def efficiency_figure(effs, output, dpi=100):
 
 
 def main(argv=None) -> None:
-    args = arguments(__doc__, argv)
+    args = arguments(__doc__, argv, flags=[(
+        "--site-measured-turbulence", "also the site's roughness with the measured turbulence "
+        "in the wake (the atmosphere block's turbulence_factor, as fit_site sets it)")])
+    readings = ATMOSPHERES + ((SITE_MEASURED_TURBULENCE,) if args.site_measured_turbulence else ())
     start = time.perf_counter()
-    profiles = single_wakes()
+    profiles = single_wakes(readings=readings)
     errors = single_wake_errors(profiles)
-    rows = farm_rows()
-    effs = efficiency()
-    text = tables(errors, rows, effs)
+    rows = farm_rows(readings=readings)
+    effs = efficiency(readings=readings)
+    text = tables(errors, rows, effs, readings)
     print(text)
     (args.output / "validation_tables.md").write_text(text + "\n")
     rows.to_csv(args.output / "validation_rows.csv", index=False)

@@ -121,6 +121,61 @@ def test_every_model_sees_the_atmospheres_turbulence():
         models.floris_input(case, "site", "jensen")
 
 
+@pytest.mark.parametrize("name", ["NREL-5MW_TIhigh", "Lillgrund"])
+def test_site_measured_turbulence_reading_is_the_site_workflow(name):
+    """The option "site_measured_turbulence" is what fit_site gives a user with the site's data
+    (docs/validation.md#the-atmosphere-of-a-case): the site's roughness, and the block's
+    turbulence_factor = measured I_u(z_h) / the site ABL's I_u(z_h) (1.80 for the high-TI LES on
+    farmland, 0.85 at Lillgrund). The M-1 wake's ambient I_u(z_h), as FLORIS solves the block,
+    is the measured one, its k_w Eq. (kw_CNBL_SBL_model) of it by hand, FLORIS's built-ins get
+    the same TI; the rotor's U(z), V(z) are the site roughness's, not the matched reading's;
+    validity_report flags the factor as beyond the paper."""
+    from floris_ekman_veer.plugin.inflow.atmosphere_block import atmosphere_of
+    from floris_ekman_veer.plugin.inflow.solve_cache import solve
+    from floris_ekman_veer.studies.validity import validity_report
+
+    case = {**cases.SINGLE_WAKE_CASES, **cases.FARM_CASES}[name]
+    reading = atmospheres.SITE_MEASURED_TURBULENCE
+    block, site = atmospheres.atmosphere(case, reading), atmospheres.atmosphere(case, "site")
+    measured = case.streamwise_turbulence
+    assert block["roughness_length"] == site["roughness_length"] == case.site_roughness
+    assert block["turbulence_factor"] == pytest.approx(
+        measured / atmospheres.hub_turbulence(case, site), rel=1e-12)
+    assert block["turbulence_factor"] == pytest.approx(
+        {"NREL-5MW_TIhigh": 1.80, "Lillgrund": 0.85}[name], abs=0.005)
+
+    fmodel = models.build_model(case, reading, "M-1")
+    speeds = np.array([case.wind_speed])
+    abl = solve(atmosphere_of(fmodel.core), speeds, case.hub_height)
+    ambient = np.asarray(abl.turbulence_intensity(case.hub_height,
+                                                  reference_height=case.hub_height)).reshape(-1)
+    np.testing.assert_allclose(ambient, measured, rtol=1e-10)
+    at_hub = np.full((1, 1, 1, 1), case.hub_height)
+    k_w = fmodel.core.wake.velocity_model.expansion_rate(
+        abl, at_hub, speeds.reshape(1, 1, 1, 1), ambient.reshape(1, 1, 1, 1),
+        ambient.reshape(1, 1, 1, 1))
+    np.testing.assert_allclose(np.asarray(k_w).reshape(-1),
+                               (0.021**6 + (0.33 * measured) ** 6) ** (1 / 6), rtol=1e-10)
+    for model in ("GCH", "cc", "M-3"):
+        ti = models.build_model(case, reading, model).core.flow_field.turbulence_intensities[0]
+        assert ti == pytest.approx(measured, rel=1e-10), model
+
+    # Shear and veer across the rotor: the site roughness's ABL (the factor touches only the
+    # turbulence), measurably not the matched roughness's.
+    heights = case.hub_height + 0.5 * case.rotor_diameter * np.linspace(-1.0, 1.0, 5)
+    def rotor_wind(b):
+        return np.array(solve(atmosphere_of(models.build_model(case, b, "M-1").core), speeds,
+                              case.hub_height).hub_aligned_velocity(heights, case.hub_height))
+    np.testing.assert_allclose(np.array(abl.hub_aligned_velocity(heights, case.hub_height)),
+                               rotor_wind("site"), rtol=1e-12, atol=1e-12)
+    assert np.abs(rotor_wind(reading) - rotor_wind("matched")).max() > 0.01
+
+    report = validity_report(fmodel)
+    assert bool(report["ambient_turbulence_beyond_paper"].iloc[0])
+    assert not bool(validity_report(models.build_model(case, "site", "M-1"))
+                    ["ambient_turbulence_beyond_paper"].iloc[0])
+
+
 def test_no_warning_about_the_studys_own_settings():
     """Building every model of the study for a farm raises none of the package's warnings
     (the study sets FLORIS's veer only for FLORIS's models, its power-law shear only where

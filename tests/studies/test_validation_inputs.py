@@ -188,7 +188,7 @@ def test_a_farm_given_its_own_atmosphere_runs_the_given_reading():
     """A case with an atmosphere block and no turbulence runs the "given" reading: its models
     see the block's I_u(z_h) (lower in the stable block than in the neutral one of the same
     roughness), the waked turbines lose power; the "matched" reading is refused naming the
-    missing turbulence."""
+    missing turbulence, as is the "site_measured_turbulence" option."""
     block = {"latitude": 54.0, "roughness_length": 0.01}
     stable = farm(turbulence=None, atmosphere={**block, "cooling_rate": -0.25})
     neutral = farm(turbulence=None, atmosphere=block)
@@ -201,6 +201,9 @@ def test_a_farm_given_its_own_atmosphere_runs_the_given_reading():
     assert ratios[0] == 1.0 and np.all((ratios[1:] > 0.3) & (ratios[1:] < 0.9))
     with pytest.raises(ValueError, match="turbulence"):
         models.row_ratios(stable, ["M-1"], offsets=(0.0,))
+    with pytest.raises(ValueError, match=r"reading 'site_measured_turbulence' needs the case's "
+                                         r"turbulence"):
+        atmospheres.atmosphere(stable, atmospheres.SITE_MEASURED_TURBULENCE)
 
 
 # --------------------------------------------------------------------------- bad input

@@ -16,6 +16,14 @@ wind speed:
     the k_w floor) are left as they are; k_w then follows from the matched I_u through
     Eq. (kw_CNBL_SBL_model).
 
+``site_measured_turbulence`` (an option, not among :data:`ATMOSPHERES`)
+    What the product does at a site with measured turbulence (``fit_site``): the site's
+    roughness for the ABL's shear and veer, and the atmosphere block's ``turbulence_factor`` =
+    measured I_u(z_h) / the site ABL's I_u(z_h), so that the wake's ambient I_u(z_h), hence k_w
+    (Eq. kw_CNBL_SBL_model), is the measured one (docs/atmosphere.md#ambient-turbulence).
+    Beyond the paper's validation (``validity_report`` flags the factor). It was not made the
+    "site" reading: FLORIS's gauss, GCH and cc and M-3 do worse with the measured TI at
+    Wieringermeer-East and Nibe (docs/validation.md#the-atmosphere-of-a-case).
 ``given``
     A case's own ``atmosphere`` block (e.g. a stable one), as a user's FLORIS input has it.
 
@@ -30,12 +38,15 @@ from scipy.optimize import brentq
 
 from floris_ekman_veer._validation import number
 from floris_ekman_veer.atmosphere.ekman import EkmanABL
+from floris_ekman_veer.studies.site.atmospheres import turbulence_factors
 from floris_ekman_veer.wake.deficit import potential_core_length
 
 #: The two atmospheres of a case from its measured TI (see the module docstring).
 ATMOSPHERES = ("site", "matched")
 #: ...and the reading of a case's own atmosphere block.
 GIVEN = "given"
+#: The site's roughness with the measured hub turbulence in the wake, as ``fit_site`` does.
+SITE_MEASURED_TURBULENCE = "site_measured_turbulence"
 #: Search range of the matched roughness length [m].
 ROUGHNESS_RANGE = (1.0e-6, 5.0)
 #: Roughness lengths of the "site" atmospheres [m]: open sea and open farmland.
@@ -63,24 +74,35 @@ def site_roughness_length(offshore: bool) -> float:
     return SEA_ROUGHNESS if offshore else LAND_ROUGHNESS
 
 
-def _abl(case, roughness_length: float) -> EkmanABL:
-    return EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, latitude=case.latitude,
-                                        roughness_length=roughness_length)
+def _abl(case, roughness_length) -> EkmanABL:
+    # The neutral ABL with ``roughness_length`` [m] at the case's latitude, or an atmosphere
+    # block (dict), at the case's hub-height speed.
+    inputs = (roughness_length if isinstance(roughness_length, dict)
+              else {"latitude": case.latitude, "roughness_length": roughness_length})
+    return EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, **inputs)
+
+
+def site_turbulence_factor(case) -> float:
+    """The atmosphere block's ``turbulence_factor`` a user with the site's data gets
+    (docs/atmosphere.md#ambient-turbulence): the case's measured I_u(z_h) over the site ABL's
+    I_u(z_h) (Eq. Iu_model), by the site pipeline's own ``turbulence_factors`` (1 where the
+    ratio leaves the factor's range). The ABL's shear and veer stay the site roughness's."""
+    abl = _abl(case, case.site_roughness)
+    (factor,) = turbulence_factors(abl, (case.hub_height, [case.streamwise_turbulence]), [0])
+    return float(factor)
 
 
 def hub_turbulence(case, roughness_length) -> float:
     """I_u(z_h) (Eq. Iu_model) of the case's atmosphere at its hub-height speed and latitude:
     the neutral ABL with ``roughness_length`` [m], or an ``atmosphere`` block (dict)."""
-    if isinstance(roughness_length, dict):
-        abl = EkmanABL.from_reference_wind(case.wind_speed, case.hub_height, **roughness_length)
-    else:
-        abl = _abl(case, roughness_length)
+    abl = _abl(case, roughness_length)
     return float(abl.turbulence_intensity(case.hub_height, reference_height=case.hub_height))
 
 
-def wake_scales(case, roughness_length: float, thrust_coefficient: float) -> tuple[float, float]:
+def wake_scales(case, roughness_length, thrust_coefficient: float) -> tuple[float, float]:
     """(k_w, x0/D) of an unwaked turbine of the case: Eqs. (kw_CNBL_SBL_model), (x0_transition)
-    with the paper's constants; arcs closer than x0 lie in the potential core."""
+    with the paper's constants, in the neutral ABL with ``roughness_length`` [m] or an
+    ``atmosphere`` block (dict); arcs closer than x0 lie in the potential core."""
     k_w = float(_abl(case, roughness_length).wake_expansion_rate(case.hub_height))
     radius = 0.5 * case.rotor_diameter
     return k_w, float(potential_core_length(k_w, radius, thrust_coefficient, 0.0)) / case.rotor_diameter
@@ -117,10 +139,14 @@ def atmosphere(case, reading: str) -> dict:
         if getattr(case, "atmosphere", None) is None:
             raise ValueError(f"{case.name}: reading {GIVEN!r} needs the case's atmosphere block")
         return dict(case.atmosphere)
-    if reading not in ATMOSPHERES:
-        raise ValueError(f"reading must be one of {ATMOSPHERES + (GIVEN,)}, got {reading!r}")
-    if reading == "matched" and case.streamwise_turbulence is None:
-        raise ValueError(f"{case.name}: reading 'matched' needs the case's turbulence (the "
+    readings = ATMOSPHERES + (SITE_MEASURED_TURBULENCE, GIVEN)
+    if reading not in readings:
+        raise ValueError(f"reading must be one of {readings}, got {reading!r}")
+    if reading != "site" and case.streamwise_turbulence is None:
+        raise ValueError(f"{case.name}: reading {reading!r} needs the case's turbulence (the "
                          f"measured I_u); this case gives an atmosphere block: use reading {GIVEN!r}")
-    z0 = case.site_roughness if reading == "site" else matched_roughness(case)
-    return {"latitude": float(case.latitude), "roughness_length": float(z0)}
+    z0 = matched_roughness(case) if reading == "matched" else case.site_roughness
+    block = {"latitude": float(case.latitude), "roughness_length": float(z0)}
+    if reading == SITE_MEASURED_TURBULENCE:
+        block["turbulence_factor"] = site_turbulence_factor(case)
+    return block
