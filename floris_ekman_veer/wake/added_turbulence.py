@@ -18,7 +18,7 @@ wakes (C_T 0.4-0.9, I_a 0.035-0.137):
 
 a ring peaked at the rotor's edge, the tip shear layer, that fills the axis as the wake widens,
 less below the hub where the ground's own turbulence already is (delta). The constants are the
-published ones, unchanged. Pure numpy.
+published ones, unchanged; in numpy.
 
 FLORIS's Crespo-Hernandez form (Crespo & Hernandez 1996, as FLORIS's ``CrespoHernandez`` model
 has it, with its exponents as parameters) is compiled here for the solver on a turbine grid
