@@ -18,12 +18,77 @@ wakes (C_T 0.4-0.9, I_a 0.035-0.137):
 
 a ring peaked at the rotor's edge, the tip shear layer, that fills the axis as the wake widens,
 less below the hub where the ground's own turbulence already is (delta). The constants are the
-published ones, unchanged. Pure numpy.
+published ones, unchanged; in numpy.
+
+FLORIS's Crespo-Hernandez form (Crespo & Hernandez 1996, as FLORIS's ``CrespoHernandez`` model
+has it, with its exponents as parameters) is compiled here for the solver on a turbine grid
+(:func:`crespo_hernandez_overlap`): the same formula, operation by operation, so the same bits
+as FLORIS's own call [`test_compiled_crespo_hernandez_is_floris_s`].
 """
 
 from __future__ import annotations
 
+import numba
 import numpy as np
+
+from .fused import JIT
+
+
+@numba.njit(inline="always", **JIT)
+def crespo_hernandez(ambient_turbulence, x, x_source, diameter, axial_induction, constant, ai,
+                     initial, downstream):
+    """FLORIS's ``CrespoHernandez.function`` at one point (floris/core/wake_turbulence/
+    crespo_hernandez.py): constant a^ai I_0^initial (dx / D)^downstream downstream of the
+    rotor (dx = x - x_source > -0.1 m), 0 upstream; dx within 0.1 m of the rotor is taken as
+    dx + 1 m, as FLORIS does."""
+    delta_x = x - x_source
+    upstream = 1.0 if delta_x <= 0.1 else 0.0
+    downstream_mask = 1.0 if delta_x > -0.1 else 0.0
+    delta_x = delta_x * downstream_mask + 1.0 * upstream
+    return (constant * axial_induction**ai * ambient_turbulence**initial
+            * (delta_x / diameter) ** downstream) * downstream_mask
+
+
+@numba.njit(**JIT)
+def _crespo_hernandez_overlap(ambient_turbulence, x, x_source, diameter, axial_induction,
+                              overlap, y, y_source, lateral, constant, ai, initial, downstream,
+                              out):
+    for p in range(x.shape[0]):
+        for m in range(x.shape[1]):
+            added = crespo_hernandez(ambient_turbulence[p], x[p, m], x_source[p], diameter[p],
+                                     axial_induction[p], constant, ai, initial, downstream)
+            # numpy's nan_to_num(added, posinf=0.0), as FLORIS's solver takes it
+            if np.isnan(added) or added == np.inf:
+                added = 0.0
+            elif added == -np.inf:
+                added = -np.finfo(np.float64).max
+            # FLORIS's solver's factors, in its order (each 1 or 0).
+            added = overlap[p] * added * (1.0 if x[p, m] > x_source[p] else 0.0)
+            if lateral:
+                added = added * (1.0 if abs(y_source[p] - y[p, m]) < 2 * diameter[p] else 0.0)
+            out[p, m] = added * (1.0 if x[p, m] <= 15 * diameter[p] + x_source[p] else 0.0)
+
+
+def crespo_hernandez_overlap(ambient_turbulence, x, x_source, diameter, axial_induction,
+                             overlap, parameters, y=None, y_source=None):
+    """The wake-added turbulence of wakes at points as FLORIS's sequential solver weights it:
+    ``overlap`` times :func:`crespo_hernandez` (NaN and +inf as 0), downstream of the source,
+    within 2 D of it laterally (with the points' ``y`` (pairs, points) and the sources'
+    ``y_source``) and within 15 D downstream; per wake and rotor (pairs,) the ambient
+    turbulence, the source's x, diameter and axial induction, and the rotor's overlap; ``x``
+    (pairs, points) the rotor's points; ``parameters`` FLORIS's (constant, ai, initial,
+    downstream). Returns (pairs, points)."""
+    x = np.ascontiguousarray(x, dtype=float)
+    out = np.empty(x.shape)
+    per_pair = [np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (
+        ambient_turbulence, x_source, diameter, axial_induction, overlap)]
+    lateral = y is not None
+    y = np.ascontiguousarray(y, dtype=float) if lateral else x
+    y_source = (np.ascontiguousarray(y_source, dtype=float).reshape(-1) if lateral
+                else per_pair[1])
+    _crespo_hernandez_overlap(per_pair[0], x, *per_pair[1:], y, y_source, lateral,
+                              *(float(v) for v in parameters), out)
+    return out
 
 
 def ishihara_qian_added_turbulence(x, r, z, thrust_coefficient, ambient_turbulence, diameter,

@@ -40,7 +40,7 @@ JIT = {"cache": True, "fastmath": False, "error_model": "numpy"}
 GAUSSIAN_SHAPE = 2.0
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def curl_polynomial(t_hat, alpha):
     """(q0, ..., q4) with xi_hat = sum_k q_k cos(theta)^k, Eq. (xi_emp):
     xi_hat = 1 - (a2 cos 2theta + a3 cos 3theta + a4 cos 4theta) with
@@ -57,25 +57,43 @@ def curl_polynomial(t_hat, alpha):
     return 1.0 + a2 - a4, 3.0 * a3, 8.0 * a4 - 2.0 * a2, -4.0 * a3, -8.0 * a4
 
 
-@numba.njit(**JIT)
-def point_deficit(dy, dz, polar_dy, amplitude, kx, xi0, sin2b, q0, q1, q2, q3, q4, shape):
-    """Delta u / U_h of Eq. (du_model) at one point (dy, dz) from the wake's centre: the width
-    sigma = k_w x + xi0 xi_hat(theta) / sqrt(1 - sin^2 beta sin^2 theta) of Eqs.
+@numba.njit(inline="always", **JIT)
+def point_exponent(dy, dz, polar_dy, kx, xi0, sin2b, q0, q1, q2, q3, q4):
+    """rho^2 / (2 sigma^2) of Eq. (du_model) at one point (dy, dz) from the wake's centre: the
+    width sigma = k_w x + xi0 xi_hat(theta) / sqrt(1 - sin^2 beta sin^2 theta) of Eqs.
     (sigma_width), (xi0_theta), the polar angle theta measured at (polar_dy, dz)
     (docs/wake_model.md#polar-angle; theta := 0 at the centre, where the Gaussian is 1 whatever
-    the width), and the radial shape exp(-(rho^2 / (2 sigma^2))^(shape / 2)) (2: the Gaussian).
-    ``xi0`` = 0.4 R sqrt(A*) |cos beta|; (q0, ..., q4) of :func:`curl_polynomial`."""
+    the width). ``xi0`` = 0.4 R sqrt(A*) |cos beta|; (q0, ..., q4) of :func:`curl_polynomial`.
+    No call and no branch but a select: the rotor-cell kernel evaluates it along a sub-point
+    row in the compiler's vector instructions (IEEE-exact, as the scalar ones)."""
     squared = polar_dy * polar_dy + dz * dz
-    c = polar_dy / np.sqrt(squared) if squared > 0.0 else 1.0
+    c = polar_dy / np.sqrt(squared)
+    c = c if squared > 0.0 else 1.0
     curl = q0 + c * (q1 + c * (q2 + c * (q3 + c * q4)))
     sigma = kx + xi0 / np.sqrt(1.0 - sin2b * (1.0 - c * c)) * curl
-    exponent = (dy * dy + dz * dz) / (2.0 * sigma * sigma)
+    return (dy * dy + dz * dz) / (2.0 * sigma * sigma)
+
+
+@numba.njit(inline="always", **JIT)
+def shaped_deficit(exponent, amplitude, shape):
+    """Delta u / U_h = C exp(-(rho^2 / (2 sigma^2))^(shape / 2)) from :func:`point_exponent`'s
+    ``exponent``: the radial shape (2: the Gaussian; a near wake's super-Gaussian order)."""
     if shape != GAUSSIAN_SHAPE:
         exponent = exponent ** (0.5 * shape)
     return amplitude * np.exp(-exponent)
 
 
 @numba.njit(**JIT)
+def point_deficit(dy, dz, polar_dy, amplitude, kx, xi0, sin2b, q0, q1, q2, q3, q4, shape):
+    """Delta u / U_h of Eq. (du_model) at one point (dy, dz) from the wake's centre:
+    :func:`shaped_deficit` of :func:`point_exponent` (the polar angle measured at
+    (polar_dy, dz)); the radial shape exp(-(rho^2 / (2 sigma^2))^(shape / 2)) (2: the
+    Gaussian)."""
+    return shaped_deficit(point_exponent(dy, dz, polar_dy, kx, xi0, sin2b, q0, q1, q2, q3, q4),
+                          amplitude, shape)
+
+
+@numba.njit(inline="always", **JIT)
 def centre_offset(x, z, local_u, local_v, strength, r_tube, hub_height, radius, friction_velocity,
                   veer, ground_image):
     """y_c(x, z) of Eq. (yc_xz) at one height z (x > 0), as wake/deflection.py's
@@ -90,14 +108,14 @@ def centre_offset(x, z, local_u, local_v, strength, r_tube, hub_height, radius, 
                                ground_image)
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def time_growth(x, speed, radius, friction_velocity):
     """1 - exp(-0.35 (u*/U) x/R), t_hat's growth of Eq. (that) at a height where the speed is
     U = ``speed`` > 0 (the centre's and the curl's t_hat at a row share it)."""
     return -np.expm1(-0.35 * (friction_velocity / speed) * x / radius)
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def _vortex_pair_offset(abs_t):
     # |y_hat_c| of Eq. (yhatc) without the image, at |t_hat| = abs_t (increasing in abs_t).
     pm1 = np.pi - 1.0
@@ -108,7 +126,7 @@ def _vortex_pair_offset(abs_t):
     return numerator / denominator
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, radius,
                         friction_velocity, veer, ground_image):
     """(drift, bound) with |:func:`centre_offset` - drift| <= bound, without its exponential
@@ -130,7 +148,7 @@ def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, ra
     return drift, r_tube * offset * (1.0 + 1e-6) + 1e-6
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def grown_centre_offset(growth, x, z, local_u, local_v, strength, r_tube, hub_height, veer,
                         ground_image):
     """:func:`centre_offset` with t_hat's growth (:func:`time_growth`) given (U(z) > 0)."""
@@ -168,6 +186,15 @@ def _centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radi
                     radius[f], friction_velocity[f], veer, ground_image)
 
 
+def _contiguous(value, shape) -> np.ndarray:
+    """``value`` as a contiguous float array of ``shape`` (broadcast; as it is if it already
+    is one)."""
+    value = np.asarray(value, dtype=float)
+    if value.shape != shape:
+        value = np.broadcast_to(value, shape)
+    return np.ascontiguousarray(value)
+
+
 def centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radius,
                   friction_velocity, veer=True, ground_image=True):
     """:func:`centre_offset` of one wake at the points of every rotor downstream of it (0
@@ -177,9 +204,8 @@ def centre_points(dx, z, u, v, cos_a, sin_a, strength, r_tube, hub_height, radiu
     ``sin_a``); the wake's factors per condition (n_findex,). Returns (n_findex, n_turbines,
     heights)."""
     arrays = [np.ascontiguousarray(a, dtype=float) for a in (dx, z, u, v)]
-    per_condition = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), dx.shape[:1]))
-                     for a in (cos_a, sin_a, strength, r_tube, hub_height, radius,
-                               friction_velocity)]
+    per_condition = [_contiguous(a, dx.shape[:1]) for a in (
+        cos_a, sin_a, strength, r_tube, hub_height, radius, friction_velocity)]
     points = np.zeros(arrays[1].shape)
     _centre_points(*arrays, *per_condition, float(veer), float(ground_image), points)
     return points
@@ -275,6 +301,11 @@ def deficit_on_rows(dy, dz, parameters):
 WAKE_TABLE = ("amplitude", "kx", "xi0", "sin2b", "strength", "polar_veer", "shape",
               "width_bound", "amplitude_bound", "centre_deficit")
 
+#: The ``shape`` of a near-wake pair whose order :func:`wake_table` left for later
+#: (``bound_only``): its ``width_bound`` holds for every order (the rotor's reach is bounded
+#: before the order's root is solved; the rotors kept get their exact table).
+DEFERRED_ORDER = 0.0
+
 
 @numba.njit(**JIT)
 def _digamma(x):
@@ -337,21 +368,39 @@ def super_gaussian_order(centre_deficit, loading, width_squared):
 
 @numba.njit(**JIT)
 def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, near_wake,
-                polar_veer, out):
+                polar_veer, bound_only, out):
+    # The factors of the wake alone (its rotor's k_w, R, ct, yaw, U_h, u*), evaluated again only
+    # where they change from one pair to the next (the pairs come wake by wake: one per
+    # condition).
+    kw = r = c_t = beta = speed = u_star = np.nan
+    cos_b = root = induction = core = width0 = cos_cubed = np.nan
+    xi0 = sin2b = strength = bound0 = np.nan
     for k in range(x.size):
-        xk, kw, r, c_t, beta = x[k], k_w[k], radius[k], ct[k], yaw[k]
-        cos_b, sin_b = np.cos(beta), np.sin(beta)
-        # Momentum theory of the yawed rotor, Eqs. (A_star), (ind_factor) (wake/deficit.py).
-        root = np.sqrt(1.0 - c_t * (cos_b * cos_b))
-        area = (1.0 + root) / (2.0 * root)
-        r_tube = r * np.sqrt(area)
-        induction = c_t * (cos_b * cos_b) / (2.0 * (1.0 + root))
-        # x0, Eq. (x0_transition), and C(x), Eq. (Cx), with sigma_tilde^2 of Eq. (sigma_tilde).
-        core = (np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * r**2 * cos_b)
-                + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * kw)
-        width0 = WIDTH_FACTOR * r_tube
+        xk = x[k]
+        if not (k_w[k] == kw and radius[k] == r and ct[k] == c_t and yaw[k] == beta
+                and hub_speed[k] == speed and friction_velocity[k] == u_star):
+            kw, r, c_t, beta = k_w[k], radius[k], ct[k], yaw[k]
+            speed, u_star = hub_speed[k], friction_velocity[k]
+            cos_b, sin_b = np.cos(beta), np.sin(beta)
+            # Momentum theory of the yawed rotor, Eqs. (A_star), (ind_factor) (wake/deficit.py).
+            root = np.sqrt(1.0 - c_t * (cos_b * cos_b))
+            area = (1.0 + root) / (2.0 * root)
+            r_tube = r * np.sqrt(area)
+            induction = c_t * (cos_b * cos_b) / (2.0 * (1.0 + root))
+            # x0, Eq. (x0_transition), with sigma_tilde^2 of Eq. (sigma_tilde).
+            core = (np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * r**2 * cos_b)
+                    + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * kw)
+            width0 = WIDTH_FACTOR * r_tube
+            cos_cubed = cos_b**3.0
+            xi0 = WIDTH_FACTOR * r_tube * abs(cos_b)
+            sin2b = sin_b**2
+            # t_hat's prefactor, Eq. (that) (0: no curl, xi_hat = 1).
+            strength = (-1.44 * (speed / u_star) / np.sqrt(area)
+                        * (c_t * (cos_b * cos_b) * sin_b)) if curl else 0.0
+            bound0 = WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)
+        # C(x), Eq. (Cx).
         x_decay = max(xk, core)
-        q = c_t * cos_b**3.0 * r**2 / (2.0 * ((kw * x_decay + width0)
+        q = c_t * cos_cubed * r**2 / (2.0 * ((kw * x_decay + width0)
                                             * (kw * x_decay + width0 * cos_b)))
         decay = q / (1.0 + np.sqrt(max(1.0 - q, 0.0)))
         amplitude = 2.0 * induction if xk <= core else decay
@@ -361,25 +410,30 @@ def _wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl, nea
         if near_wake and x_wake < core:
             width_squared = ((kw * x_wake + width0) * (kw * x_wake + width0 * cos_b)
                              / (2.0 * r) ** 2)
-            order = super_gaussian_order(2.0 * induction, c_t * cos_b**3.0, width_squared)
-            if order != GAUSSIAN_ORDER:
-                factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
+            if bound_only:
+                # m = (2 w^2)^(1/n - 1/2) with n >= 2 is at most 1 / sqrt(2 w^2) below
+                # 2 w^2 = 1, at most 1 above (widened by the round-off).
+                order = DEFERRED_ORDER
+                factor = (1.0 + 1e-12) * (1.0 / np.sqrt(2.0 * width_squared)
+                                          if 2.0 * width_squared < 1.0 else 1.0)
+            else:
+                order = super_gaussian_order(2.0 * induction, c_t * cos_cubed, width_squared)
+                if order != GAUSSIAN_ORDER:
+                    factor = (2.0 * width_squared) ** (1.0 / order - 0.5)
         out[k, 0] = amplitude
         out[k, 1] = kw * xk * factor
-        out[k, 2] = WIDTH_FACTOR * r_tube * abs(cos_b) * factor
-        out[k, 3] = sin_b**2
-        # t_hat's prefactor, Eq. (that) (0: no curl, xi_hat = 1).
-        out[k, 4] = (-1.44 * (hub_speed[k] / friction_velocity[k]) / np.sqrt(area)
-                     * (c_t * (cos_b * cos_b) * sin_b)) if curl else 0.0
+        out[k, 2] = xi0 * factor
+        out[k, 3] = sin2b
+        out[k, 4] = strength
         out[k, 5] = polar_veer
         out[k, 6] = order
-        out[k, 7] = (kw * xk + WIDTH_FACTOR * r_tube * (1.0 + CURL_ALPHA)) * factor
+        out[k, 7] = (kw * xk + bound0) * factor
         out[k, 8] = amplitude
         out[k, 9] = amplitude
 
 
 def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
-               near_wake=True, polar_veer=0.0):
+               near_wake=True, polar_veer=0.0, bound_only=False):
     """The per-wake factors of Eq. (du_model) for the rotor-cell kernel and the wake's reach,
     (pairs, :data:`WAKE_TABLE`), compiled, one row per wake and rotor: the same numbers as
     :func:`wake_deficit_parameters` with wake/near_wake.py's ``near_wake_shape`` (with
@@ -387,9 +441,12 @@ def wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=True,
     0.4 R sqrt(A*) (1 + alpha), times the near wake's width factor; ``amplitude_bound`` and
     ``centre_deficit``: C(x)), in one pass (tests/physics/test_near_wake.py compares them).
     Arguments: 1-D arrays of the pairs (``x`` > 0 the distance behind the rotor; the
-    thrust coefficient ``ct`` within momentum theory, as the velocity model limits it)."""
-    arrays = [np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), np.shape(x)))
+    thrust coefficient ``ct`` within momentum theory, as the velocity model limits it).
+    ``bound_only``: a near-wake pair's order is not solved (``shape`` DEFERRED_ORDER) and its
+    ``width_bound`` is the bound over every order: the table to choose the rotors a wake
+    reaches by, cheaply, before their exact table."""
+    arrays = [_contiguous(a, np.shape(x))
               for a in (x, k_w, radius, ct, yaw, friction_velocity, hub_speed)]
     out = np.empty((arrays[0].size, len(WAKE_TABLE)))
-    _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), out)
+    _wake_table(*arrays, bool(curl), bool(near_wake), float(polar_veer), bool(bound_only), out)
     return out

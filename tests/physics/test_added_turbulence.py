@@ -69,3 +69,42 @@ def test_ring_peaks_at_the_edge_and_fills_the_axis_downstream():
     xs = np.arange(4.0, 20.0) * D
     along = ishihara_qian_added_turbulence(xs, 0.5 * D, H, 0.8, 0.06, D, H)
     assert np.all(np.diff(along) < 0.0)
+
+
+@pytest.mark.parametrize("parameters", [(0.9, 0.8, 0.1, -0.32), (0.73, 0.8325, -0.0325, -0.32),
+                                        (1.2, 0.5, 0.3, -0.5)])
+def test_compiled_crespo_hernandez_is_floris_s(parameters):
+    """wake/added_turbulence.py's compiled Crespo-Hernandez is FLORIS's CrespoHernandez model
+    (its numexpr formula and its masks around the rotor plane) bit for bit, times the overlap,
+    with FLORIS's solver's factors (NaN and +inf as 0, downstream, within 2 D laterally,
+    within 15 D) as FLORIS's sequential solver writes them, on random points including the
+    +-0.1 m band at the rotor plane and zero induction."""
+    from floris.core.wake_turbulence.crespo_hernandez import CrespoHernandez
+
+    from floris_ekman_veer.wake.added_turbulence import crespo_hernandez_overlap
+
+    floris = CrespoHernandez(**dict(zip(("constant", "ai", "initial", "downstream"),
+                                        parameters)))
+    rng = np.random.default_rng(11)
+    pairs, points = 5000, 9
+    x_source = rng.uniform(-500.0, 500.0, (pairs, 1))
+    x = x_source + rng.uniform(-300.0, 3000.0, (pairs, points))
+    x[:200] = x_source[:200] + rng.uniform(-0.2, 0.2, (200, points))
+    y_source = rng.uniform(-500.0, 500.0, (pairs, 1))
+    y = y_source + rng.uniform(-400.0, 400.0, (pairs, points))
+    diameter = rng.uniform(50.0, 200.0, (pairs, 1))
+    ambient = rng.uniform(0.01, 0.3, (pairs, 1))
+    induction = rng.uniform(0.0, 0.5, (pairs, 1))
+    induction[:50] = 0.0
+    overlap = rng.uniform(0.0, 1.0, (pairs, 1))
+    reference = floris.function(ambient, x, x_source, diameter, induction)
+    alone = crespo_hernandez_overlap(ambient, x, x_source, diameter, induction,
+                                     np.ones((pairs, 1)), parameters)
+    in_reach = (x > x_source) & (x <= 15 * diameter + x_source)
+    np.testing.assert_array_equal(alone, reference * in_reach)
+    solver = (overlap * np.nan_to_num(reference, posinf=0.0) * (x > x_source)
+              * (np.abs(y_source - y) < 2 * diameter) * (x <= 15 * diameter + x_source))
+    compiled = crespo_hernandez_overlap(ambient, x, x_source, diameter, induction, overlap,
+                                        parameters, y, y_source)
+    np.testing.assert_array_equal(compiled, solver)
+    assert 0.2 < np.mean(compiled > 0.0) < 0.8

@@ -139,3 +139,36 @@ def test_compiled_wake_table_equals_the_model_methods(near_wake, polar_angle_cen
         assert 20 < np.count_nonzero(inside) < pairs - 20
         assert (near_wake == "potential_core") == np.all(compiled[:, 6] == 2.0)
         np.testing.assert_allclose(compiled, readable, rtol=1e-13, atol=0.0)
+
+
+def test_wake_table_by_wake_and_its_reach_bound():
+    """The compiled table evaluates a wake's own factors once for its run of pairs: rows of
+    pairs that share a wake (as the rotor cells hand them, wake by wake) equal the rows of the
+    same pairs alone, bit for bit. With ``bound_only`` a near-wake pair's order is left for
+    later (shape DEFERRED_ORDER) and its width bound is at least the exact one, whatever the
+    order (the rotors it keeps get their exact table, plugin/rotor/rotor.py); the other
+    columns of the other pairs are the exact table's."""
+    from floris_ekman_veer.wake.fused import DEFERRED_ORDER, WAKE_TABLE, wake_table
+
+    rng = np.random.default_rng(5)
+    wakes, per_wake = 40, 25
+    by_wake = lambda a: np.repeat(a, per_wake)  # noqa: E731
+    x = rng.uniform(0.2, 40.0, wakes * per_wake) * RADIUS
+    arguments = (x, by_wake(rng.uniform(0.01, 0.08, wakes)), np.full(x.size, RADIUS),
+                 by_wake(rng.uniform(0.1, 0.95, wakes)), by_wake(rng.uniform(-0.5, 0.5, wakes)),
+                 by_wake(rng.uniform(0.1, 0.6, wakes)), by_wake(rng.uniform(4.0, 14.0, wakes)))
+    exact = wake_table(*arguments)
+    alone = np.concatenate([wake_table(*(a[[p]] for a in arguments)) for p in range(x.size)])
+    np.testing.assert_array_equal(exact, alone)
+
+    bound = wake_table(*arguments, bound_only=True)
+    shape, width = WAKE_TABLE.index("shape"), WAKE_TABLE.index("width_bound")
+    deferred = bound[:, shape] == DEFERRED_ORDER
+    inside = x < wd.potential_core_length(arguments[1], RADIUS, arguments[3], arguments[4])
+    np.testing.assert_array_equal(deferred, inside)
+    assert 50 < np.count_nonzero(deferred) < x.size - 50
+    assert np.all(bound[deferred, width] >= exact[deferred, width])
+    np.testing.assert_array_equal(bound[~deferred], exact[~deferred])
+    for column in ("amplitude_bound", "centre_deficit"):
+        k = WAKE_TABLE.index(column)
+        np.testing.assert_array_equal(bound[:, k], exact[:, k])

@@ -43,8 +43,10 @@ from floris_ekman_veer.plugin.floris_hooks import patching
 from floris_ekman_veer.plugin.inflow import inflow
 from floris_ekman_veer.plugin.inflow.ambient import is_rotor_grid
 from floris_ekman_veer.plugin.rotor import turbine_states
-from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE
+from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE, condition_column
+from floris_ekman_veer.plugin.rotor.rotor_wakes import crespo_hernandez_parameters
 from floris_ekman_veer.plugin.wake_models.models import EkmanWakeModel
+from floris_ekman_veer.wake.added_turbulence import crespo_hernandez_overlap
 
 #: GCH's switches: each makes FLORIS's solver read or write whole-farm fields per turbine.
 WHOLE_FARM_TERMS = ("enable_secondary_steering", "enable_transverse_velocities",
@@ -104,6 +106,7 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
             np.repeat(turbine_turbulence_intensity, grid.grid_resolution, axis=2),
             grid.grid_resolution, axis=3)
     ambient_turbulence_intensities = flow_field.turbulence_intensities.copy()[:, None, None, None]
+    crespo_parameters = crespo_hernandez_parameters(model_manager.turbulence_model)
 
     for i in range(n_turbines):
         x_i = np.mean(grid.x_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
@@ -161,19 +164,26 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
             continue
         f, j, area_overlap = f[hit], j[hit], area_overlap[hit, None, None]
         x = grid.x_sorted[f, j]
-        per_pair = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[f, 0]  # noqa: E731
+        per_pair = lambda a: condition_column(a, n_findex)[f, None, None]  # noqa: E731
         x_source, diameter = per_pair(x_i), per_pair(rotor_diameter_i)
         ambient = ambient_turbulence_intensities[f, 0]
-        wake_added_turbulence_intensity = model_manager.turbulence_model.function(
-            ambient, x, x_source, diameter, per_pair(axial_induction_i),
-        )
-        ti_added = (
-            area_overlap
-            * np.nan_to_num(wake_added_turbulence_intensity, posinf=0.0)
-            * (x > x_source)
-            * (np.abs(per_pair(y_i) - grid.y_sorted[f, j]) < 2 * diameter)
-            * (x <= 15 * diameter + x_source)
-        )
+        if crespo_parameters is not None:
+            # FLORIS's Crespo-Hernandez and the factors below compiled, the same bits
+            # (wake/added_turbulence.py).
+            ti_added = crespo_hernandez_overlap(
+                ambient, x.reshape(f.size, -1), x_source, diameter, per_pair(axial_induction_i),
+                area_overlap, crespo_parameters, grid.y_sorted[f, j].reshape(f.size, -1),
+                per_pair(y_i)).reshape(x.shape)
+        else:
+            ti_added = (
+                area_overlap
+                * np.nan_to_num(model_manager.turbulence_model.function(
+                    ambient, x, x_source, diameter, per_pair(axial_induction_i),
+                ), posinf=0.0)
+                * (x > x_source)
+                * (np.abs(per_pair(y_i) - grid.y_sorted[f, j]) < 2 * diameter)
+                * (x <= 15 * diameter + x_source)
+            )
         turbine_turbulence_intensity[f, j] = np.maximum(
             np.sqrt(ti_added**2 + ambient**2), turbine_turbulence_intensity[f, j])
 

@@ -24,11 +24,17 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     integrate_wake,
     near_pairs,
 )
-from floris_ekman_veer.plugin.rotor.rotor_wakes import WAKE_OVERLAP_VELOCITY
+from floris_ekman_veer.plugin.rotor.rotor_wakes import (
+    WAKE_OVERLAP_VELOCITY,
+    crespo_hernandez_parameters,
+)
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
-from floris_ekman_veer.wake.added_turbulence import ishihara_qian_added_turbulence
-from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, stream_tube_area_ratio
-from floris_ekman_veer.wake.fused import WAKE_TABLE
+from floris_ekman_veer.wake.added_turbulence import (
+    crespo_hernandez_overlap,
+    ishihara_qian_added_turbulence,
+)
+from floris_ekman_veer.wake.deficit import WIDTH_FACTOR, axial_induction, stream_tube_area_ratio
+from floris_ekman_veer.wake.fused import DEFERRED_ORDER, WAKE_TABLE
 
 #: A wake starts this far [m] behind its rotor plane. FLORIS passes x_i as the mean of the rotor's
 #: points (turbine grids) and rotates sampled points (points and planar grids), so a turbine's own
@@ -99,6 +105,14 @@ def rotor_cell_deficit(
         model, x_i, y_i, hub_height_i, deflection_field_i, yaw, ct, radius_i,
         turbulence_intensity_i, axial_induction_i, u_initial, ambient, wakes)
     return result
+
+
+def condition_column(value, n_findex) -> np.ndarray:
+    """(n_findex,) of a per-condition value FLORIS hands as (n_findex, 1, 1, 1) (a view), or
+    of a scalar (broadcast)."""
+    if np.shape(value) == (n_findex, 1, 1, 1):
+        return np.asarray(value)[:, 0, 0, 0]
+    return np.broadcast_to(value, (n_findex, 1, 1, 1))[:, 0, 0, 0]
 
 
 #: No rotor reached: (f, j) empty.
@@ -172,14 +186,16 @@ def reached_rotor_cell_deficit(
     k_w = model.expansion_rate(abl, hub_height_i, hub_speed, turbulence,
                               ambient.floris_turbulence)
     # Turbine i's quantities, one per condition; the wake's factors per rotor downstream.
-    column = lambda a: np.broadcast_to(a, (n_findex, 1, 1, 1))[:, 0, 0, 0]  # noqa: E731
+    column = lambda a: condition_column(a, n_findex)  # noqa: E731
     source_wake = {"k_w": k_w, "radius": radius_i, "ct": ct, "yaw": yaw,
                    "friction_velocity": abl.friction_velocity, "hub_speed": hub_speed}
     source_wake = {k: column(v) for k, v in source_wake.items()}
     x_pair = dx[f, j]
     # The velocity model's table (plugin/rotor/rotor_kernel.py): the deficit's factors that
     # depend on the wake only, its width and amplitude bounds and its centre deficit.
-    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+    # (Where a near wake's order is costly, first a bound of its width: the rotors kept below
+    # get their exact table.)
+    table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()), bound_only=True)
     centre_table = getattr(deflection_field_i, "kernel_table", None)
     # The rotors the wake reaches, with the deficit C(x) exp(-gap^2 / (2 sigma^2)) below
     # NEGLIGIBLE_DEFICIT beyond gap^2 = 2 sigma^2 ln(C / NEGLIGIBLE_DEFICIT) (sigma the widest
@@ -196,10 +212,14 @@ def reached_rotor_cell_deficit(
         # The wake's velocity at its radius 2 sigma, exp(-2) times its centre's (Niayifar &
         # Porte-Agel 2016), per rotor reached: the overlap counts the disk inside that radius.
         edge_factor = np.exp(-2.0)
-    near, pair = near_pairs(
-        f, j, x_pair, table, points, rotor, column(y_i), column(hub_height_i),
-        NEGLIGIBLE_DEFICIT, WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"],
-        speed_fraction)
+    reach = (points, rotor, column(y_i), column(hub_height_i), NEGLIGIBLE_DEFICIT,
+             WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"], speed_fraction)
+    near, pair = near_pairs(f, j, x_pair, table, *reach)
+    if np.any(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER):
+        # The exact table of the rotors the bound kept, and those it reaches (a subset).
+        f, j, x_pair = f[near], j[near], x_pair[near]
+        table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+        near, pair = near_pairs(f, j, x_pair, table, *reach)
     if near.size == 0:
         return result.reshape(u_initial.shape), _NONE
     f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
@@ -258,9 +278,12 @@ def reached_rotor_cell_deficit(
         wake_convection = pair[:, scale] - 0.5 * centre_speed
         pair[:, scale] = pair[:, scale] * wake_convection
         pair[:, edge] = pair[:, edge] * wake_convection
+    # (The momentum-conserving superposition and Ishihara & Qian's turbulence read the
+    # wake's centre at every row of the rotors reached.)
+    ishihara_qian = track and model.wake_turbulence == "ishihara_qian"
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
-        kind, rotor, wakes, track, row_scale)
+        kind, rotor, wakes, track, every_row=convecting or ishihara_qian, row_scale=row_scale)
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE
@@ -272,13 +295,11 @@ def reached_rotor_cell_deficit(
             wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
-    _check_resolution(x_pair[reached], {k: v[f[reached]] for k, v in source_wake.items()},
-                      centre[reached], rotor.radius[f[reached], j[reached]], cells,
-                      rotor.warned)
+    _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
     u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
     result[f[reached], j[reached]] = wakes.cell_returns(
         flat[reached], removed[reached], u_cell, moment[reached][:, None])
-    if track and model.wake_turbulence == "ishihara_qian":
+    if ishihara_qian:
         added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
                                rotor, f[reached], j[reached], kind[reached],
                                hub_height_i[f[reached], 0, 0, 0],
@@ -296,14 +317,20 @@ def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambi
     """FLORIS's wake-added turbulence at rotors (f, j) from turbine i, with the overlap
     the area fraction of the disk (RotorWakes), within 15 D downstream as FLORIS has it,
     combined by ``rule`` (RotorWakes.add_turbulence)."""
-    column = lambda a: np.broadcast_to(a, (x_i.shape[0], 1, 1, 1))[f, 0, 0, 0]  # noqa: E731
+    column = lambda a: condition_column(a, x_i.shape[0])[f]  # noqa: E731
     x_j, x_source = ambient.rotor.x[f, j], column(x_i)
     diameter = 2.0 * column(radius_i)
     ambient_turbulence = column(ambient.floris_turbulence)
-    added = wakes.turbulence_model.function(
-        ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
-    added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
-        x_j <= x_source + 15.0 * diameter)
+    parameters = crespo_hernandez_parameters(wakes.turbulence_model)
+    if parameters is not None:
+        # FLORIS's formula compiled, the same bits (wake/added_turbulence.py; x_j > x_source).
+        added = crespo_hernandez_overlap(ambient_turbulence, x_j[:, None], x_source, diameter,
+                                         column(axial_induction_i), overlap, parameters)[:, 0]
+    else:
+        added = wakes.turbulence_model.function(
+            ambient_turbulence, x_j, x_source, diameter, column(axial_induction_i))
+        added = overlap * np.nan_to_num(np.asarray(added, dtype=float), posinf=0.0) * (
+            x_j <= x_source + 15.0 * diameter)
     wakes.add_turbulence(f, j, added, ambient_turbulence, rule)
 
 
@@ -380,13 +407,19 @@ def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
     return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 
-def _check_resolution(x, source_wake, centre, radius_j, cells, warned):
-    """Warn once per run when a wake band is thinner than the cells' sub-row spacing."""
+def _check_resolution(x, f, j, reached, source_wake, centre, rotor):
+    """Warn once per run when a wake band is thinner than the cells' sub-row spacing: at the
+    rotors (f, j)[reached], x behind the wake's rotor, the wake's quantities per condition
+    ``source_wake`` and its ``centre`` at the rows (pairs, rows)."""
+    warned, cells = rotor.warned, rotor.cells
     if "rows" in warned:
         return
     k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
-    width = k_w * x + WIDTH_FACTOR * radius * np.sqrt(
-        stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
+    # The wake's width k_w x + 0.4 R sqrt(A*) cos(yaw): its second term once per condition.
+    initial_width = WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
+    f, j, centre = f[reached], j[reached], centre[reached]
+    width = k_w[f] * x[reached] + initial_width[f]
+    radius_j = rotor.radius[f, j]
     height = radius_j * (cells.row_z[-1] - cells.row_z[0])
     shear = np.abs(centre[:, -1] - centre[:, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)

@@ -24,13 +24,15 @@ import numpy as np
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
 from floris_ekman_veer.wake.fused import (
+    GAUSSIAN_SHAPE,
     JIT,
     WAKE_TABLE,
     centre_offset,
     centre_offset_bound,
     curl_polynomial,
     grown_centre_offset,
-    point_deficit,
+    point_exponent,
+    shaped_deficit,
     time_growth,
 )
 
@@ -59,9 +61,9 @@ _LAUNCH = threading.Lock()
 
 
 @numba.njit(parallel=True, **JIT)
-def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kind, kind_u,
-               kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule, combined,
-               block, track, row_scale, removed, overlap, reached):
+def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
+               kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
+               combined, block, track, row_scale, removed, overlap, reached):
     per_row = row_scale.shape[0] > 0
     for k in numba.prange(wake.shape[0]):
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
@@ -71,10 +73,12 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
         (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
          ground_image) = per_condition[f]
         reach = 4.0 * radius
+        exponents = np.empty(sub_y.shape[1])
         area = 0.0
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
-        # plugin/rotor/rotor.py; the others are not used).
+        # plugin/rotor/rotor.py), or at every row where the caller reads them all
+        # (``every_row``: the bound is not used).
         skipped_first = skipped_last = False
         for r in range(row_chord.size):
             dz = kind_heights[kk, r] - hub_height
@@ -93,7 +97,7 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
                         x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
                         image_height, radius, u_star, veer, ground_image)
                     nearest = max(abs(offset - drift) - bound - radius_j * row_chord[r], 0.0)
-                    if not nearest * nearest + dz * dz < reach_squared:
+                    if not (every_row or nearest * nearest + dz * dz < reach_squared):
                         skipped_first |= r == 0
                         skipped_last |= r == row_chord.size - 1
                         continue
@@ -117,12 +121,24 @@ def _integrate(wake, pair, per_condition, compute_centre, centre, condition, kin
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
+            # The row's exponents first, then its deficits, then the superposition in the
+            # sub-points' order: short loops the compiler vectorises (wake/fused.py
+            # point_exponent) or pipelines.
+            for s in range(width[r]):
+                dy = lateral + radius_j * sub_y[r, s]
+                exponents[s] = point_exponent(dy, dz, dy + polar_shift, kx, xi0, sin2b,
+                                              q0, q1, q2, q3, q4)
+            if shape == GAUSSIAN_SHAPE:  # (the branch out of the loop)
+                for s in range(width[r]):
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, GAUSSIAN_SHAPE)
+            else:
+                for s in range(width[r]):
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, shape)
             # The cumulative wake's amplitude at the row's height (plugin/rotor/rotor.py).
             row_amplitude = scale * row_scale[k, r] if per_row else scale
             for s in range(width[r]):
                 dy = lateral + radius_j * sub_y[r, s]
-                du = point_deficit(dy, dz, dy + polar_shift, amplitude, kx, xi0, sin2b,
-                                   q0, q1, q2, q3, q4, shape) * row_amplitude
+                du = exponents[s] * row_amplitude
                 old = np.float64(combined[index, s]) if rule else 0.0
                 new = superposed(rule, old, du)
                 removed[k, cell[r, s]] += removed_moment(weight[r, s], ambient_u, old, new,
@@ -203,7 +219,7 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
 
 
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                   row_scale=None):
+                   every_row=False, row_scale=None):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -216,8 +232,11 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
-    updated in place; ``row_scale`` (pairs, rows) or None: a factor of the pair's
-    ``velocity_scale`` per row (the cumulative wake's C_n at the row's height).
+    updated in place. The centre the kernel evaluates is exact at every row of the rotors
+    reached with ``every_row``; without, at their first and last rows and those it reaches (0
+    at the rows a bound of the centre put out of reach). ``row_scale`` (pairs, rows) or None: a
+    factor of the pair's ``velocity_scale`` per row (the cumulative wake's C_n at the row's
+    height).
     """
     cells = wakes.cells
     n_pairs = flat.size
@@ -228,7 +247,7 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     with _LAUNCH:
         _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(per_condition), compute_centre, centre,
+                   np.ascontiguousarray(per_condition), compute_centre, bool(every_row), centre,
                    flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
                    rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
                    cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,

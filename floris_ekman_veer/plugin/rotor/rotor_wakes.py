@@ -48,6 +48,20 @@ def equivalent_deficit(removed, u_cell, moment) -> np.ndarray:
 #: velocities du [m/s] at the cells' sub-points: sum of squares (sosfs), linear sum (fls), max.
 COMBINATION_RULES = {"SOSFS": "sosfs", "FLS": "fls", "MAX": "max"}
 
+#: FLORIS's Crespo-Hernandez turbulence model (class name) and its parameters, in the order of
+#: the compiled form (wake/added_turbulence.py ``crespo_hernandez``).
+CRESPO_HERNANDEZ = ("CrespoHernandez", ("constant", "ai", "initial", "downstream"))
+
+
+def crespo_hernandez_parameters(turbulence_model) -> tuple | None:
+    """FLORIS's Crespo-Hernandez parameters of ``turbulence_model`` for the compiled form of its
+    function, or None for another model (whose own function is then called)."""
+    name, parameters = CRESPO_HERNANDEZ
+    if type(turbulence_model).__name__ != name:
+        return None
+    return tuple(float(getattr(turbulence_model, k)) for k in parameters)
+
+
 #: Each rule's number in the compiled kernel (:func:`superposed`; 0: no rule, each wake alone).
 #: A new rule is a row here and a branch there.
 RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3, "momentum_conserving": 4}
@@ -63,7 +77,7 @@ WAKE_SUPERPOSITIONS = ("combination_model", "momentum_conserving", "cumulative")
 WAKE_OVERLAP_VELOCITY = 0.05
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def superposed(rule, old, du):
     """The combined wake velocity at a sub-point after adding ``du`` to ``old`` by the rule
     numbered ``rule`` (:data:`RULE_CODES`): sqrt(old^2 + du^2), old + du, max(old, du), or du
@@ -80,7 +94,7 @@ def superposed(rule, old, du):
     return du
 
 
-@numba.njit(**JIT)
+@numba.njit(inline="always", **JIT)
 def removed_moment(weight, ambient_u, old, new, moment):
     """weight (u_old^m - u_new^m) with u = U - wake: the moment a wake removes at a sub-point
     whose combined wake goes from ``old`` to ``new`` (m = 3 written as one product, so that it

@@ -8,9 +8,9 @@ is, at FLORIS's n grid-point heights of the rotor (the veer-sheared centres diff
 and interpolated to the kernel's sub-point rows as the centre is (rotor_cells.row_interpolation):
 n sums per wake and rotor, not one per row (docs/coupling.md#wakes-deep-in-an-array). A rotor
 keeps only the wakes that reached it, so the store is sparse: a pool of entries, one per
-(wake, rotor) reached, linked per rotor in the order of arrival (``head``/``tail``/``following``),
-each holding C_i and the centre's lateral offset at the n grid-point heights, sigma_i^2, the
-centre's height and lateral position. A rotor's entries are returned to the pool when it becomes
+(wake, rotor) reached, in blocks of BLOCK consecutive entries linked per rotor in the order of
+arrival (``head``/``tail``/``following``), each holding C_i and the centre's y at the n
+grid-point heights, sigma_i^2 and the centre's height. A rotor's blocks are returned to the pool when it becomes
 the source of a wake: the solver steps the turbines downstream, so no later wake reaches it. The
 memory is that of the wakes kept at the rotors still ahead of the sweep, not turbines^2 x rows
 per condition; the work is that of the pairs of wakes that meet at a rotor. The sum runs over

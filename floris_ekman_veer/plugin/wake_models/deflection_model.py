@@ -15,6 +15,7 @@ from floris.core import BaseModel, FlowField, Grid
 
 from floris_ekman_veer._validation import boolean_field, number_field
 from floris_ekman_veer.plugin.inflow.ambient import Ambient
+from floris_ekman_veer.plugin.rotor.rotor import condition_column
 from floris_ekman_veer.plugin.wake_models.names import DEFLECTION_MODEL_NAME
 from floris_ekman_veer.plugin.wake_models.wake_inputs import (
     GLAUERT_THRUST_COEFFICIENT,
@@ -83,7 +84,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
         # integrates.
         rotor = ambient.rotor
         hub_speed, cos_a, sin_a = ambient.hub_frame(hub_height)
-        column = lambda a: np.broadcast_to(a, yaw.shape)[:, 0, 0, 0]  # noqa: E731
+        column = lambda a: condition_column(a, yaw.shape[0])  # noqa: E731
         radius_f, ct_f, yaw_f, u_star = (column(a) for a in (
             radius, ct, yaw, ambient.abl.friction_velocity))
         # The centre's per-wake factors, one per condition.

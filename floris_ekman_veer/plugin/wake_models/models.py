@@ -331,11 +331,14 @@ class EkmanWakeModel(BaseModel):
         per wake and rotor reached (1-D arrays or scalars); each model defines them, as FLORIS's
         BaseModel leaves ``prepare_function`` and ``function`` to its models."""
 
-    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> np.ndarray:
+    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
+                   bound_only=False) -> np.ndarray:
         """(pairs, wake/fused.py ``WAKE_TABLE``): :meth:`kernel_table`'s columns, then
         :meth:`width_bound`, :meth:`amplitude_bound` and :meth:`centre_deficit`, per wake and
         rotor (1-D arrays ``x`` > 0, the rest per pair): what the rotor cells take of the model
-        (plugin/rotor/rotor.py) in one table."""
+        (plugin/rotor/rotor.py) in one table. With ``bound_only`` a model may leave costly
+        columns for later (``shape`` wake/fused.py DEFERRED_ORDER) where its bounds still
+        hold: the rotors kept get the exact table."""
         table = self.kernel_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed)
         table = {**table, "width_bound": self.width_bound(x, k_w, radius, ct, yaw),
                  "amplitude_bound": self.amplitude_bound(x, k_w, radius, ct, yaw),
@@ -447,11 +450,13 @@ class EkmanVeerVelocityDeficit(EkmanWakeModel):
         table["polar_veer"] = float(self.polar_angle_centre == "yaw_centre")
         return table
 
-    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed) -> np.ndarray:
+    def wake_table(self, x, k_w, radius, ct, yaw, friction_velocity, hub_speed,
+                   bound_only=False) -> np.ndarray:
         # kernel_table, width_bound and C(x) at once, compiled (wake/fused.py wake_table).
         return wake_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed, curl=self.curl,
                           near_wake=self.near_wake == "super_gaussian",
-                          polar_veer=float(self.polar_angle_centre == "yaw_centre"))
+                          polar_veer=float(self.polar_angle_centre == "yaw_centre"),
+                          bound_only=bound_only)
 
     def normalised_deficit(self, wake: TurbineWake) -> np.ndarray:
         flowing = wake.local_u > 0

@@ -194,3 +194,55 @@ def test_threads_give_the_same_bits(threads):
         numba.set_num_threads(before)
     for a, b in zip(one, many, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("option", [{"wake_superposition": "momentum_conserving"},
+                                    {"wake_turbulence": "ishihara_qian"}])
+def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
+    """The momentum-conserving superposition and Ishihara & Qian's turbulence read the wake's
+    centre at every sub-point row of the rotors reached: there the kernel returns the compiled
+    Eq. (yc_xz) at every row (wake/fused.py centre_offset, evaluated here on its own), not 0
+    at the rows its bound put out of reach; the kernel's other outputs are those without it."""
+    from floris_ekman_veer.plugin.rotor import rotor as rotor_module
+    from floris_ekman_veer.plugin.rotor.rotor_kernel import CONDITION_COLUMNS, PAIR_COLUMNS
+    from floris_ekman_veer.wake.fused import centre_offsets
+
+    config = farm_config("farm_sbl6", "ekman_veer", True, "fls", "local_turbulence", 3, 16)
+    config["wake"]["wake_velocity_parameters"]["ekman_veer"].update(option)
+    rng = np.random.default_rng(4)
+    n = 6
+    speeds, directions = rng.uniform(5.0, 13.0, n), rng.uniform(0.0, 360.0, n)
+    yaw = rng.uniform(-25.0, 25.0, (n, 16))
+    original = rotor_module.integrate_wake
+    checked = []
+
+    def checking(*arguments, every_row=False, **options):
+        # (options: the cumulative wake's row_scale, passed through)
+        wake, pair, per_condition, centre, flat, kind, rotor, wakes = arguments[:8]
+        assert every_row and centre is None
+        combined = wakes.combined.copy()
+        bounded = original(*arguments, **options)
+        wakes.combined[...] = combined
+        result = original(*arguments, every_row=True, **options)
+        for a, b in zip(bounded[:3], result[:3], strict=True):
+            np.testing.assert_array_equal(a, b)
+        reached = result[2]
+        f = (flat // rotor.x.shape[1])[reached]
+        k = kind[reached]
+        column = lambda name: per_condition[f, CONDITION_COLUMNS.index(name)][:, None]  # noqa: E731
+        u, v = rotor.kind_u[f, k], rotor.kind_v[f, k]
+        cos_a, sin_a = column("cos"), column("sin")
+        exact = centre_offsets(
+            pair[reached, PAIR_COLUMNS.index("x")][:, None], rotor.kind_heights[k],
+            u * cos_a + v * sin_a, v * cos_a - u * sin_a, column("centre_strength"),
+            column("centre_r_tube"), column("centre_image_height"), column("radius"),
+            column("friction_velocity"))
+        np.testing.assert_array_equal(result[3][reached], exact)
+        skipped = bounded[3][reached] != exact
+        assert np.all(bounded[3][reached][skipped] == 0.0)
+        checked.append(np.count_nonzero(skipped))
+        return result
+
+    monkeypatch.setattr(rotor_module, "integrate_wake", checking)
+    solve(config, speeds, directions, yaw, floris_own=False)
+    assert len(checked) > 5 and sum(checked) > 0
