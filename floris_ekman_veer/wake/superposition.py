@@ -32,12 +32,19 @@ there: with the upstream wakes' centre deficits C_i at the same x,
 U_n the rotor's incoming speed, the deficits then summed (:func:`cumulative_deficit`; the factor
 2 of Eq. 4.9 as PyWake's CumulativeWakeSum takes it, FLORIS's cc uses 1). The model's own
 single-wake momentum term K = C_T D^2 / (8 sigma^2) is taken from its C(x) (K = 1 - (1 - C)^2), so
-that without upstream wakes and U_n = U_0 the wake is the model's. Pure numpy.
+that without upstream wakes and U_n = U_0 the wake is the model's. Numpy, and Eq. 4.10 as one
+compiled ufunc that the point-wise grids call on arrays and the turbine grid's compiled sum
+(plugin/rotor/upstream_wakes.py) on numbers.
 """
 
 from __future__ import annotations
 
+import math
+
+import numba
 import numpy as np
+
+from .fused import JIT
 
 #: Wakes more than sqrt(2 * OVERLAP_EXPONENT_LIMIT) combined widths apart share nothing in
 #: :func:`overlap_weight`: lambda below 2 exp(-16) = 2.3e-7 is negligible and taken as 0 (it
@@ -80,13 +87,16 @@ def overlap_weight(sigma_squared_new, sigma_squared_old, distance_squared):
                     * np.exp(-np.minimum(exponent, OVERLAP_EXPONENT_LIMIT)), 0.0)
 
 
+@numba.vectorize(["float64(float64, float64, float64, float64, float64)"],
+                 cache=JIT["cache"])
 def cumulative_deficit(single_deficit, ambient_speed, incoming_speed, upstream, core_deficit):
     """C_n [m/s] of Bastankhah et al. (2021, Eq. 4.10, the module docstring): ``single_deficit``
     the model's C(x) / U_h of the wake alone, ``ambient_speed`` U_0, ``incoming_speed`` U_n,
     ``upstream`` sum_i lambda_ni C_i [m/s]; where the root is not real, or beyond it, the
-    potential core's ``core_deficit`` [m/s] (2a U_n), as PyWake's CumulativeWakeSum bounds it."""
+    potential core's ``core_deficit`` [m/s] (2a U_n), as PyWake's CumulativeWakeSum bounds it.
+    A ufunc: arrays broadcast."""
     momentum = 1.0 - (1.0 - single_deficit) ** 2
     a = ambient_speed - upstream
     root = a**2 - momentum * incoming_speed**2
-    deficit = a - np.sqrt(np.maximum(root, 0.0))
-    return np.where((root > 0.0) & (deficit <= core_deficit), deficit, core_deficit)
+    deficit = a - math.sqrt(max(root, 0.0))
+    return deficit if root > 0.0 and deficit <= core_deficit else core_deficit

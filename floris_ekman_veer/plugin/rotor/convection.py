@@ -7,8 +7,8 @@ The rotor cells superpose wakes point-wise at their sub-points (plugin/rotor/rot
 Zong & Porte-Agel's weights U_c,i / U_c need the combined wake's convection velocity U_c, a
 cross-plane integral that no rotor's sub-points hold. Each wake's Gaussian equivalent (centre
 deficit u_c,i, width sigma_i, centre at the rotor's plane) is kept per rotor, so that the plane
-integrals are the Gaussians' closed forms; the sub-points hold sum_i U_c,i u_i (the kernel's rule
-"momentum_conserving", a sum) and the combined wake there is that sum over U_c. Each wake step
+integrals are the Gaussians' closed forms; the sub-points hold sum_i U_c,i u_i (summed by the
+kernel's ``fls``) and the combined wake there is that sum over U_c. Each wake step
 updates U_c of the rotors it reaches and recomputes their cells' removed moment from the
 sub-points (every sub-point's combined wake changes with U_c). Numpy; no FLORIS import. The tables
 are dense, (rotors, n_turbines) per quantity: one value per kept wake (the Gaussian's centre, not

@@ -64,7 +64,7 @@ def crespo_hernandez_parameters(turbulence_model) -> tuple | None:
 
 #: Each rule's number in the compiled kernel (:func:`superposed`; 0: no rule, each wake alone).
 #: A new rule is a row here and a branch there.
-RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3, "momentum_conserving": 4}
+RULE_CODES = {None: 0, "sosfs": 1, "fls": 2, "max": 3}
 
 #: The velocity models' ``wake_superposition`` choices: FLORIS's combination model point-wise
 #: at the sub-points, or Zong & Porte-Agel's (2020) momentum-conserving weights, on FLORIS's
@@ -81,16 +81,14 @@ WAKE_OVERLAP_VELOCITY = 0.05
 def superposed(rule, old, du):
     """The combined wake velocity at a sub-point after adding ``du`` to ``old`` by the rule
     numbered ``rule`` (:data:`RULE_CODES`): sqrt(old^2 + du^2), old + du, max(old, du), or du
-    alone; for the momentum-conserving rule (4) the sum of U_c,i u_i, ``du`` being the wake's
-    deficit times its convection velocity (plugin/rotor/convection.py)."""
+    alone. (The momentum-conserving superposition sums U_c,i u_i by ``fls``, ``du`` being the
+    wake's deficit times its convection velocity: plugin/rotor/convection.py.)"""
     if rule == 1:
         return np.sqrt(old * old + du * du)
     if rule == 2:
         return old + du
     if rule == 3:
         return du if du > old else old
-    if rule == 4:
-        return old + du
     return du
 
 
@@ -185,10 +183,8 @@ class RotorWakes:
                 "increments of a sum: it needs wake.model_strings.combination_model: fls, "
                 f"got {rule!r} (docs/coupling.md#wakes-deep-in-an-array)")
         if superposition != "combination_model" and rule == "fls":
-            # (The cumulative wake is summed; with another combination, each wake is combined
-            # by it alone, as input_checks.warn_deficit_superposition says.)
-            if superposition == "momentum_conserving":
-                rule = "momentum_conserving"
+            # (Both are summed by fls; with another combination, each wake is combined by it
+            # alone, as input_checks.warn_deficit_superposition says.)
             # (the cumulative wake keeps its upstream wakes at the grid-point heights of a rotor)
             convection = (UpstreamWakes.start(pairs, cells) if superposition == "cumulative"
                           else WakeConvection.start(pairs, n_turbines))
@@ -235,7 +231,7 @@ class RotorWakes:
         total = u_cell * equivalent_deficit(removed, u_cell, moment)
         if self.rule == "sosfs":
             increment = np.sqrt(np.maximum(total**2 - self.wake[pair] ** 2, 0.0))
-        elif self.rule in ("fls", "momentum_conserving"):
+        elif self.rule == "fls":
             increment = total - self.wake[pair]
         else:  # max, or each wake alone
             increment = total

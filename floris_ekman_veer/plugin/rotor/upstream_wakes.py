@@ -29,7 +29,7 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation
 from floris_ekman_veer.wake.fused import JIT
-from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT
+from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
 GROWTH = 1.0625
@@ -116,12 +116,9 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                         upstream[q] += share * overlap_exp(-exponent[q]) * record[q]
             remaining -= BLOCK
             block = following[block]
-        momentum = 1.0 - (1.0 - single[k]) ** 2
         for q in range(n):
-            a = ambient[k] - upstream[q]
-            root = a**2 - momentum * incoming[k] ** 2
-            value = a - math.sqrt(max(root, 0.0))
-            upstream[q] = value if root > 0.0 and value <= core[k] else core[k]
+            upstream[q] = cumulative_deficit(single[k], ambient[k], incoming[k], upstream[q],
+                                             core[k])
         _to_rows(upstream, interpolation, row_deficit[k])
 
 
