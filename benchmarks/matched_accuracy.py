@@ -242,12 +242,12 @@ def speed(settings: dict, n: int, repeats: int) -> None:
                        np.arange(side) * bench_models.SPACING)
     runs = {}
     for model in ("M-1", "gauss"):
-        for p in sorted(settings[model]):
+        for p in sorted(settings.get(model, ())):  # a model --speed-only leaves out: none
             fmodel = on_grid(FlorisModel(bench_models.configuration(model, side)), p)
             fmodel.set(wind_directions=directions, wind_speeds=speeds,
                        turbulence_intensities=np.full(n, 0.06), yaw_angles=yaw)
             runs[f"{model} {p} x {p}"] = fmodel.run
-    for setting in sorted(settings["PyWake"]):
+    for setting in sorted(settings.get("PyWake", ())):
         wind_farm = bench_peers.pywake_wind_farm(pywake_rotor(setting))
         runs[f"PyWake {pywake_label(setting)}"] = (
             lambda w=wind_farm: w(x.ravel(), y.ravel(), wd=directions, ws=speeds, yaw=yaw.T,
