@@ -15,13 +15,13 @@ I_u(z_h) (studies/comparison.py). Variants:
                       it), otherwise as ``ambient``;
     array             the farm input's defaults: the upstream wakes' added turbulence summed in
                       quadrature, each waked rotor's wake scaled with its incoming speed, the
-                      wakes summed (fls) (docs/coupling.md#wakes-deep-in-an-array);
+                      cumulative wake on fls (docs/coupling.md#wakes-deep-in-an-array);
     gauss             FLORIS's gauss velocity and deflection on the same inflow and TI (sosfs),
                       for reference (FLORIS's wake expansion grows with the local TI).
 
 Prints, per atmosphere, the mean power of each row (row 1 faces the wind) relative to row 1, and
-the farm's total relative to 100 unwaked turbines. The README's "Wake expansion in farms" table
-and docs/coupling.md#wake-expansion-in-farms come from this script with its defaults.
+the farm's total relative to 100 unwaked turbines. The table of
+docs/coupling.md#wake-expansion-in-farms comes from this script with its defaults.
 """
 
 from __future__ import annotations
