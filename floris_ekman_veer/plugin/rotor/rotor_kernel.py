@@ -53,6 +53,7 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
                kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
                combined, block, track, row_scale, removed, overlap, reached, first, stride):
     per_row = row_scale.shape[0] > 0
+    exponents = np.empty(sub_y.shape[1])
     for k in range(wake.shape[0]):
         if not in_share(k, first, stride):
             continue
@@ -63,7 +64,6 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
          ground_image) = per_condition[f]
         reach = 4.0 * radius
-        exponents = np.empty(sub_y.shape[1])
         area = 0.0
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
