@@ -1,8 +1,8 @@
-"""The threads a wake step's compiled passes over its rotors run on
+"""The threads a wake step's compiled pass over its rotors runs on
 (docs/performance.md#threads).
 
-A pass (the rotor-cell kernel, plugin/rotor/rotor_kernel.py; the cumulative wake's upstream sums,
-plugin/rotor/upstream_wakes.py) is a compiled function that releases the GIL (``nogil``) and takes
+A pass (the rotor-cell kernel, plugin/rotor/rotor_kernel.py) is a compiled function that
+releases the GIL (``nogil``) and takes
 its share of the rotors as its last two arguments, ``first`` and ``stride``: the blocks of
 ROTOR_BLOCK consecutive rotors first, first + stride, ... (block-cyclic: each thread gets near
 and far rotors alike, and threads write to different cache lines). :func:`split_over_threads`

@@ -28,7 +28,6 @@ import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation
-from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
 from floris_ekman_veer.wake.fused import JIT
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
@@ -74,10 +73,10 @@ def overlap_exp(x):
     return EXP_TABLE[int(step)] * value
 
 
-@numba.njit(nogil=True, **JIT)
+@numba.njit(**JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, head, following, count, kept, deficit,
-                         row_deficit, first, stride):
+                         row_deficit):
     """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the n grid-point heights
     into ``deficit`` (k, n) and interpolated to the rows into ``row_deficit`` (k, rows): the
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
@@ -86,14 +85,11 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     ``overlap_weight``, ``cumulative_deficit``; exp to round-off, ``overlap_exp``), then the
     rows' values as the centre's, sum_q C_n(z_q) interpolation[q, r] (rotor_cells.
     row_interpolation, summed over the points in order). An entry whose overlap exponent is
-    beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no exp. The new wakes
-    of share ``first`` of ``stride`` (plugin/rotor/rotor_threads.py)."""
+    beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no exp."""
     n = deficit.shape[1]
     new_points = np.empty(n)
     exponent = np.empty(n)
     for k in range(rotor.size):
-        if not in_share(k, first, stride):
-            continue
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
         upstream = deficit[k]
@@ -233,8 +229,7 @@ class UpstreamWakes:
         n, rows = self.interpolation.shape
         deficit = np.empty((np.size(rotor), n))
         row_deficit = np.empty((np.size(rotor), rows))
-        split_over_threads(
-            _cumulative_deficits, np.size(rotor),
+        _cumulative_deficits(
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
