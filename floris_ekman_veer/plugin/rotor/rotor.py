@@ -265,7 +265,8 @@ def reached_rotor_cell_deficit(
         incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
         deficit, row_scale = wakes.convection.deficits(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
-            incoming_speed, model.core_deficit(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
+            incoming_speed,
+            model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
@@ -417,11 +418,11 @@ def _check_resolution(x, f, j, reached, source_wake, centre, rotor):
     k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
     # The wake's width k_w x + 0.4 R sqrt(A*) cos(yaw): its second term once per condition.
     initial_width = WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
-    f, j, centre = f[reached], j[reached], centre[reached]
+    f, j = f[reached], j[reached]
     width = k_w[f] * x[reached] + initial_width[f]
     radius_j = rotor.radius[f, j]
     height = radius_j * (cells.row_z[-1] - cells.row_z[0])
-    shear = np.abs(centre[:, -1] - centre[:, 0]) / height
+    shear = np.abs(centre[reached, -1] - centre[reached, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)
     spacing = 2.0 * radius_j / cells.rows
     if np.any(thickness < MIN_BAND_PER_ROW * spacing):
