@@ -297,9 +297,11 @@ def reached_rotor_cell_deficit(
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
     _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
-    u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
-    result[f[reached], j[reached]] = wakes.cell_returns(
-        flat[reached], removed[reached], u_cell, moment[reached][:, None])
+    # (The rotors' cells by flat index: one index array, not two.)
+    rows = flat[reached]
+    u_cell = u_initial.reshape(n_findex * n_turbines, -1).take(rows, axis=0)
+    result.reshape(n_findex * n_turbines, -1)[rows] = wakes.cell_returns(
+        rows, removed[reached], u_cell, moment[reached][:, None])
     if ishihara_qian:
         added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
                                rotor, f[reached], j[reached], kind[reached],
