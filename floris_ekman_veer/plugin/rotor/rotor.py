@@ -215,10 +215,13 @@ def reached_rotor_cell_deficit(
     reach = (points, rotor, column(y_i), column(hub_height_i), NEGLIGIBLE_DEFICIT,
              WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"], speed_fraction)
     near, pair = near_pairs(f, j, x_pair, table, *reach)
-    if np.any(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER):
-        # The exact table of the rotors the bound kept, and those it reaches (a subset).
-        f, j, x_pair = f[near], j[near], x_pair[near]
-        table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+    deferred = np.flatnonzero(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER)
+    if deferred.size:
+        # The exact table of the rotors the bound kept (its other rows are exact already:
+        # only the deferred ones are evaluated again), and those it reaches (a subset).
+        f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
+        table[deferred] = model.wake_table(x_pair[deferred],
+                                           *(v[f[deferred]] for v in source_wake.values()))
         near, pair = near_pairs(f, j, x_pair, table, *reach)
     if near.size == 0:
         return result.reshape(u_initial.shape), _NONE
