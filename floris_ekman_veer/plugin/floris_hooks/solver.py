@@ -115,10 +115,13 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
     ambient_turbulence_intensities = flow_field.turbulence_intensities.copy()[:, None, None, None]
     crespo_parameters = crespo_hernandez_parameters(model_manager.turbulence_model)
 
+    # FLORIS's x_i, y_i, z_i: the mean of each rotor's points, for every turbine at once (each
+    # rotor's points summed in the same order as one turbine's slice: the same bits).
+    centres = [np.mean(a, axis=(2, 3), keepdims=True)
+               for a in (grid.x_sorted, grid.y_sorted, grid.z_sorted)]
+
     for i in range(n_turbines):
-        x_i = np.mean(grid.x_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
-        y_i = np.mean(grid.y_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
-        z_i = np.mean(grid.z_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
+        x_i, y_i, z_i = (centre[:, i:i+1] for centre in centres)
         # (FLORIS's axial induction computes the thrust coefficient again: shared, the same bits.)
         with sharing_thrust():
             ct_i = _turbine_operation(thrust_coefficient, farm, flow_field, grid, i,
