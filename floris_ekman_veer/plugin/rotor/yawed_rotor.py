@@ -142,16 +142,20 @@ def veer_aware_operation(original, kind):
     is FLORIS's own, bitwise. Inside :func:`sharing_thrust` a thrust coefficient is computed
     once per set of arguments."""
     signature = inspect.signature(original)
+    parameters = {name for name, p in signature.parameters.items()
+                  if p.kind is not inspect.Parameter.VAR_KEYWORD}
 
     @functools.wraps(original)
     def wrapper(*args, **kwargs):
-        arguments = signature.bind(*args, **kwargs).arguments
+        # FLORIS passes keywords only: then they are the arguments as they are (the names
+        # the model does not declare go to its ``**_``).
+        arguments = signature.bind(*args, **kwargs).arguments if args else kwargs
         shared = _SHARED_THRUST.get() if kind == "thrust" else None
         if shared is None:
             return _veer_aware(original, kind, arguments)
-        # The result depends on the named arguments (``_`` the model discards) and the
-        # crossflow look-up the call sees.
-        named = {k: v for k, v in arguments.items() if k != "_"}
+        # The result depends on the named arguments (those in ``_`` the model discards) and
+        # the crossflow look-up the call sees.
+        named = {k: v for k, v in arguments.items() if k in parameters}
         named["crossflow"] = CROSSFLOW.get()
         for function, earlier, result in shared:
             if function is original and _equal_arguments(named, earlier):
@@ -164,7 +168,7 @@ def veer_aware_operation(original, kind):
 
 
 def _veer_aware(original, kind, arguments):
-    """:func:`veer_aware_operation`'s call of ``original`` with its bound ``arguments``."""
+    """:func:`veer_aware_operation`'s call of ``original`` with its ``arguments`` by name."""
     arguments = dict(arguments)
     extra = arguments.pop("_", {})
     if not np.any(arguments["yaw_angles"]):
