@@ -7,20 +7,18 @@ deficit of Eq. (du_model) (wake/fused.py ``point_deficit``, the per-height facto
 ``curl_polynomial`` once per row), its superposition on the wakes so far by FLORIS's rule and
 the moment it removes (plugin/rotor/rotor_wakes.py ``superposed``, ``removed_moment``), the sums over
 the rotor cells and the wake's overlap as the area of the disk (FLORIS's count, or the part
-inside the wake radius). The rotors run in parallel
-(numba's ``prange``, on numba's threads: NUMBA_NUM_THREADS, all cores by default); each rotor's
-sums run in the same order on any thread, so the results are the same bit for bit with 1 or N
-threads. Compiled once per installation (``cache=True``, wake/fused.py ``JIT``).
+inside the wake radius). The rotors are shared among threads
+(plugin/rotor/rotor_threads.py); each rotor's sums run in the same order on any thread, so the
+results are the same bit for bit with 1 or N threads. Compiled once per installation
+(``cache=True``, wake/fused.py ``JIT``).
 """
 
 from __future__ import annotations
 
-import os
-import threading
-
 import numba
 import numpy as np
 
+from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
 from floris_ekman_veer.wake.fused import (
@@ -50,22 +48,15 @@ CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
                      *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
-#: numba's threading layer where the user has not chosen one: one that survives a fork
-#: (FLORIS's ParFlorisModel forks workers; GNU OpenMP's pool does not survive it).
-if "NUMBA_THREADING_LAYER" not in os.environ:
-    numba.config.THREADING_LAYER = "forksafe"
-
-#: One parallel kernel at a time per process: numba's fork-safe workqueue layer is not
-#: thread-safe, and solves in several threads of a process (a Dask worker's) would share it.
-_LAUNCH = threading.Lock()
-
-
-@numba.njit(parallel=True, **JIT)
+@numba.njit(nogil=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
                kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
-               combined, block, track, row_scale, removed, overlap, reached):
+               combined, block, track, row_scale, removed, overlap, reached, first, stride):
     per_row = row_scale.shape[0] > 0
-    for k in numba.prange(wake.shape[0]):
+    exponents = np.empty(sub_y.shape[1])
+    for k in range(wake.shape[0]):
+        if not in_share(k, first, stride):
+            continue
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
         strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
         x, offset, radius_j, moment, reach_squared, overlap_edge, scale = pair[k]
@@ -73,7 +64,6 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         (cos_a, sin_a, u_star, radius, hub_height, strength_c, r_tube, image_height, veer,
          ground_image) = per_condition[f]
         reach = 4.0 * radius
-        exponents = np.empty(sub_y.shape[1])
         area = 0.0
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
@@ -245,13 +235,12 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     reached = np.zeros(n_pairs, dtype=bool)
     compute_centre = centre is None
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
-    with _LAUNCH:
-        _integrate(np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-                   np.ascontiguousarray(per_condition), compute_centre, bool(every_row), centre,
-                   flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
-                   rotor.kind_heights, cells.row_chord, cells.sub_y, cells.weight,
-                   cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined,
-                   flat * cells.rows, bool(track),
-                   np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale),
-                   removed, overlap, reached)
+    split_over_threads(
+        _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
+        np.ascontiguousarray(per_condition), compute_centre, bool(every_row), centre,
+        flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
+        cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid, cells.row_width,
+        wakes.rule_code, wakes.combined, flat * cells.rows, bool(track),
+        np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), removed,
+        overlap, reached)
     return removed, overlap, reached, centre
