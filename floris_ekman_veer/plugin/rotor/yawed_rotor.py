@@ -153,8 +153,8 @@ def veer_aware_operation(original, kind):
         shared = _SHARED_THRUST.get() if kind == "thrust" else None
         if shared is None:
             return _veer_aware(original, kind, arguments)
-        # The result depends on the named arguments (those in ``_`` the model discards) and
-        # the crossflow look-up the call sees.
+        # The result depends on the arguments the model declares (not on those its ``**_``
+        # discards) and on the crossflow look-up the call sees.
         named = {k: v for k, v in arguments.items() if k in parameters}
         named["crossflow"] = CROSSFLOW.get()
         for function, earlier, result in shared:
