@@ -69,6 +69,11 @@ def initial_radius(radius, ct, yaw) -> np.ndarray:
     return positive(radius, "radius") * np.sqrt(stream_tube_area_ratio(ct, yaw))
 
 
+def _tube_radius(radius, root) -> np.ndarray:
+    """:func:`initial_radius` from the momentum root (:func:`_momentum_root`)."""
+    return radius * np.sqrt(_area_ratio(root))
+
+
 # --------------------------------------------------------------------------------------------
 # Momentum theory of the yawed rotor
 # --------------------------------------------------------------------------------------------
@@ -82,8 +87,12 @@ def stream_tube_area_ratio(ct, yaw):
     Parameters: ``ct`` un-yawed C_T in [0, 1); ``yaw`` beta in (-pi/2, pi/2) rad. A* >= 1, = 1 at
     C_T = 0.
     """
-    s = _momentum_root(ct, yaw)
-    return (1.0 + s) / (2.0 * s)
+    return _area_ratio(_momentum_root(ct, yaw))
+
+
+def _area_ratio(root):
+    """A* of Eq. (A_star) from the momentum root s = sqrt(1 - C_T cos^2 beta)."""
+    return (1.0 + root) / (2.0 * root)
 
 
 def axial_induction(ct, yaw):
@@ -92,8 +101,12 @@ def axial_induction(ct, yaw):
     Evaluated in the algebraically identical form C_T cos^2 beta / (2 (1 + sqrt(...))), which keeps
     full relative precision for small C_T (the printed form loses it to cancellation).
     """
-    s = _momentum_root(ct, yaw)
-    return np.asarray(ct) * np.cos(yaw) ** 2 / (2.0 * (1.0 + s))
+    return _induction(ct, yaw, _momentum_root(ct, yaw))
+
+
+def _induction(ct, yaw, root):
+    """a of Eq. (ind_factor) from the momentum root (:func:`axial_induction`'s form)."""
+    return np.asarray(ct) * np.cos(yaw) ** 2 / (2.0 * (1.0 + root))
 
 
 # --------------------------------------------------------------------------------------------
@@ -110,7 +123,12 @@ def sigma_tilde_squared(x, k_w, radius, ct, yaw):
     """
     x = np.asarray(x, dtype=float)
     k_w = positive(k_w, "k_w")
-    width0 = WIDTH_FACTOR * initial_radius(radius, ct, yaw)
+    return _width_product(x, k_w, initial_radius(radius, ct, yaw), yaw)
+
+
+def _width_product(x, k_w, r_tube, yaw):
+    """sigma_tilde^2 of Eq. (sigma_tilde) from the stream tube's radius R sqrt(A*)."""
+    width0 = WIDTH_FACTOR * r_tube
     return (k_w * x + width0) * (k_w * x + width0 * np.cos(yaw))
 
 
@@ -131,7 +149,11 @@ def potential_core_length(k_w, radius, ct, yaw):
     """
     k_w = positive(k_w, "k_w")
     radius = positive(radius, "radius")
-    r_tube = initial_radius(radius, ct, yaw)
+    return _core_length(k_w, radius, initial_radius(radius, ct, yaw), yaw)
+
+
+def _core_length(k_w, radius, r_tube, yaw):
+    """x0 of Eq. (x0_transition) from the stream tube's radius R sqrt(A*)."""
     cos_b = np.cos(yaw)
     root = np.sqrt(r_tube**2 * (1.0 - cos_b) ** 2 + 12.5 * radius**2 * cos_b)
     return (root + r_tube * (1.0 - cos_b) - 2.0 * r_tube) / (5.0 * k_w)
@@ -149,15 +171,20 @@ def max_deficit(x, k_w, radius, ct, yaw):
     """
     x = np.asarray(x, dtype=float)
     radius = positive(radius, "radius")
-    x0 = potential_core_length(k_w, radius, ct, yaw)
+    k_w = positive(k_w, "k_w")
+    # Momentum theory once for x0, sigma_tilde and 2a (the same operations as
+    # potential_core_length, sigma_tilde_squared and axial_induction).
+    root = _momentum_root(ct, yaw)
+    r_tube = _tube_radius(radius, root)
+    x0 = _core_length(k_w, radius, r_tube, yaw)
     # The decaying branch is real only for x >= x0; evaluate it there and nowhere else.
     x_decay = np.maximum(x, x0)
     q = np.asarray(ct) * np.cos(yaw) ** 3 * radius**2 / (
-        2.0 * sigma_tilde_squared(x_decay, k_w, radius, ct, yaw)
+        2.0 * _width_product(x_decay, k_w, r_tube, yaw)
     )
     # Analytically 1 - q >= 1 - C_T cos^2 beta > 0 for x >= x0; the floor absorbs rounding only.
     decay = q / (1.0 + np.sqrt(np.maximum(1.0 - q, 0.0)))
-    return np.where(x <= x0, 2.0 * axial_induction(ct, yaw), decay)
+    return np.where(x <= x0, 2.0 * _induction(ct, yaw, root), decay)
 
 
 # --------------------------------------------------------------------------------------------

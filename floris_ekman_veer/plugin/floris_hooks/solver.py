@@ -45,6 +45,7 @@ from floris_ekman_veer.plugin.inflow.ambient import is_rotor_grid
 from floris_ekman_veer.plugin.rotor import turbine_states
 from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE, condition_column
 from floris_ekman_veer.plugin.rotor.rotor_wakes import crespo_hernandez_parameters
+from floris_ekman_veer.plugin.rotor.yawed_rotor import sharing_thrust
 from floris_ekman_veer.plugin.wake_models.models import EkmanWakeModel
 from floris_ekman_veer.wake.added_turbulence import crespo_hernandez_overlap
 
@@ -93,9 +94,15 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
     deficit_model_args = model_manager.velocity_model.prepare_function(grid, flow_field)
 
     u_initial = flow_field.u_initial_sorted
-    wake_field = np.zeros_like(u_initial)
+    wake_field = np.zeros_like(u_initial, order="C")
     flow_field.u_sorted = u_initial - wake_field
     n_findex, n_turbines, n_y, n_z = u_initial.shape
+    # The rotors' points by flat rotor index (condition * n_turbines + turbine): the gathers
+    # of a step's rotors read these (one index array, not two).
+    by_rotor = lambda a: np.reshape(a, (n_findex * n_turbines, n_y, n_z))  # noqa: E731
+    u_initial_rotors, x_rotors, y_rotors = (by_rotor(a) for a in (u_initial, grid.x_sorted,
+                                                                   grid.y_sorted))
+    wake_rotors = by_rotor(wake_field)  # a view: the step's updates are written through it
 
     # As FLORIS: per turbine, or per rotor point with the turbulence grid; FLORIS's first
     # update makes it per rotor point in any case (its wake-added turbulence is a grid field).
@@ -108,16 +115,21 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
     ambient_turbulence_intensities = flow_field.turbulence_intensities.copy()[:, None, None, None]
     crespo_parameters = crespo_hernandez_parameters(model_manager.turbulence_model)
 
+    # FLORIS's x_i, y_i, z_i: the mean of each rotor's points, for every turbine at once (each
+    # rotor's points summed in the same order as one turbine's slice: the same bits).
+    centres = [np.mean(a, axis=(2, 3), keepdims=True)
+               for a in (grid.x_sorted, grid.y_sorted, grid.z_sorted)]
+
     for i in range(n_turbines):
-        x_i = np.mean(grid.x_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
-        y_i = np.mean(grid.y_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
-        z_i = np.mean(grid.z_sorted[:, i:i+1], axis=(2, 3), keepdims=True)
-        ct_i = _turbine_operation(thrust_coefficient, farm, flow_field, grid, i,
-                                  "thrust_coefficient_functions",
-                                  farm.turbine_thrust_coefficient_functions)
-        axial_induction_i = _turbine_operation(axial_induction, farm, flow_field, grid, i,
-                                               "axial_induction_functions",
-                                               farm.turbine_axial_induction_functions)
+        x_i, y_i, z_i = (centre[:, i:i+1] for centre in centres)
+        # (FLORIS's axial induction computes the thrust coefficient again: shared, the same bits.)
+        with sharing_thrust():
+            ct_i = _turbine_operation(thrust_coefficient, farm, flow_field, grid, i,
+                                      "thrust_coefficient_functions",
+                                      farm.turbine_thrust_coefficient_functions)
+            axial_induction_i = _turbine_operation(axial_induction, farm, flow_field, grid, i,
+                                                   "axial_induction_functions",
+                                                   farm.turbine_axial_induction_functions)
         turbulence_intensity_i = turbine_turbulence_intensity[:, i:i+1]
         yaw_angle_i = farm.yaw_angles_sorted[:, i:i+1, None, None]
         hub_height_i = farm.hub_heights_sorted[:, i:i+1, None, None]
@@ -141,6 +153,7 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         if i == 0:
             turbine_turbulence_intensity = np.broadcast_to(
                 turbine_turbulence_intensity, u_initial.shape).copy()
+            turbulence_rotors = by_rotor(turbine_turbulence_intensity)  # a view, as wake_rotors
         # The rotors (f, j) turbine i's wake reaches: elsewhere FLORIS's update is the identity
         # (the model's list of them where it gives one: a rotor in it whose deficit is 0 is
         # left as it is by the update, bit for bit).
@@ -151,10 +164,13 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
                                      axis=2))
         if f.size == 0:
             continue
-        deficit = velocity_deficit[f, j] * u_initial[f, j]  # (pairs, n, n)
-        wake_field[f, j] = model_manager.combination_model.function(wake_field[f, j], deficit)
+        rotors = f * n_turbines + j
+        u_initial_fj = u_initial_rotors.take(rotors, axis=0)
+        deficit = by_rotor(velocity_deficit).take(rotors, axis=0) * u_initial_fj  # (pairs, n, n)
+        wake_rotors[rotors] = model_manager.combination_model.function(
+            wake_rotors.take(rotors, axis=0), deficit)
 
-        flow_field.u_sorted[f, j] = u_initial[f, j] - wake_field[f, j]
+        flow_field.u_sorted[f, j] = u_initial_fj - wake_rotors.take(rotors, axis=0)
 
         # Wake-added turbulence where the wake overlaps a rotor (elsewhere FLORIS adds 0).
         area_overlap = (np.sum(deficit > 0.05, axis=(1, 2))
@@ -162,8 +178,8 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         hit = np.flatnonzero(area_overlap)
         if hit.size == 0:
             continue
-        f, j, area_overlap = f[hit], j[hit], area_overlap[hit, None, None]
-        x = grid.x_sorted[f, j]
+        f, j, rotors, area_overlap = f[hit], j[hit], rotors[hit], area_overlap[hit, None, None]
+        x = x_rotors.take(rotors, axis=0)
         per_pair = lambda a: condition_column(a, n_findex)[f, None, None]  # noqa: E731
         x_source, diameter = per_pair(x_i), per_pair(rotor_diameter_i)
         ambient = ambient_turbulence_intensities[f, 0]
@@ -172,7 +188,7 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
             # (wake/added_turbulence.py).
             ti_added = crespo_hernandez_overlap(
                 ambient, x.reshape(f.size, -1), x_source, diameter, per_pair(axial_induction_i),
-                area_overlap, crespo_parameters, grid.y_sorted[f, j].reshape(f.size, -1),
+                area_overlap, crespo_parameters, y_rotors.take(rotors, axis=0).reshape(f.size, -1),
                 per_pair(y_i)).reshape(x.shape)
         else:
             ti_added = (
@@ -181,11 +197,11 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
                     ambient, x, x_source, diameter, per_pair(axial_induction_i),
                 ), posinf=0.0)
                 * (x > x_source)
-                * (np.abs(per_pair(y_i) - grid.y_sorted[f, j]) < 2 * diameter)
+                * (np.abs(per_pair(y_i) - y_rotors.take(rotors, axis=0)) < 2 * diameter)
                 * (x <= 15 * diameter + x_source)
             )
-        turbine_turbulence_intensity[f, j] = np.maximum(
-            np.sqrt(ti_added**2 + ambient**2), turbine_turbulence_intensity[f, j])
+        turbulence_rotors[rotors] = np.maximum(
+            np.sqrt(ti_added**2 + ambient**2), turbulence_rotors.take(rotors, axis=0))
 
     flow_field.turbulence_intensity_field_sorted = turbine_turbulence_intensity
     if model_manager.enable_turbine_turbulence_grid:

@@ -215,10 +215,13 @@ def reached_rotor_cell_deficit(
     reach = (points, rotor, column(y_i), column(hub_height_i), NEGLIGIBLE_DEFICIT,
              WAKE_OVERLAP_VELOCITY, edge_factor, source_wake["hub_speed"], speed_fraction)
     near, pair = near_pairs(f, j, x_pair, table, *reach)
-    if np.any(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER):
-        # The exact table of the rotors the bound kept, and those it reaches (a subset).
-        f, j, x_pair = f[near], j[near], x_pair[near]
-        table = model.wake_table(x_pair, *(v[f] for v in source_wake.values()))
+    deferred = np.flatnonzero(table[near, WAKE_TABLE.index("shape")] == DEFERRED_ORDER)
+    if deferred.size:
+        # The exact table of the rotors the bound kept (its other rows are exact already:
+        # only the deferred ones are evaluated again), and those it reaches (a subset).
+        f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
+        table[deferred] = model.wake_table(x_pair[deferred],
+                                           *(v[f[deferred]] for v in source_wake.values()))
         near, pair = near_pairs(f, j, x_pair, table, *reach)
     if near.size == 0:
         return result.reshape(u_initial.shape), _NONE
@@ -265,7 +268,8 @@ def reached_rotor_cell_deficit(
         incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
         deficit, row_scale = wakes.convection.deficits(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
-            incoming_speed, model.core_deficit(per_pair["ct"], per_pair["yaw"]) * incoming_speed)
+            incoming_speed,
+            model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
@@ -296,9 +300,11 @@ def reached_rotor_cell_deficit(
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
     _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
-    u_cell = u_initial.reshape(n_findex, n_turbines, -1)[f[reached], j[reached]]
-    result[f[reached], j[reached]] = wakes.cell_returns(
-        flat[reached], removed[reached], u_cell, moment[reached][:, None])
+    # (The rotors' cells by flat index: one index array, not two.)
+    rows = flat[reached]
+    u_cell = u_initial.reshape(n_findex * n_turbines, -1).take(rows, axis=0)
+    result.reshape(n_findex * n_turbines, -1)[rows] = wakes.cell_returns(
+        rows, removed[reached], u_cell, moment[reached][:, None])
     if ishihara_qian:
         added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
                                rotor, f[reached], j[reached], kind[reached],
@@ -417,11 +423,11 @@ def _check_resolution(x, f, j, reached, source_wake, centre, rotor):
     k_w, radius, ct, yaw = (source_wake[k] for k in ("k_w", "radius", "ct", "yaw"))
     # The wake's width k_w x + 0.4 R sqrt(A*) cos(yaw): its second term once per condition.
     initial_width = WIDTH_FACTOR * radius * np.sqrt(stream_tube_area_ratio(ct, yaw)) * np.cos(yaw)
-    f, j, centre = f[reached], j[reached], centre[reached]
+    f, j = f[reached], j[reached]
     width = k_w[f] * x[reached] + initial_width[f]
     radius_j = rotor.radius[f, j]
     height = radius_j * (cells.row_z[-1] - cells.row_z[0])
-    shear = np.abs(centre[:, -1] - centre[:, 0]) / height
+    shear = np.abs(centre[reached, -1] - centre[reached, 0]) / height
     thickness = width / np.sqrt(1.0 + shear**2)
     spacing = 2.0 * radius_j / cells.rows
     if np.any(thickness < MIN_BAND_PER_ROW * spacing):

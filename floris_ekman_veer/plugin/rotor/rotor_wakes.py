@@ -226,13 +226,13 @@ class RotorWakes:
         (pairs, n^2)."""
         removed = self.cells.n**2 * removed
         if self.rule is not None:
-            removed += self.removed[pair]
+            removed += self.removed.take(pair, axis=0)
             self.removed[pair] = removed
         total = u_cell * equivalent_deficit(removed, u_cell, moment)
         if self.rule == "sosfs":
-            increment = np.sqrt(np.maximum(total**2 - self.wake[pair] ** 2, 0.0))
+            increment = np.sqrt(np.maximum(total**2 - self.wake.take(pair, axis=0) ** 2, 0.0))
         elif self.rule == "fls":
-            increment = total - self.wake[pair]
+            increment = total - self.wake.take(pair, axis=0)
         else:  # max, or each wake alone
             increment = total
         if self.rule is not None:
@@ -255,5 +255,5 @@ class RotorWakes:
         velocity in the wakes superposed so far, U_k - U_k d_k, over that of the inflow U_k
         (``u_cell``, (pairs, n^2)); 1 for a rotor no wake has reached."""
         ambient = u_cell.sum(axis=1)
-        waked = self.wake[pair].sum(axis=1)
+        waked = self.wake.take(pair, axis=0).sum(axis=1)
         return 1.0 - waked / np.where(ambient > 0.0, ambient, 1.0)

@@ -32,6 +32,7 @@ not V. FLORIS allows one definition per ``turbine_type`` name, so the V cells ar
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import inspect
 
@@ -97,36 +98,98 @@ def thrust_veer_ratio(velocities, crossflow, yaw_angles, average_method="cubic-m
     )
 
 
+#: The thrust coefficients computed inside :func:`sharing_thrust`, (function, its named
+#: arguments and the crossflow look-up, result) per call; None outside it.
+_SHARED_THRUST: contextvars.ContextVar = contextvars.ContextVar("shared_thrust", default=None)
+
+
+@contextlib.contextmanager
+def sharing_thrust():
+    """One step of FLORIS's sequential solver asks for turbine i's thrust coefficient, then for
+    its axial induction, which FLORIS's cosine-loss model derives from the thrust coefficient
+    it computes again from the same arguments. Inside this context a thrust coefficient is
+    computed once per set of arguments and the later call with equal arguments gets the same
+    array (the same bits, half the thrust's cost per step)."""
+    token = _SHARED_THRUST.set([])
+    try:
+        yield
+    finally:
+        _SHARED_THRUST.reset(token)
+
+
+def _equal_arguments(a, b) -> bool:
+    """Whether two calls' named arguments are equal: the same objects (tables, interpolants,
+    the crossflow) or arrays with equal values."""
+    if a.keys() != b.keys():
+        return False
+    for name, value in a.items():
+        other = b[name]
+        if value is other:
+            continue
+        if isinstance(value, np.ndarray) and isinstance(other, np.ndarray):
+            if value.shape != other.shape or not np.array_equal(value, other):
+                return False
+        elif isinstance(value, str) and isinstance(other, str):
+            if value != other:
+                return False
+        else:
+            return False
+    return True
+
+
 def veer_aware_operation(original, kind):
     """Wrap a cosine-loss static method (``kind``: "power" or "thrust"): without a crossflow it
-    is FLORIS's own, bitwise."""
+    is FLORIS's own, bitwise. Inside :func:`sharing_thrust` a thrust coefficient is computed
+    once per set of arguments."""
     signature = inspect.signature(original)
+    parameters = {name for name, p in signature.parameters.items()
+                  if p.kind is not inspect.Parameter.VAR_KEYWORD}
 
     @functools.wraps(original)
     def wrapper(*args, **kwargs):
-        arguments = signature.bind(*args, **kwargs).arguments
-        extra = arguments.pop("_", {})
-        if not np.any(arguments["yaw_angles"]):
-            # The ratios are exactly 1 on un-yawed rotors (veer_ratio): the rotor cells' V
-            # moments, the hook's largest cost on small farms with many conditions, are not
-            # needed where no rotor of the batch is yawed.
-            return original(*args, **kwargs)
-        velocities = np.asarray(arguments["velocities"], dtype=float)
-        crossflow = ambient_crossflow(arguments["power_thrust_table"], velocities)
-        if crossflow is None:
-            return original(*args, **kwargs)
-        common = (velocities, crossflow, arguments["yaw_angles"],
-                  arguments.get("average_method", "cubic-mean"),
-                  arguments.get("cubature_weights"))
-        if kind == "power":
-            ratio = power_veer_ratio(*common)
-            arguments["velocities"] = velocities * ratio[(...,) + (None,) * (velocities.ndim - 2)]
-            return original(**arguments, **extra)
-        cosine_law = original(**arguments, **extra)
-        return bounded_thrust(cosine_law * thrust_veer_ratio(*common), cosine_law,
-                              arguments["yaw_angles"])
+        # FLORIS passes keywords only: then they are the arguments as they are (the names
+        # the model does not declare go to its ``**_``).
+        arguments = signature.bind(*args, **kwargs).arguments if args else kwargs
+        shared = _SHARED_THRUST.get() if kind == "thrust" else None
+        if shared is None:
+            return _veer_aware(original, kind, arguments)
+        # The result depends on the arguments the model declares (not on those its ``**_``
+        # discards) and on the crossflow look-up the call sees.
+        named = {k: v for k, v in arguments.items() if k in parameters}
+        named["crossflow"] = CROSSFLOW.get()
+        for function, earlier, result in shared:
+            if function is original and _equal_arguments(named, earlier):
+                return result
+        result = _veer_aware(original, kind, arguments)
+        shared.append((original, named, result))
+        return result
 
     return wrapper
+
+
+def _veer_aware(original, kind, arguments):
+    """:func:`veer_aware_operation`'s call of ``original`` with its ``arguments`` by name."""
+    arguments = dict(arguments)
+    extra = arguments.pop("_", {})
+    if not np.any(arguments["yaw_angles"]):
+        # The ratios are exactly 1 on un-yawed rotors (veer_ratio): the rotor cells' V
+        # moments, the hook's largest cost on small farms with many conditions, are not
+        # needed where no rotor of the batch is yawed.
+        return original(**arguments, **extra)
+    velocities = np.asarray(arguments["velocities"], dtype=float)
+    crossflow = ambient_crossflow(arguments["power_thrust_table"], velocities)
+    if crossflow is None:
+        return original(**arguments, **extra)
+    common = (velocities, crossflow, arguments["yaw_angles"],
+              arguments.get("average_method", "cubic-mean"),
+              arguments.get("cubature_weights"))
+    if kind == "power":
+        ratio = power_veer_ratio(*common)
+        arguments["velocities"] = velocities * ratio[(...,) + (None,) * (velocities.ndim - 2)]
+        return original(**arguments, **extra)
+    cosine_law = original(**arguments, **extra)
+    return bounded_thrust(cosine_law * thrust_veer_ratio(*common), cosine_law,
+                          arguments["yaw_angles"])
 
 
 #: FLORIS's cosine-loss model clips the table's C_T to [0.0001, 0.9999] before it multiplies by

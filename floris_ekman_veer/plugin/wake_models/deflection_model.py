@@ -53,7 +53,13 @@ class EkmanVeerVelocityDeflection(BaseModel):
     from_dict = classmethod(from_input_block)
 
     def prepare_function(self, grid: Grid, flow_field: FlowField) -> dict[str, Any]:
-        return {"x": grid.x_sorted, "z": grid.z_sorted, "ambient": Ambient.of(grid, flow_field)}
+        ambient = Ambient.of(grid, flow_field)
+        # Turbine grid: the heights of the grid's point rows (the centre depends on height
+        # only), contiguous once per solve rather than at every turbine's call.
+        heights = (np.ascontiguousarray(grid.z_sorted[:, :, 0, :], dtype=float)
+                   if ambient.rotor is not None else None)
+        return {"x": grid.x_sorted, "z": grid.z_sorted, "ambient": ambient,
+                "point_heights": heights}
 
     def function(
         self,
@@ -67,6 +73,7 @@ class EkmanVeerVelocityDeflection(BaseModel):
         x: np.ndarray,
         z: np.ndarray,
         ambient: Ambient,
+        point_heights: np.ndarray | None = None,
     ) -> np.ndarray:
         hub_height = ambient.hub_height_at(x_i, y_i)
         # Without the vortex pair the yaw term vanishes: the offset is that of an unyawed rotor.
@@ -94,7 +101,8 @@ class EkmanVeerVelocityDeflection(BaseModel):
                  "ground_image": float(self.ground_image)}
         # The compiled centre of the rotor-cell kernel (wake/fused.py centre_offset).
         points = centre_points(
-            rotor.x - x_i[:, 0, 0], z[:, :, 0, :], ambient.u[:, :, 0, :],
+            rotor.x - x_i[:, 0, 0], z[:, :, 0, :] if point_heights is None else point_heights,
+            ambient.u[:, :, 0, :],
             ambient.v[:, :, 0, :], column(cos_a), column(sin_a), table["strength"],
             table["r_tube"], table["image_height"], radius_f, u_star, self.veer,
             self.ground_image)

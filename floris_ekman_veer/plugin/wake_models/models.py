@@ -338,7 +338,8 @@ class EkmanWakeModel(BaseModel):
         rotor (1-D arrays ``x`` > 0, the rest per pair): what the rotor cells take of the model
         (plugin/rotor/rotor.py) in one table. With ``bound_only`` a model may leave costly
         columns for later (``shape`` wake/fused.py DEFERRED_ORDER) where its bounds still
-        hold: the rotors kept get the exact table."""
+        hold, its other rows exact: the deferred rows of the rotors kept are evaluated
+        again."""
         table = self.kernel_table(x, k_w, radius, ct, yaw, friction_velocity, hub_speed)
         table = {**table, "width_bound": self.width_bound(x, k_w, radius, ct, yaw),
                  "amplitude_bound": self.amplitude_bound(x, k_w, radius, ct, yaw),

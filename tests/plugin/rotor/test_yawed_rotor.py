@@ -156,6 +156,55 @@ def test_no_crossflow_is_floris_bitwise(method):
     assert np.all(helped[np.abs(yaw) > 1.0] > 0.0)
 
 
+def test_shared_thrust_is_computed_once_per_arguments(monkeypatch):
+    """Inside ``sharing_thrust`` (one step of the rotor solver) FLORIS's axial induction reuses
+    the veer-aware thrust coefficient computed for the same arguments: the same bits as
+    without sharing, one thrust computation per distinct arguments."""
+    from floris.core.turbine.turbine import Turbine
+
+    from floris_ekman_veer.plugin.rotor import yawed_rotor
+
+    rng = np.random.default_rng(4)
+    velocities = rng.uniform(4.0, 14.0, (5, 1, 3, 3))
+    yaw = rng.uniform(-30.0, 30.0, (5, 1))
+    veered = {name: np.full((5, 1, 3, 3), 1.5) for name in MOMENTS}
+    veered["U3"] = veered["U1"] = np.full((5, 1, 3, 3), 8.0)
+    table = Turbine.from_dict(FlorisModel(FARM).core.farm.turbine_definitions[0]
+                              ).power_thrust_table
+
+    def call(method, velocities, yaw):
+        # New arrays of equal values each call, as FLORIS's per-turbine selection makes them.
+        return getattr(CosineLossTurbine, method)(
+            power_thrust_table=table, velocities=velocities.copy(), air_density=1.225,
+            yaw_angles=yaw.copy(), tilt_angles=np.zeros_like(yaw), tilt_interp=None,
+            average_method="cubic-mean", cubature_weights=None,
+            correct_cp_ct_for_tilt=np.zeros_like(yaw, dtype=bool))
+
+    calls = []
+    computed = yawed_rotor.thrust_veer_ratio
+    monkeypatch.setattr(yawed_rotor, "thrust_veer_ratio",
+                        lambda *a, **k: calls.append(1) or computed(*a, **k))
+    token = CROSSFLOW.set(_lookup(veered))
+    try:
+        alone = [call(m, velocities, yaw) for m in ("thrust_coefficient", "axial_induction")]
+        assert len(calls) == 2
+        with yawed_rotor.sharing_thrust():
+            thrust = call("thrust_coefficient", velocities, yaw)
+            induction = call("axial_induction", velocities, yaw)
+            assert len(calls) == 3
+            other = call("thrust_coefficient", velocities, -yaw)
+            assert len(calls) == 4
+        # Outside the context nothing is shared.
+        again = call("thrust_coefficient", velocities, yaw)
+        assert len(calls) == 5
+    finally:
+        CROSSFLOW.reset(token)
+    np.testing.assert_array_equal(thrust, alone[0])
+    np.testing.assert_array_equal(induction, alone[1])
+    np.testing.assert_array_equal(again, alone[0])
+    assert not np.array_equal(other, thrust)
+
+
 def test_veer_at_zero_yaw_is_floris_bitwise(nrel_sbl4):
     """beta = 0 with a veered inflow: the power FLORIS's own cosine-loss model gives."""
     model = nrel_sbl4.copy()
