@@ -167,10 +167,11 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
         rotors = f * n_turbines + j
         u_initial_fj = u_initial_rotors.take(rotors, axis=0)
         deficit = by_rotor(velocity_deficit).take(rotors, axis=0) * u_initial_fj  # (pairs, n, n)
-        wake_rotors[rotors] = model_manager.combination_model.function(
-            wake_rotors.take(rotors, axis=0), deficit)
+        combined = model_manager.combination_model.function(wake_rotors.take(rotors, axis=0),
+                                                            deficit)
+        wake_rotors[rotors] = combined
 
-        flow_field.u_sorted[f, j] = u_initial_fj - wake_rotors.take(rotors, axis=0)
+        flow_field.u_sorted[f, j] = u_initial_fj - combined
 
         # Wake-added turbulence where the wake overlaps a rotor (elsewhere FLORIS adds 0).
         area_overlap = (np.sum(deficit > 0.05, axis=(1, 2))
