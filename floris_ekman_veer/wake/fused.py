@@ -149,6 +149,31 @@ def centre_offset_bound(x, z, local_u, local_v, strength, r_tube, hub_height, ra
 
 
 @numba.njit(inline="always", **JIT)
+def rotor_centre_offset_bound(x, slowest_u, strength, r_tube, radius, friction_velocity,
+                              image_factor):
+    """A bound of :func:`centre_offset_bound`'s ``bound`` at every row of a rotor, one per wake
+    and rotor: the same formula at the rotor's slowest speed ``slowest_u`` > 0 (its smallest
+    U(z) > 0: a, hence the bound of |t_hat|, is largest there) with the image's factor
+    ``image_factor`` the largest of (2/pi) / (eta^2 - 1) over the rotor's rows (0 without the
+    ground image), widened by another millionth and micrometre for the round-off of the
+    factored forms. The rotor-cell kernel skips a row that this bound puts out of a wake's
+    reach before it evaluates the row's own bound: a row skipped here is skipped by that one
+    too, so the results are the same bits."""
+    a = 0.35 * (friction_velocity / slowest_u) * x / radius
+    t_bound = abs(strength) * min(2.0 * a / (2.0 + a), 1.0)
+    offset = max(_vortex_pair_offset(t_bound), image_factor * t_bound)
+    return r_tube * offset * (1.0 + 2e-6) + 2e-6
+
+
+@numba.njit(inline="always", **JIT)
+def image_factor(z, hub_height, r_tube):
+    """(2/pi) / (eta^2 - 1), the ground image's offset per unit |t_hat| at height ``z`` of Eq.
+    (yhatc) (eta floored as :func:`centre_offset` floors it)."""
+    eta = max((z + hub_height) / r_tube, 1.0 + IMAGE_CORE)
+    return (2.0 / np.pi) / (eta * eta - 1.0)
+
+
+@numba.njit(inline="always", **JIT)
 def grown_centre_offset(growth, x, z, local_u, local_v, strength, r_tube, hub_height, veer,
                         ground_image):
     """:func:`centre_offset` with t_hat's growth (:func:`time_growth`) given (U(z) > 0)."""

@@ -29,7 +29,9 @@ from floris_ekman_veer.wake.fused import (
     centre_offset_bound,
     curl_polynomial,
     grown_centre_offset,
+    image_factor,
     point_exponent,
+    rotor_centre_offset_bound,
     shaped_deficit,
     time_growth,
 )
@@ -48,10 +50,28 @@ CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
                      *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
+@numba.njit(**JIT)
+def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image):
+    # Per condition and kind of rotor: the slowest U(z) > 0 over the rows and the largest
+    # image factor, for rotor_centre_offset_bound (inf and 0 where no row flows).
+    for f in range(kind_u.shape[0]):
+        (cos_a, sin_a, _, _, _, _, r_tube, image_height, _, ground_image) = per_condition[f]
+        for kk in range(kind_u.shape[1]):
+            lowest, factor = np.inf, 0.0
+            for r in range(kind_u.shape[2]):
+                local_u = kind_u[f, kk, r] * cos_a + kind_v[f, kk, r] * sin_a
+                if local_u > 0.0:
+                    lowest = min(lowest, local_u)
+                if ground_image:
+                    factor = max(factor, image_factor(kind_heights[kk, r], image_height, r_tube))
+            slowest[f, kk], image[f, kk] = lowest, factor
+
+
 @numba.njit(nogil=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
                kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
-               combined, block, track, row_scale, removed, overlap, reached, first, stride):
+               combined, block, track, row_scale, slowest, image, removed, overlap, reached,
+               first, stride):
     per_row = row_scale.shape[0] > 0
     exponents = np.empty(sub_y.shape[1])
     for k in range(wake.shape[0]):
@@ -65,6 +85,12 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
          ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
+        # A bound of the centre's rows' bounds (wake/fused.py rotor_centre_offset_bound): most
+        # rows are out of reach by it, with one division.
+        rotor_bound = 0.0
+        if compute_centre and not every_row:
+            rotor_bound = rotor_centre_offset_bound(x, slowest[f, kk], strength_c, r_tube, radius,
+                                                    u_star, image[f, kk])
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
         # plugin/rotor/rotor.py), or at every row where the caller reads them all
@@ -82,7 +108,16 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
             if compute_centre:
                 if flowing:
                     # Out of reach whatever the exact centre (wake/fused.py centre_offset_bound):
-                    # the row is skipped without the exponential.
+                    # the row is skipped without the exponential, and first by the rotor's bound
+                    # (the same drift, a wider bound: it skips a subset of the rows).
+                    if not every_row:
+                        drift = veer * (x * local_v / local_u)
+                        nearest = max(abs(offset - drift) - rotor_bound
+                                      - radius_j * row_chord[r], 0.0)
+                        if not nearest * nearest + dz * dz < reach_squared:
+                            skipped_first |= r == 0
+                            skipped_last |= r == row_chord.size - 1
+                            continue
                     drift, bound = centre_offset_bound(
                         x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
                         image_height, radius, u_star, veer, ground_image)
@@ -235,12 +270,17 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     reached = np.zeros(n_pairs, dtype=bool)
     compute_centre = centre is None
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
+    per_condition = np.ascontiguousarray(per_condition)
+    slowest = np.empty(rotor.kind_u.shape[:2])
+    image = np.empty(rotor.kind_u.shape[:2])
+    if compute_centre and not every_row:
+        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights, slowest, image)
     split_over_threads(
         _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-        np.ascontiguousarray(per_condition), compute_centre, bool(every_row), centre,
+        per_condition, compute_centre, bool(every_row), centre,
         flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
         cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid, cells.row_width,
         wakes.rule_code, wakes.combined, flat * cells.rows, bool(track),
-        np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), removed,
-        overlap, reached)
+        np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), slowest,
+        image, removed, overlap, reached)
     return removed, overlap, reached, centre

@@ -300,3 +300,38 @@ def test_centre_bound_holds_and_is_tight():
         if not image and 0.35 * u_star / u * x / 60.0 < 0.05 and abs(exact - drift) > 1.0:
             worst = max(worst, bound / abs(exact - drift))
     assert 1.0 < worst < 1.05
+
+
+def test_rotor_centre_bound_holds_at_every_row():
+    """The rotor's bound that lets the kernel skip a row before its own bound
+    (wake/fused.py rotor_centre_offset_bound, at the rotor's slowest U(z) and largest image
+    factor) is at least every row's centre_offset_bound, so the rows it skips are a subset of
+    those the row's bound skips (the kernel's results stay the same bits), and equals the
+    slowest row's bound to its widening without the image."""
+    from floris_ekman_veer.wake.fused import (
+        centre_offset_bound,
+        image_factor,
+        rotor_centre_offset_bound,
+    )
+
+    rng = np.random.default_rng(9)
+    for _ in range(2000):
+        x = rng.uniform(5.0, 3000.0)
+        hub, radius = rng.uniform(40.0, 150.0), 60.0
+        heights = hub + radius * np.linspace(-0.95, 0.95, 8)
+        speeds = rng.uniform(0.5, 14.0, heights.size)
+        v = rng.uniform(-3.0, 3.0)
+        ct, yaw = rng.uniform(0.2, 0.95), rng.uniform(-0.5, 0.5)
+        strength = float(time_like_strength(rng.uniform(0.1, 0.6), 9.0, ct, yaw))
+        r_tube = float(initial_radius(radius, ct, yaw))
+        u_star = rng.uniform(0.1, 0.6)
+        veer, image = float(rng.integers(2)), float(rng.integers(2))
+        factor = image * max(image_factor(z, hub, r_tube) for z in heights)
+        bound = rotor_centre_offset_bound(x, speeds.min(), strength, r_tube, radius, u_star,
+                                          factor)
+        rows = [centre_offset_bound(x, z, u, v, strength, r_tube, hub, radius, u_star, veer,
+                                    image)[1] for z, u in zip(heights, speeds)]
+        assert max(rows) <= bound
+        if not image:
+            slowest = rows[int(np.argmin(speeds))]
+            assert bound <= slowest * (1.0 + 2e-6) + 2e-6
