@@ -51,9 +51,10 @@ CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
                      *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
 @numba.njit(**JIT)
-def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image):
+def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image, drift_ratio):
     # Per condition and kind of rotor: the slowest U(z) > 0 over the rows and the largest
-    # image factor, for rotor_centre_offset_bound (inf and 0 where no row flows).
+    # image factor, for rotor_centre_offset_bound (inf and 0 where no row flows), and per row
+    # V/U of the veer's drift x V/U (NaN where U <= 0: no flow).
     for f in range(kind_u.shape[0]):
         (cos_a, sin_a, _, _, _, _, r_tube, image_height, _, ground_image) = per_condition[f]
         for kk in range(kind_u.shape[1]):
@@ -62,6 +63,10 @@ def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image):
                 local_u = kind_u[f, kk, r] * cos_a + kind_v[f, kk, r] * sin_a
                 if local_u > 0.0:
                     lowest = min(lowest, local_u)
+                    drift_ratio[f, kk, r] = (kind_v[f, kk, r] * cos_a
+                                             - kind_u[f, kk, r] * sin_a) / local_u
+                else:
+                    drift_ratio[f, kk, r] = np.nan
                 if ground_image:
                     factor = max(factor, image_factor(kind_heights[kk, r], image_height, r_tube))
             slowest[f, kk], image[f, kk] = lowest, factor
@@ -70,8 +75,8 @@ def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image):
 @numba.njit(nogil=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
                kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
-               combined, block, track, row_scale, slowest, image, removed, overlap, reached,
-               first, stride):
+               combined, block, track, row_scale, slowest, image, drift_ratio, removed, overlap,
+               reached, first, stride):
     per_row = row_scale.shape[0] > 0
     exponents = np.empty(sub_y.shape[1])
     for k in range(wake.shape[0]):
@@ -86,9 +91,12 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         reach = 4.0 * radius
         area = 0.0
         # A bound of the centre's rows' bounds (wake/fused.py rotor_centre_offset_bound): most
-        # rows are out of reach by it, with one division.
+        # rows are out of reach by it, with the drift x (V/U) (rounded otherwise than x V / U:
+        # a billionth of it is added to the bound), before the row's own bound, which skips
+        # them too (a subset of its rows: the same bits).
         rotor_bound = 0.0
-        if compute_centre and not every_row:
+        rotor_skip = compute_centre and not every_row
+        if rotor_skip:
             rotor_bound = rotor_centre_offset_bound(x, slowest[f, kk], strength_c, r_tube, radius,
                                                     u_star, image[f, kk])
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
@@ -98,6 +106,17 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         skipped_first = skipped_last = False
         for r in range(row_chord.size):
             dz = kind_heights[kk, r] - hub_height
+            if rotor_skip:
+                ratio = drift_ratio[f, kk, r]
+                if ratio == ratio:
+                    drift = veer * (x * ratio)
+                    nearest = max(abs(offset - drift) - 1e-9 * abs(drift) - rotor_bound
+                                  - radius_j * row_chord[r], 0.0)
+                    # (NaN, from an overflow, skips nothing)
+                    if nearest * nearest + dz * dz >= reach_squared:
+                        skipped_first |= r == 0
+                        skipped_last |= r == row_chord.size - 1
+                        continue
             u, v = kind_u[f, kk, r], kind_v[f, kk, r]
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
@@ -108,16 +127,7 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
             if compute_centre:
                 if flowing:
                     # Out of reach whatever the exact centre (wake/fused.py centre_offset_bound):
-                    # the row is skipped without the exponential, and first by the rotor's bound
-                    # (the same drift, a wider bound: it skips a subset of the rows).
-                    if not every_row:
-                        drift = veer * (x * local_v / local_u)
-                        nearest = max(abs(offset - drift) - rotor_bound
-                                      - radius_j * row_chord[r], 0.0)
-                        if not nearest * nearest + dz * dz < reach_squared:
-                            skipped_first |= r == 0
-                            skipped_last |= r == row_chord.size - 1
-                            continue
+                    # the row is skipped without the exponential.
                     drift, bound = centre_offset_bound(
                         x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
                         image_height, radius, u_star, veer, ground_image)
@@ -271,10 +281,11 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     compute_centre = centre is None
     centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
     per_condition = np.ascontiguousarray(per_condition)
-    slowest = np.empty(rotor.kind_u.shape[:2])
-    image = np.empty(rotor.kind_u.shape[:2])
+    slowest, image = np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2])
+    drift_ratio = np.empty(rotor.kind_u.shape)
     if compute_centre and not every_row:
-        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights, slowest, image)
+        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights, slowest, image,
+                    drift_ratio)
     split_over_threads(
         _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
         per_condition, compute_centre, bool(every_row), centre,
@@ -282,5 +293,5 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
         cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid, cells.row_width,
         wakes.rule_code, wakes.combined, flat * cells.rows, bool(track),
         np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), slowest,
-        image, removed, overlap, reached)
+        image, drift_ratio, removed, overlap, reached)
     return removed, overlap, reached, centre
