@@ -24,6 +24,7 @@ import floris.core.core as floris_core
 import floris.par_floris_model as floris_parallel
 from floris.core import Core, FlowField
 from floris.core.farm import Farm
+from floris.core.turbine import operation_models
 from floris.core.turbine.operation_models import CosineLossTurbine
 from floris.core.wake import WakeModelManager
 from floris.floris_model import FlorisModel
@@ -134,6 +135,10 @@ PATCHES: tuple[Patch, ...] = (
           ("thrust_coefficient", "thrust", "the rotor-normal force of a yawed rotor in veer "
                                            "follows the normal velocity's square per rotor "
                                            "cell, held to FLORIS's own clip"))),
+    wrapped(operation_models, "interp1d", yawed_rotor.sharing_interpolant,
+            "FLORIS's power-curve turbines build their table's interpolant at every call, "
+            "i.e. at every step of a solve; the package's solver has them build it once per "
+            "solve and table (the same interpolant, the same bits)"),
     *(wrapped(FlorisModel, name, yawed_rotor.with_crossflow, _GETTER.format(what=what))
       for name, what in (("_get_turbine_powers", "powers"),
                          ("get_turbine_thrust_coefficients", "thrust coefficients"),

@@ -45,7 +45,7 @@ from floris_ekman_veer.plugin.inflow.ambient import is_rotor_grid
 from floris_ekman_veer.plugin.rotor import turbine_states
 from floris_ekman_veer.plugin.rotor.rotor import ADDED_TURBULENCE, condition_column
 from floris_ekman_veer.plugin.rotor.rotor_wakes import crespo_hernandez_parameters
-from floris_ekman_veer.plugin.rotor.yawed_rotor import sharing_thrust
+from floris_ekman_veer.plugin.rotor.yawed_rotor import sharing_interpolants, sharing_thrust
 from floris_ekman_veer.plugin.wake_models.models import EkmanWakeModel
 from floris_ekman_veer.wake.added_turbulence import crespo_hernandez_overlap
 
@@ -90,6 +90,13 @@ def rotor_solver(farm, flow_field, grid, model_manager) -> None:
     Same arguments and outputs as FLORIS's: ``flow_field.u_sorted``, the turbulence-intensity
     fields and (with ``enable_turbine_turbulence_grid``) the wake-mixing field.
     """
+    # (FLORIS's turbines build their table's interpolant at every step: once per solve here.)
+    with sharing_interpolants():
+        _solve(farm, flow_field, grid, model_manager)
+
+
+def _solve(farm, flow_field, grid, model_manager) -> None:
+    """:func:`rotor_solver`'s steps."""
     deflection_model_args = model_manager.deflection_model.prepare_function(grid, flow_field)
     deficit_model_args = model_manager.velocity_model.prepare_function(grid, flow_field)
 

@@ -117,6 +117,47 @@ def sharing_thrust():
         _SHARED_THRUST.reset(token)
 
 
+#: FLORIS's interpolants of the turbine tables built inside :func:`sharing_interpolants`, by
+#: (id(x), id(y), settings) -> (x, y, interpolant); None outside it.
+_SHARED_INTERPOLANTS: contextvars.ContextVar = contextvars.ContextVar("shared_interpolants",
+                                                                      default=None)
+
+
+@contextlib.contextmanager
+def sharing_interpolants():
+    """FLORIS's power-curve turbines build scipy's interpolant of their table at every thrust
+    and power call, i.e. at every step of its sequential solver. Inside this context (the
+    package's solver, plugin/floris_hooks/solver.py) one is built per table and settings and
+    handed to the later calls: the same interpolant, the same bits."""
+    token = _SHARED_INTERPOLANTS.set({})
+    try:
+        yield
+    finally:
+        _SHARED_INTERPOLANTS.reset(token)
+
+
+def sharing_interpolant(original):
+    """FLORIS's operation models' ``interp1d`` (the name in their module): inside
+    :func:`sharing_interpolants` one interpolant per table (its x and y arrays by identity,
+    held while the context lasts) and keyword settings; scipy's own call otherwise."""
+
+    @functools.wraps(original)
+    def interp1d(x, y, *args, **kwargs):
+        shared = _SHARED_INTERPOLANTS.get()
+        if shared is None or args:
+            return original(x, y, *args, **kwargs)
+        try:
+            key = (id(x), id(y), tuple(sorted(kwargs.items())))
+            entry = shared.get(key)
+        except TypeError:  # an unhashable setting: not shared
+            return original(x, y, **kwargs)
+        if entry is None or entry[0] is not x or entry[1] is not y:
+            entry = shared[key] = (x, y, original(x, y, **kwargs))
+        return entry[2]
+
+    return interp1d
+
+
 def _equal_arguments(a, b) -> bool:
     """Whether two calls' named arguments are equal: the same objects (tables, interpolants,
     the crossflow) or arrays with equal values."""

@@ -205,6 +205,53 @@ def test_shared_thrust_is_computed_once_per_arguments(monkeypatch):
     assert not np.array_equal(other, thrust)
 
 
+def test_table_interpolant_is_built_once_per_solve(monkeypatch):
+    """FLORIS's cosine-loss turbines build scipy's interpolant of their table at every call;
+    inside ``sharing_interpolants`` (the package's solver) one is built per table and settings:
+    the same object for the same arrays and settings, another for other ones, scipy's own call
+    outside; a farm's solve builds the thrust interpolant once and gives the same bits as
+    with one per step."""
+    from floris.core.turbine import operation_models
+
+    from floris_ekman_veer.plugin.rotor import yawed_rotor
+
+    wind_speed, thrust = np.array([3.0, 10.0, 25.0]), np.array([0.9, 0.8, 0.1])
+    with yawed_rotor.sharing_interpolants():
+        first = operation_models.interp1d(wind_speed, thrust, fill_value=0.0001,
+                                          bounds_error=False)
+        assert operation_models.interp1d(wind_speed, thrust, fill_value=0.0001,
+                                         bounds_error=False) is first
+        assert operation_models.interp1d(wind_speed, thrust.copy(), fill_value=0.0001,
+                                         bounds_error=False) is not first
+        assert operation_models.interp1d(wind_speed, thrust, fill_value=0.5,
+                                         bounds_error=False) is not first
+    assert operation_models.interp1d(wind_speed, thrust, fill_value=0.0001,
+                                     bounds_error=False) is not first
+    np.testing.assert_allclose(first([5.0, 30.0]), [0.9 - 0.1 * 2.0 / 7.0, 0.0001], rtol=1e-15)
+
+    scipy_own = patching.ORIGINALS[(operation_models, "interp1d")]
+    built = []
+    counting = yawed_rotor.sharing_interpolant(
+        lambda *a, **k: built.append(1) or scipy_own(*a, **k))
+    config = copy.deepcopy(load_yaml(FARM))
+    config["farm"]["layout_x"], config["farm"]["layout_y"] = [0.0, 630.0, 1260.0], [0.0] * 3
+    powers = []
+    for interpolant in (counting, lambda *a, **k: built.append(1) or scipy_own(*a, **k)):
+        monkeypatch.setattr(operation_models, "interp1d", interpolant)
+        built.clear()
+        model = FlorisModel(config)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model.set(wind_directions=[270.0, 275.0], wind_speeds=[8.0, 9.0],
+                      turbulence_intensities=[0.06, 0.06], yaw_angles=[[20.0, -10.0, 0.0]] * 2)
+            model.run()
+        solve_builds = len(built)
+        powers.append(model.get_turbine_powers())
+        # Shared: the thrust's interpolant once per solve; unshared: once per turbine's step.
+        assert solve_builds == (1 if interpolant is counting else 3)
+    np.testing.assert_array_equal(powers[0], powers[1])
+
+
 def test_veer_at_zero_yaw_is_floris_bitwise(nrel_sbl4):
     """beta = 0 with a veered inflow: the power FLORIS's own cosine-loss model gives."""
     model = nrel_sbl4.copy()
