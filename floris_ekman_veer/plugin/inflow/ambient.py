@@ -101,6 +101,9 @@ class Ambient:
 
     def hub_height_at(self, x_i, y_i):
         """Hub height of the turbine at (x_i, y_i) (shapes (n_findex, 1, 1, 1))."""
+        if self.hub_heights.size == 1:
+            # One hub height in the farm: the search would find it whatever the turbine.
+            return np.full((self.turbine_x.shape[0], 1, 1, 1), self.hub_heights[0])
         distance = (self.turbine_x - x_i[:, 0, 0]) ** 2 + (self.turbine_y - y_i[:, 0, 0]) ** 2
         return self.turbine_hub_heights[np.argmin(distance, axis=1)][:, None, None, None]
 
