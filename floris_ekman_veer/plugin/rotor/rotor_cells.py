@@ -37,14 +37,15 @@ metres below the top) are steps in height, at a height that moves with the condi
 integrated to first order: the whole strip it cuts counts on one side of it
 [``test_a_step_in_height_is_integrated_to_the_strip_it_cuts``], so the error is erratic in the
 strip count (2 x 2 cells, wakes summed, the worst farm power over the 16 cases of
-benchmarks/matched_accuracy.py against 20 x 20: 1.63 % with 16 strips, 1.66 % with 20, 0.41 %
-with 28, 0.54 % with 32, 0.56 % with 40). Rules of higher order with the same rows do no better
-there: Gauss-Chebyshev rows (spectral on smooth bands) 2.17 % at 2 x 2 / 1.26 % at 3 x 3,
-mapped to keep the central spacing 1.85 / 0.58 %, two Gauss points per strip with the chord as
-weight 3.09 / 0.61 %, rows at the strips' area centroids 1.77 / 1.02 %, against equal strips'
-1.63 / 1.02 %. Against a step at an unknown height equal strips are the best a row count can
-do (no strip's error exceeds its own area), so they stay; the step needs thinner strips where
-the layer top is, not another rule.
+benchmarks/matched_accuracy.py against 20 x 20: 1.63 % with 16 strips, 1.66 % with 20, 1.17 %
+with 24, 0.41 % with 28, 0.54 % with 32, 0.41 % with 48). Other rules with the same rows do no
+better there (2 x 2 / 3 x 3: equal strips 1.63 / 1.02 %; Gauss-Chebyshev rows, spectral on
+smooth bands, 2.17 / 1.26 %; two Gauss points per strip 3.09 / 0.61 %; area centroids 1.77 /
+1.02 %; the table in docs/coupling.md#rotor-average). Against a step at an unknown height equal
+strips are the best a row count can do (no strip's error exceeds its own area), and the
+kernel's work goes with the rows more than with the sub-points (strips staggered between the
+disk's halves, twice the heights at the same sub-points: 0.52 / 0.71 % for +30 % CPU), so they
+stay: the step needs rows, not another rule.
 """
 
 from __future__ import annotations
