@@ -18,11 +18,34 @@ odd n alone); ring after ring (inwards out) takes an annulus whose area is its s
 (a ring whose annulus would miss its own points joins the ring inside), and each annulus is
 cut into equal sectors centred on its points. For n = 3: a central disk of radius R/3 and eight
 45-degree sectors of the annulus R/3 < r < R, all of area pi R^2 / 9.
-The sub-quadrature: ``rows`` horizontal strips of equal height (each weighted by its exact area
-of the disk) times ``columns`` Gauss-Legendre points across the chord; a sub-point belongs to the
-cell it lies in, and the weights of each cell are scaled to its exact area. Uniform strips
-integrate a band crossing them spectrally (error ~ exp(-2 pi^2 s^2 / h^2) for a Gaussian of width
-s in z sampled at spacing h), which is what the sheared wakes need.
+The sub-quadrature: ``rows`` horizontal strips of equal height h, a row of sub-points at each
+strip's mid-height weighted by the strip's exact area of the disk, times Gauss-Legendre points
+on each cell's stretch of the row's chord; a sub-point belongs to the cell it lies in. A cell's
+quadrature area is exact to the strips' resolution; the wake cells' deficits take the exact
+1/n^2 (plugin/rotor/rotor_wakes.py), so FLORIS's mean of the cells is this sub-quadrature's
+integral over the disk, whatever the cells.
+
+Why equal strips (measured for issue 41, docs/coupling.md#rotor-average): a smooth band of
+deficit is integrated with an error falling as h^2 (the exact strip areas against the chord at
+mid-height; order 2.00 from 24 to 96 strips), below 1.2e-4 of the disk mean at the shipped 8 n
+strips for n >= 2 [``test_wake_cell_strips_converge_as_the_square_of_their_height``]. That is
+not what sets the rotor points a farm's power needs. In the stable layers whose top lies on the
+rotor (the SBL-6 farm input: h from 57 to 102 m at 7-11 m/s) the inflow's jet nose there (U
+changing by up to 0.5 m/s within 1-2 m)
+and the veer deflection x V / U (a wake centre moving by up to a rotor radius within a few
+metres below the top) are steps in height, at a height that moves with the condition. A step is
+integrated to first order: the whole strip it cuts counts on one side of it
+[``test_a_step_in_height_is_integrated_to_the_strip_it_cuts``], so the error is erratic in the
+strip count (2 x 2 cells, wakes summed, the worst farm power over the 16 cases of
+benchmarks/matched_accuracy.py against 20 x 20: 1.63 % with 16 strips, 1.66 % with 20, 1.17 %
+with 24, 0.41 % with 28, 0.54 % with 32, 0.41 % with 48). Other rules with the same rows do no
+better there (2 x 2 / 3 x 3: equal strips 1.63 / 1.02 %; Gauss-Chebyshev rows, spectral on
+smooth bands, 2.17 / 1.26 %; two Gauss points per strip 3.09 / 0.61 %; area centroids 1.77 /
+1.02 %; the table in docs/coupling.md#rotor-average). Against a step at an unknown height equal
+strips are the best a row count can do (no strip's error exceeds its own area), and the
+kernel's work goes with the rows more than with the sub-points (strips staggered between the
+disk's halves, twice the heights at the same sub-points: 0.52 / 0.71 % for +30 % CPU), so they
+stay: the step needs rows, not another rule.
 """
 
 from __future__ import annotations
