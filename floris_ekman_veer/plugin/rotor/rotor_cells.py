@@ -38,14 +38,15 @@ integrated to first order: the whole strip it cuts counts on one side of it
 [``test_a_step_in_height_is_integrated_to_the_strip_it_cuts``], so the error is erratic in the
 strip count (2 x 2 cells, wakes summed, the worst farm power over the 16 cases of
 benchmarks/matched_accuracy.py against 20 x 20: 1.63 % with 16 strips, 1.66 % with 20, 1.17 %
-with 24, 0.41 % with 28, 0.54 % with 32, 0.41 % with 48). Other rules with the same rows do no
-better there (2 x 2 / 3 x 3: equal strips 1.63 / 1.02 %; Gauss-Chebyshev rows, spectral on
-smooth bands, 2.17 / 1.26 %; two Gauss points per strip 3.09 / 0.61 %; area centroids 1.77 /
-1.02 %; the table in docs/coupling.md#rotor-average). Against a step at an unknown height equal
-strips are the best a row count can do (no strip's error exceeds its own area), and the
-kernel's work goes with the rows more than with the sub-points (strips staggered between the
-disk's halves, twice the heights at the same sub-points: 0.52 / 0.71 % for +30 % CPU), so they
-stay: the step needs rows, not another rule.
+with 24, 0.41 % with 28, 0.54 % with 32, 0.41 % with 48: benchmarks/layer_top_strips.py
+``--sweep``). Other rules with the same rows (Gauss-Chebyshev rows, spectral on smooth bands;
+two Gauss points per strip; area centroids) did no better there, and the kernel's work goes with
+the rows more than with the sub-points (strips staggered between the disk's halves, twice the
+heights at the same sub-points, cost as much as more strips), so equal strips stay. The step's
+height is known per condition (the layer top h): a strip edge there
+(``rotor_cells(..., step_height=...)``) takes the 2 x 2 cells to 0.45 % on the same 16 strips
+(benchmarks/layer_top_strips.py), but the strips are shared by every condition of a rotor kind
+and h moves with the condition, so that needs a strip split per condition, not yet done.
 """
 
 from __future__ import annotations
@@ -228,7 +229,8 @@ def _row_intervals(n: int, z: float):
 
 
 @functools.lru_cache(maxsize=32)
-def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
+def rotor_cells(n: int, rows: int, nodes_per_interval: int,
+                step_height: float | None = None) -> RotorCells:
     """The cells of an n x n turbine grid and their sub-quadrature (cached).
 
     ``rows`` strips of equal height, each weighted by its exact area of the disk; along the
@@ -236,6 +238,12 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
     Gauss-Legendre points. Every cell's area is thereby exact to the strips' resolution (it must
     be 1/n^2 of the disk: FLORIS weights the points equally). Rows crossing fewer cells are
     padded with zero-weight points, so that the sub-points form a (rows, columns) array.
+
+    ``step_height`` (rotor radii from the hub, inside the disk): the strip edge nearest to it is
+    moved there, so that a step in height at a known place (a stable layer's top) is integrated
+    by whole strips on either side of it (the module docstring). The package's wake cells do not
+    use it: their strips are shared by every condition of a rotor kind, while the layer top
+    moves with the condition; benchmarks/layer_top_strips.py measures what it would gain.
     """
     if n < 1 or rows < 1 or nodes_per_interval < 1:
         raise ValueError(
@@ -243,6 +251,12 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int) -> RotorCells:
             f"{nodes_per_interval}"
         )
     edges = np.linspace(-1.0, 1.0, rows + 1)
+    if step_height is not None and rows > 1:
+        if not -1.0 < step_height < 1.0:
+            raise ValueError(f"rotor cells: step_height must lie inside the disk (-1, 1) rotor "
+                             f"radii from the hub, got {step_height!r}")
+        nearest = 1 + int(np.argmin(np.abs(edges[1:-1] - step_height)))
+        edges[nearest] = step_height
     row_z = 0.5 * (edges[1:] + edges[:-1])
     chord = np.sqrt(1.0 - row_z**2)
     strip = _strip_area(edges[:-1], edges[1:]) / np.pi
