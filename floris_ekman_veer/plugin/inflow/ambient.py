@@ -16,10 +16,12 @@ from floris.core import FlowField, Grid, TurbineCubatureGrid, TurbineGrid
 from floris.utilities import rotate_coordinates_rel_west
 
 from floris_ekman_veer.plugin.inflow.inflow import ambient_velocity, solved_atmosphere
+from floris_ekman_veer.plugin.rotor.strip_split import StripSplit
 from floris_ekman_veer.plugin.rotor.rotor_cells import (
     RotorCells,
     rotor_cells,
     rotor_geometry,
+    rotor_kinds,
     rows_profile,
     sorted_moments,
     sub_quadrature,
@@ -139,7 +141,8 @@ class RotorAmbient:
     Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
     radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
     (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
-    FLORIS's inflow component, V the lateral one).
+    FLORIS's inflow component, V the lateral one); ``split`` the strip each condition's layer
+    top cuts on each kind (plugin/rotor/strip_split.py).
     """
 
     cells: RotorCells
@@ -152,6 +155,7 @@ class RotorAmbient:
     kind_heights: np.ndarray
     kind_u: np.ndarray
     kind_v: np.ndarray
+    split: StripSplit
     warned: set = field(factory=set)
 
     @classmethod
@@ -159,10 +163,14 @@ class RotorAmbient:
         cells = rotor_cells(grid.grid_resolution, *sub_quadrature(
             grid.grid_resolution, float(np.max(grid.turbine_diameters))))
         x, y, z, radius, _ = rotor_geometry(grid)
-        kind, heights, u, v = rows_profile(
-            lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
-        )
-        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v)
+        profile = lambda heights: ambient_velocity(abl, heights, reference_height)  # noqa: E731
+        kind, heights, u, v = rows_profile(profile, grid, cells)
+        kinds, _ = rotor_kinds(grid)
+        # (conditions at rest have no layer top)
+        top = np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1))
+        split = StripSplit.of(cells, kinds[:, 0], kinds[:, 1],
+                              np.broadcast_to(top, x.shape[:1]), profile)
+        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v, split)
 
     def rows(self, f, j):
         """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""

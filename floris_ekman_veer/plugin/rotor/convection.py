@@ -83,7 +83,9 @@ def removed_moments(cells: RotorCells, combined, pair, convection, ambient_u, mo
     RotorWakes.combined, one block of rows per rotor), ``convection`` (pairs,) U_c,
     ``ambient_u`` (pairs, rows) U at the rows (0 where there is no flow), ``moment`` (pairs,)
     3 or 1. Returns (pairs, n^2), as the kernel's ``removed``."""
-    blocks = combined.reshape(-1, cells.rows, cells.sub_y.shape[1])[pair].astype(float)
+    # (the rows of each rotor's slots: this superposition integrates the shared strips)
+    blocks = combined.reshape(-1, cells.slots, cells.sub_y.shape[1])[pair, :cells.rows]
+    blocks = blocks.astype(float)
     wake = blocks / convection[:, None, None]
     u = ambient_u[:, :, None]
     cubic = (moment == 3.0)[:, None, None]

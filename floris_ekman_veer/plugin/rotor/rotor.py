@@ -227,12 +227,23 @@ def reached_rotor_cell_deficit(
         return result.reshape(u_initial.shape), _NONE
     f, j, x_pair, table = f[near], j[near], x_pair[near], table[near]
     centre = None
+    convecting = wakes.superposition == "momentum_conserving"
+    # (The momentum-conserving superposition and Ishihara & Qian's turbulence read the
+    # wake's centre at every row of the rotors reached.)
+    ishihara_qian = track and model.wake_turbulence == "ishihara_qian"
+    every_row = convecting or ishihara_qian
+    # The strip a layer top cuts, integrated as its parts below and above the top
+    # (plugin/rotor/strip_split.py); not yet on the paths that read every row's centre.
+    split = rotor.split.any and not every_row
     if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
         # (A sum over the n points, not a matrix product: BLAS would block the product by
         # the number of pairs, i.e. by the batch.)
         centre = np.sum(deflection_field_i[f, j, 0, :, None]
                         * row_interpolation(cells.n, cells.row_z), axis=1)
+        if split:
+            centre = rotor.split.at_rows(deflection_field_i[f, j, 0, :], centre, f,
+                                         rotor.kind[f, j], cells.n)
         centre_table = {"strength": 0.0, "r_tube": 1.0, "image_height": 0.0, "veer": 0.0,
                         "ground_image": 0.0}
     else:
@@ -249,7 +260,6 @@ def reached_rotor_cell_deficit(
     per_pair = {k: v[f] for k, v in source_wake.items()}
     per_pair.update(speed_fraction=speed_fraction[f], cos=column(cos_a)[f],
                     sin=column(sin_a)[f], offset=pair[:, PAIR_COLUMNS.index("offset")])
-    convecting = wakes.superposition == "momentum_conserving"
     row_scale = None
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
@@ -273,6 +283,8 @@ def reached_rotor_cell_deficit(
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
+        if split:
+            row_scale = rotor.split.at_rows(deficit, row_scale, f, kind, cells.n)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
@@ -282,12 +294,11 @@ def reached_rotor_cell_deficit(
         wake_convection = pair[:, scale] - 0.5 * centre_speed
         pair[:, scale] = pair[:, scale] * wake_convection
         pair[:, edge] = pair[:, edge] * wake_convection
-    # (The momentum-conserving superposition and Ishihara & Qian's turbulence read the
-    # wake's centre at every row of the rotors reached.)
-    ishihara_qian = track and model.wake_turbulence == "ishihara_qian"
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
-        kind, rotor, wakes, track, every_row=convecting or ishihara_qian, row_scale=row_scale)
+        kind, rotor, wakes, track, every_row=every_row, row_scale=row_scale, split=split)
+    # (the shared rows' centres: the cut strip's row holds its part below the top)
+    centre = centre[:, :cells.rows]
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE

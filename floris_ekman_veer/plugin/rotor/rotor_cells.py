@@ -110,6 +110,7 @@ class RotorCells:
         weight: (rows, columns) area weights over the disk area, summing to 1.
         area: (n^2,) the cells' areas in this quadrature (exact: 1/n^2 each).
         cell: (rows * columns,) cell index of each sub-point.
+        edges: (rows + 1,) the strips' edges (None: not known).
         row_chord: (rows,) half-chord of the disk at each row height.
         nodes: sub-points per stretch of a row in one cell (each row: stretches of ``nodes``
             consecutive sub-points, padding included).
@@ -126,10 +127,17 @@ class RotorCells:
     row_chord: np.ndarray
     area: np.ndarray
     nodes: int = 1
+    edges: np.ndarray | None = None
 
     @property
     def rows(self) -> int:
         return self.row_z.size
+
+    @property
+    def slots(self) -> int:
+        """Row slots per rotor of the wakes' storage: the rows and one more, for the part above
+        a layer top of the strip it cuts (plugin/rotor/strip_split.py)."""
+        return self.rows + 1
 
     @functools.cached_property
     def row_width(self) -> np.ndarray:
@@ -171,7 +179,7 @@ def grid_offsets(n: int) -> np.ndarray:
     return np.zeros(1) if n == 1 else np.linspace(-0.5, 0.5, n)
 
 
-def _strip_area(a, b):
+def strip_area(a, b):
     """Area of the unit disk between heights a < b."""
     primitive = lambda z: z * np.sqrt(1.0 - z * z) + np.arcsin(z)  # noqa: E731
     return primitive(b) - primitive(a)
@@ -259,7 +267,7 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int,
         edges[nearest] = step_height
     row_z = 0.5 * (edges[1:] + edges[:-1])
     chord = np.sqrt(1.0 - row_z**2)
-    strip = _strip_area(edges[:-1], edges[1:]) / np.pi
+    strip = strip_area(edges[:-1], edges[1:]) / np.pi
     nodes, gl = np.polynomial.legendre.leggauss(nodes_per_interval)
     intervals = [_row_intervals(n, z) for z in row_z]
     columns = nodes_per_interval * max(len(row) for row in intervals)
@@ -280,7 +288,7 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int,
             "more rows"
         )
     return RotorCells(n, row_z, sub_y, weight.reshape(sub_y.shape), cell, chord, totals,
-                      nodes_per_interval)
+                      nodes_per_interval, edges)
 
 
 def row_cell_sums(values: np.ndarray, cells: RotorCells) -> np.ndarray:
@@ -390,29 +398,36 @@ def rows_profile(profile, grid, cells: RotorCells):
     turbine, ``heights`` (kinds, rows) the rows' heights, and per output of ``profile`` its
     values (n_findex, kinds, rows).
     """
+    kinds, kind = rotor_kinds(grid)
+    heights = kinds[:, :1] + kinds[:, 1:] * cells.row_z  # (kinds, rows)
+    distinct, inverse = np.unique(heights, return_inverse=True)
+    inverse = inverse.reshape(heights.shape)
+    n_findex = kind.shape[0]
+    out = []
+    for values in profile(distinct.reshape(1, 1, 1, -1)):
+        values = np.broadcast_to(values, (n_findex, 1, 1, distinct.size)).reshape(n_findex, -1)
+        out.append(values[:, inverse])
+    return kind, heights, *out
+
+
+def rotor_kinds(grid) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct (hub height, radius) of a FLORIS grid's rotors, (kinds, 2) [m], and the
+    kind of each sorted turbine, (n_findex, n_turbines)."""
     _, _, _, _, order = rotor_geometry(grid)
     coordinates = np.asarray(grid.turbine_coordinates, dtype=float)
     radius = 0.5 * np.asarray(grid.turbine_diameters, dtype=float)
     kinds, kind_of = np.unique(np.stack([coordinates[:, 2], radius], axis=1), axis=0,
                                return_inverse=True)
-    heights = kinds[:, :1] + kinds[:, 1:] * cells.row_z  # (kinds, rows)
-    distinct, inverse = np.unique(heights, return_inverse=True)
-    inverse = inverse.reshape(heights.shape)
-    n_findex = order.shape[0]
-    out = []
-    for values in profile(distinct.reshape(1, 1, 1, -1)):
-        values = np.broadcast_to(values, (n_findex, 1, 1, distinct.size)).reshape(n_findex, -1)
-        out.append(values[:, inverse])
-    return kind_of.ravel()[order], heights, *out
+    return kinds, kind_of.ravel()[order]
 
 
 def row_interpolation(n: int, row_z: np.ndarray) -> np.ndarray:
     """(n, rows) matrix interpolating values at the grid's point heights linearly to the rows
     (constant beyond the outer points): the wake centre of a deflection model that gives it at
-    FLORIS's points only."""
+    FLORIS's points only. (``row_z`` of any shape: (n, *row_z.shape).)"""
     g = grid_offsets(n)
     if n == 1:
-        return np.ones((1, row_z.size))
+        return np.ones((1, *np.shape(row_z)))
     return np.stack([np.interp(row_z, g, np.eye(n)[k]) for k in range(n)])
 
 

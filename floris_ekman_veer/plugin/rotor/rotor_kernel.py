@@ -50,34 +50,57 @@ CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
                      *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
+@numba.njit(inline="always", **JIT)
+def _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row, split_height, split_u,
+         split_v):
+    # Row slot r of kind kk at condition f: its height, ambient (U, V) and, for the parts of
+    # the strip the layer top cuts (plugin/rotor/strip_split.py), which part (0 below, 1
+    # above in the extra slot r = rows; -1: a whole strip).
+    part = -1
+    if r == rows:
+        part = 1
+    elif split_row.shape[0] > 0 and r == split_row[f, kk]:
+        part = 0
+    if part < 0:
+        return kind_heights[kk, r], kind_u[f, kk, r], kind_v[f, kk, r], part
+    return (split_height[f, kk, part], split_u[f, kk, part], split_v[f, kk, part], part)
+
+
 @numba.njit(**JIT)
-def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, slowest, image, drift_ratio):
-    # Per condition and kind of rotor: the slowest U(z) > 0 over the rows and the largest
+def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, split_row, split_height, split_u,
+                split_v, slowest, image, drift_ratio):
+    # Per condition and kind of rotor: the slowest U(z) > 0 over the row slots and the largest
     # image factor, for rotor_centre_offset_bound (inf and 0 where no row flows), and per row
-    # V/U of the veer's drift x V/U (NaN where U <= 0: no flow).
+    # slot V/U of the veer's drift x V/U (NaN where U <= 0: no flow).
+    rows = kind_u.shape[2]
     for f in range(kind_u.shape[0]):
         (cos_a, sin_a, _, _, _, _, r_tube, image_height, _, ground_image) = per_condition[f]
         for kk in range(kind_u.shape[1]):
             lowest, factor = np.inf, 0.0
-            for r in range(kind_u.shape[2]):
-                local_u = kind_u[f, kk, r] * cos_a + kind_v[f, kk, r] * sin_a
+            slots = rows + 1 if split_row.shape[0] > 0 and split_row[f, kk] >= 0 else rows
+            for r in range(slots):
+                z, u, v, _ = _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row,
+                                  split_height, split_u, split_v)
+                local_u = u * cos_a + v * sin_a
                 if local_u > 0.0:
                     lowest = min(lowest, local_u)
-                    drift_ratio[f, kk, r] = (kind_v[f, kk, r] * cos_a
-                                             - kind_u[f, kk, r] * sin_a) / local_u
+                    drift_ratio[f, kk, r] = (v * cos_a - u * sin_a) / local_u
                 else:
                     drift_ratio[f, kk, r] = np.nan
                 if ground_image:
-                    factor = max(factor, image_factor(kind_heights[kk, r], image_height, r_tube))
+                    factor = max(factor, image_factor(z, image_height, r_tube))
             slowest[f, kk], image[f, kk] = lowest, factor
 
 
 @numba.njit(nogil=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
-               kind_u, kind_v, kind_heights, row_chord, sub_y, weight, cell, width, rule,
-               combined, block, track, row_scale, slowest, image, drift_ratio, removed, overlap,
-               reached, first, stride):
+               kind_u, kind_v, kind_heights, split_row, split_height, split_u, split_v,
+               split_fraction, row_chord, sub_y, weight, cell, width, rule, combined, block,
+               track, row_scale, slowest, image, drift_ratio, removed, overlap, reached, first,
+               stride):
     per_row = row_scale.shape[0] > 0
+    split = split_row.shape[0] > 0
+    rows = row_chord.size
     exponents = np.empty(sub_y.shape[1])
     for k in range(wake.shape[0]):
         if not in_share(k, first, stride):
@@ -90,6 +113,10 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
          ground_image) = per_condition[f]
         reach = 4.0 * radius
         area = 0.0
+        # The strip the layer top cuts on this rotor (-1: none): its part above the top is
+        # integrated in the extra row slot ``rows`` at the strip's sub-points.
+        cut = split_row[f, kk] if split else -1
+        slots = rows + 1 if cut >= 0 else rows
         # A bound of the centre's rows' bounds (wake/fused.py rotor_centre_offset_bound): most
         # rows are out of reach by it, with the drift x (V/U) (rounded otherwise than x V / U:
         # a billionth of it is added to the bound), before the row's own bound, which skips
@@ -104,20 +131,23 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         # plugin/rotor/rotor.py), or at every row where the caller reads them all
         # (``every_row``: the bound is not used).
         skipped_first = skipped_last = False
-        for r in range(row_chord.size):
-            dz = kind_heights[kk, r] - hub_height
+        for r in range(slots):
+            height, u, v, part = _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row,
+                                      split_height, split_u, split_v)
+            # (the strip's sub-points, for either part of a cut strip)
+            g = cut if r == rows else r
+            dz = height - hub_height
             if rotor_skip:
                 ratio = drift_ratio[f, kk, r]
                 if ratio == ratio:
                     drift = veer * (x * ratio)
                     nearest = max(abs(offset - drift) - 1e-9 * abs(drift) - rotor_bound
-                                  - radius_j * row_chord[r], 0.0)
+                                  - radius_j * row_chord[g], 0.0)
                     # (NaN, from an overflow, skips nothing)
                     if nearest * nearest + dz * dz >= reach_squared:
                         skipped_first |= r == 0
-                        skipped_last |= r == row_chord.size - 1
+                        skipped_last |= r == rows - 1
                         continue
-            u, v = kind_u[f, kk, r], kind_v[f, kk, r]
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
             # No flow (at and below z0): no wake, no t_hat.
@@ -129,23 +159,23 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
                     # Out of reach whatever the exact centre (wake/fused.py centre_offset_bound):
                     # the row is skipped without the exponential.
                     drift, bound = centre_offset_bound(
-                        x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        x, height, local_u, local_v, strength_c, r_tube,
                         image_height, radius, u_star, veer, ground_image)
-                    nearest = max(abs(offset - drift) - bound - radius_j * row_chord[r], 0.0)
+                    nearest = max(abs(offset - drift) - bound - radius_j * row_chord[g], 0.0)
                     if not (every_row or nearest * nearest + dz * dz < reach_squared):
                         skipped_first |= r == 0
-                        skipped_last |= r == row_chord.size - 1
+                        skipped_last |= r == rows - 1
                         continue
                     growth = time_growth(x, speed, radius, u_star)
                     centre[k, r] = grown_centre_offset(
-                        growth, x, kind_heights[kk, r], local_u, local_v, strength_c, r_tube,
+                        growth, x, height, local_u, local_v, strength_c, r_tube,
                         image_height, veer, ground_image)
                 else:
                     centre[k, r] = 0.0
             lateral = offset - centre[k, r]
             # Only the rows the wake reaches are integrated (plugin/rotor/rotor.py
             # NEGLIGIBLE_DEFICIT): the row's nearest point within reach.
-            gap = max(abs(lateral) - radius_j * row_chord[r], 0.0) ** 2 + dz * dz
+            gap = max(abs(lateral) - radius_j * row_chord[g], 0.0) ** 2 + dz * dz
             if not gap < reach_squared:
                 continue
             reached[k] = True
@@ -156,41 +186,44 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
             # The yaw-only centre lies y_c,veer = x V / U (Eq. yc_veer) beside the full one.
             polar_shift = polar_veer * (x * (local_v if flowing else 0.0) / speed)
             index = block[k] + r
+            # A part of a cut strip weighs its share of the strip's area.
+            fraction = split_fraction[f, kk, part] if part >= 0 else 1.0
             # The row's exponents first, then its deficits, then the superposition in the
             # sub-points' order: short loops the compiler vectorises (wake/fused.py
             # point_exponent) or pipelines.
-            for s in range(width[r]):
-                dy = lateral + radius_j * sub_y[r, s]
+            for s in range(width[g]):
+                dy = lateral + radius_j * sub_y[g, s]
                 exponents[s] = point_exponent(dy, dz, dy + polar_shift, kx, xi0, sin2b,
                                               q0, q1, q2, q3, q4)
             if shape == GAUSSIAN_SHAPE:  # (the branch out of the loop)
-                for s in range(width[r]):
+                for s in range(width[g]):
                     exponents[s] = shaped_deficit(exponents[s], amplitude, GAUSSIAN_SHAPE)
             else:
-                for s in range(width[r]):
+                for s in range(width[g]):
                     exponents[s] = shaped_deficit(exponents[s], amplitude, shape)
             # The cumulative wake's amplitude at the row's height (plugin/rotor/rotor.py).
             row_amplitude = scale * row_scale[k, r] if per_row else scale
-            for s in range(width[r]):
-                dy = lateral + radius_j * sub_y[r, s]
+            for s in range(width[g]):
+                dy = lateral + radius_j * sub_y[g, s]
                 du = exponents[s] * row_amplitude
                 old = np.float64(combined[index, s]) if rule else 0.0
                 new = superposed(rule, old, du)
-                removed[k, cell[r, s]] += removed_moment(weight[r, s], ambient_u, old, new,
-                                                         moment)
+                w = weight[g, s] * fraction if part >= 0 else weight[g, s]
+                removed[k, cell[g, s]] += removed_moment(w, ambient_u, old, new, moment)
                 if rule:
                     combined[index, s] = new
                 # The overlap: wake velocity above ``overlap_edge`` (FLORIS's 0.05 m/s, or the
                 # wake's velocity at its radius 2 sigma: plugin/rotor/rotor.py) within 2 D of
                 # the wake's rotor laterally, as the area of the disk where it holds.
                 if track and du > overlap_edge and abs(dy + centre[k, r]) < reach:
-                    area += weight[r, s]
+                    area += w
         overlap[k] = area
         if reached[k] and (skipped_first or skipped_last):
-            for r in (0, row_chord.size - 1):
+            for r in (0, rows - 1):
                 if (r == 0 and skipped_first) or (r > 0 and skipped_last):
-                    u, v = kind_u[f, kk, r], kind_v[f, kk, r]
-                    centre[k, r] = centre_offset(x, kind_heights[kk, r], u * cos_a + v * sin_a,
+                    height, u, v, _ = _row(f, kk, r, rows, kind_u, kind_v, kind_heights,
+                                           split_row, split_height, split_u, split_v)
+                    centre[k, r] = centre_offset(x, height, u * cos_a + v * sin_a,
                                                  v * cos_a - u * sin_a, strength_c, r_tube,
                                                  image_height, radius, u_star, veer,
                                                  ground_image)
@@ -254,24 +287,28 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
 
 
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                   every_row=False, row_scale=None):
+                   every_row=False, row_scale=None, split=False):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
     unless ``track``), (pairs,) whether
-    the wake reached a row of the rotor, and (pairs, rows) the wake's centre at the rows.
+    the wake reached a row of the rotor, and (pairs, rows + 1) the wake's centre at the row
+    slots (``RotorCells.slots``).
 
     ``wake`` (pairs, WAKE_TABLE) and ``pair`` (pairs, PAIR_COLUMNS): the tables, one row per
     rotor within reach; ``per_condition`` (n_findex, CONDITION_COLUMNS); ``centre`` (pairs,
-    rows) the wake's centre at the rows, or None: the kernel evaluates it from the centre's
-    columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each rotor's flat index (condition * n_turbines + turbine),
+    rows + 1) the wake's centre at the row slots, or None: the kernel evaluates it from the
+    centre's columns of ``per_condition`` (the ekman_veer deflection); ``flat`` (pairs,) each
+    rotor's flat index (condition * n_turbines + turbine),
     ``kind`` its kind (plugin/inflow/ambient.py ``RotorAmbient``); ``wakes`` the solve's
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
     updated in place. The centre the kernel evaluates is exact at every row of the rotors
     reached with ``every_row``; without, at their first and last rows and those it reaches (0
-    at the rows a bound of the centre put out of reach). ``row_scale`` (pairs, rows) or None: a
-    factor of the pair's ``velocity_scale`` per row (the cumulative wake's C_n at the row's
-    height).
+    at the rows a bound of the centre put out of reach). ``row_scale`` (pairs, rows + 1) or
+    None: a factor of the pair's ``velocity_scale`` per row slot (the cumulative wake's C_n at
+    the row's height). ``split``: the strip a layer top cuts is integrated as its two parts
+    (``rotor.split``, plugin/rotor/strip_split.py; ``centre`` and ``row_scale`` then hold the
+    parts at the cut strip's row and the extra slot); else the shared strips.
     """
     cells = wakes.cells
     n_pairs = flat.size
@@ -279,19 +316,24 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     overlap = np.zeros(n_pairs)
     reached = np.zeros(n_pairs, dtype=bool)
     compute_centre = centre is None
-    centre = np.zeros((n_pairs, cells.rows)) if compute_centre else np.ascontiguousarray(centre)
+    centre = np.zeros((n_pairs, cells.slots)) if compute_centre else np.ascontiguousarray(centre)
     per_condition = np.ascontiguousarray(per_condition)
+    parts = rotor.split
+    if split:
+        split_arrays = (parts.row, parts.height, parts.u, parts.v, parts.fraction)
+    else:
+        split_arrays = (np.zeros((0, 0), dtype=np.int64), *(np.zeros((0, 0, 0)),) * 4)
     slowest, image = np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2])
-    drift_ratio = np.empty(rotor.kind_u.shape)
+    drift_ratio = np.empty((*rotor.kind_u.shape[:2], cells.slots))
     if compute_centre and not every_row:
-        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights, slowest, image,
-                    drift_ratio)
+        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
+                    *split_arrays[:4], slowest, image, drift_ratio)
     split_over_threads(
         _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
         per_condition, compute_centre, bool(every_row), centre,
         flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
-        cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid, cells.row_width,
-        wakes.rule_code, wakes.combined, flat * cells.rows, bool(track),
+        *split_arrays, cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid,
+        cells.row_width, wakes.rule_code, wakes.combined, flat * cells.slots, bool(track),
         np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), slowest,
         image, drift_ratio, removed, overlap, reached)
     return removed, overlap, reached, centre

@@ -139,7 +139,8 @@ class RotorWakes:
         rule: "sosfs", "fls", "max" (FLORIS's combination model), or None: unknown, each call
             returns its own wake's cell deficits.
         combined: (n_findex * n_turbines * rows, columns) combined wake velocity [m/s] at the
-            sub-points, one block per rotor and row (RotorCells.sub_y's).
+            sub-points, one block per rotor and row slot (RotorCells.sub_y's rows and the
+            slot of the part above a layer top of the strip it cuts, RotorCells.slots).
         removed: (n_findex * n_turbines, n^2) n^2 sum_{s in k} w_s (U_s^m - u_s^m) of the
             combined wakes.
         wake: (n_findex * n_turbines, n^2) the wake velocity U_k d_k FLORIS holds at each point.
@@ -190,7 +191,7 @@ class RotorWakes:
                           else WakeConvection.start(pairs, n_turbines))
         # Single precision: a round-off of 1e-7 of the wake velocity, far below the cells'
         # quadrature error, for half the memory.
-        combined = np.zeros((pairs * cells.rows if rule else 0, cells.sub_y.shape[1]),
+        combined = np.zeros((pairs * cells.slots if rule else 0, cells.sub_y.shape[1]),
                             dtype=np.float32)
         turbulence = np.broadcast_to(np.reshape(ambient_turbulence, (-1, 1)),
                                      (n_findex, n_turbines)).copy()
@@ -213,7 +214,7 @@ class RotorWakes:
         sub-point, weight (u_before^m - u_after^m)."""
         pair, row = np.asarray(pair), np.asarray(row)
         return _superpose_rows(
-            self.rule_code, self.combined, pair * self.cells.rows + row,
+            self.rule_code, self.combined, pair * self.cells.slots + row,
             np.ascontiguousarray(du, dtype=float), np.ravel(ambient_u).astype(float),
             np.ravel(moment).astype(float), self.cells.weight, row)
 

@@ -1,0 +1,86 @@
+"""The strip of the wake cells that a stable layer's top cuts, split per condition in two
+(docs/coupling.md#rotor-average).
+
+The wake cells' strips (plugin/rotor/rotor_cells.py) are shared by every condition of a rotor
+kind; a step in height (the jet nose at the layer top h, and the veer deflection x V / U that
+moves a wake centre by up to a radius within metres below it) is integrated by them to first
+order: the strip h cuts counts on one side of it. Per condition and rotor kind whose h lies on
+the rotor, that strip is integrated here as two parts, below and above h, each at its own
+mid-height and with its exact area of the disk, at the strip's own sub-points across the chord
+(its cells): the strip's row holds the part below h, the rotor's extra row slot
+(``RotorCells.slots``) the part above. Where h is off the rotor (neutral layers, tall stable
+ones) nothing is split: the slot has no weight and is skipped, and the results are those of
+the shared strips bit for bit. Pure geometry and numpy: no FLORIS import.
+"""
+
+from __future__ import annotations
+
+import attrs
+import numpy as np
+
+from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells, row_interpolation, strip_area
+
+
+@attrs.define(frozen=True)
+class StripSplit:
+    """Per condition and rotor kind (n_findex, kinds): ``row`` the strip the layer top cuts
+    (-1: none); per part (n_findex, kinds, 2), below then above the top: ``offset`` its
+    mid-height in rotor radii from the hub, ``height`` [m], ``fraction`` its share of the
+    strip's area (the two sum to 1) and the ambient ``u``, ``v`` there (FLORIS's frame)."""
+
+    row: np.ndarray
+    offset: np.ndarray
+    height: np.ndarray
+    fraction: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+
+    @classmethod
+    def of(cls, cells: RotorCells, hub_height, radius, top, profile) -> StripSplit:
+        """The split of ``cells`` on rotor kinds of ``hub_height``, ``radius`` (kinds,) [m]
+        under layer tops ``top`` (n_findex,) [m] (not finite: no top); ``profile(z)``, ``z``
+        (n_findex, 1, 1, heights), returns the ambient (U, V) shaped like it."""
+        top = np.asarray(top, dtype=float).reshape(-1, 1)
+        offset = (np.where(np.isfinite(top), top, np.inf) - hub_height) / radius
+        row = np.searchsorted(cells.edges, offset, side="right") - 1
+        # (strictly inside a strip: a top on an edge is integrated exactly by the strips)
+        inside = (row >= 0) & (row < cells.rows)
+        row = np.where(inside, row, 0)
+        lower, upper = cells.edges[row], cells.edges[row + 1]
+        inside &= (offset > lower) & (offset < upper)
+        offset = np.where(inside, offset, 0.5 * (lower + upper))
+        parts = np.stack([0.5 * (lower + offset), 0.5 * (offset + upper)], axis=-1)
+        strip = strip_area(lower, upper)
+        fraction = np.stack([strip_area(lower, offset), strip_area(offset, upper)],
+                            axis=-1) / strip[..., None]
+        row = np.where(inside, row, -1)
+        parts = np.where(inside[..., None], parts, 0.0)
+        height = hub_height[:, None] + radius[:, None] * parts
+        n_findex, kinds = row.shape
+        u, v = (np.asarray(values).reshape(n_findex, kinds, 2)
+                for values in profile(height.reshape(n_findex, 1, 1, -1)))
+        return cls(row.astype(np.int64), parts, height, fraction, u, v)
+
+    @property
+    def any(self) -> bool:
+        """Whether a layer top lies on a rotor of some condition."""
+        return bool(np.any(self.row >= 0))
+
+    def at_rows(self, point_values, row_values, f, kind, n: int) -> np.ndarray:
+        """Values held at the n grid-point heights of rotors (f, kind) (pairs, n) at their
+        row slots (pairs, rows + 1): ``row_values`` (pairs, rows) at the shared rows, the
+        split strip's parts interpolated as the rows are (rotor_cells.row_interpolation), 0
+        in the slot of the rotors not split."""
+        pairs, rows = row_values.shape
+        out = np.zeros((pairs, rows + 1))
+        out[:, :rows] = row_values
+        row = self.row[f, kind]
+        split = np.flatnonzero(row >= 0)
+        if split.size:
+            weights = row_interpolation(n, self.offset[f[split], kind[split]])
+            parts = np.zeros((split.size, 2))
+            for q in range(n):  # (in the points' order, as the rows are summed)
+                parts += point_values[split, q, None] * weights[q]
+            out[split, row[split]] = parts[:, 0]
+            out[split, rows] = parts[:, 1]
+        return out
