@@ -7,12 +7,13 @@ The wake cells' strips (plugin/rotor/rotor_cells.py) integrate a step in height 
 the whole strip it cuts counts on one side of it. In a stable layer whose top lies on the rotor
 the inflow has such a step there (the jet nose, and the veer deflection x V / U), at a height
 that moves with the condition, so the shipped strips, shared by all conditions of a rotor kind,
-cannot follow it (docs/coupling.md#rotor-average). This study runs the 16 cases of
+cannot follow it; the package splits the strip h cuts per condition instead
+(plugin/rotor/strip_split.py, docs/coupling.md#rotor-average). This study runs the 16 cases of
 benchmarks/matched_accuracy.py one wind speed at a time (one layer top h per run), on 2 x 2 and
-3 x 3 cells with the shipped strips and with the strip edge nearest to h moved to h
-(``rotor_cells(..., step_height=...)``), each against the same 20 x 20 answer (its strips
-untouched), with the wakes summed and with the cumulative default, and prints the largest
-|P_farm / P_farm,20x20 - 1| per case and over all.
+3 x 3 cells with the shipped strips (the cut strip split) and with the strip edge nearest to h
+moved to h (``rotor_cells(..., step_height=...)``: nothing left to split), each against the same
+20 x 20 answer (its strips untouched), with the wakes summed and with the cumulative default,
+and prints the largest |P_farm / P_farm,20x20 - 1| per case and over all.
 
 ``--sweep``: instead, the shipped strips' count on 2 x 2 and 3 x 3 cells raised from 8 to 24 per
 grid point (16 / 24 strips shipped), all conditions of each case in one run, against the same

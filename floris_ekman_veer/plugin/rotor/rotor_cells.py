@@ -46,7 +46,9 @@ heights at the same sub-points, cost as much as more strips), so equal strips st
 height is known per condition (the layer top h): a strip edge there
 (``rotor_cells(..., step_height=...)``) takes the 2 x 2 cells to 0.45 % on the same 16 strips
 (benchmarks/layer_top_strips.py), but the strips are shared by every condition of a rotor kind
-and h moves with the condition, so that needs a strip split per condition, not yet done.
+and h moves with the condition: instead, per condition and rotor kind, the strip that h cuts is
+integrated as its two parts below and above h, the part above in one extra row slot per rotor
+(:attr:`RotorCells.slots`, plugin/rotor/strip_split.py).
 """
 
 from __future__ import annotations
@@ -251,7 +253,8 @@ def rotor_cells(n: int, rows: int, nodes_per_interval: int,
     moved there, so that a step in height at a known place (a stable layer's top) is integrated
     by whole strips on either side of it (the module docstring). The package's wake cells do not
     use it: their strips are shared by every condition of a rotor kind, while the layer top
-    moves with the condition; benchmarks/layer_top_strips.py measures what it would gain.
+    moves with the condition, so they split the strip it cuts per condition instead
+    (plugin/rotor/strip_split.py); benchmarks/layer_top_strips.py compares the two.
     """
     if n < 1 or rows < 1 or nodes_per_interval < 1:
         raise ValueError(
