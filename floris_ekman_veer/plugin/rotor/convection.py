@@ -77,15 +77,30 @@ class WakeConvection:
         self.count[pair] += 1
 
 
-def removed_moments(cells: RotorCells, combined, pair, convection, ambient_u, moment):
+def removed_moments(cells: RotorCells, combined, pair, convection, ambient_u, moment,
+                    slots=None):
     """sum_{s in k} w_s (U_s^m - (U_s - c_s)^m) of every cell of rotors ``pair`` (flat indices),
     with c_s = (sum_i U_c,i u_i) / U_c the combined wake at the sub-points (``combined``:
-    RotorWakes.combined, one block of rows per rotor), ``convection`` (pairs,) U_c,
+    RotorWakes.combined, one block of row slots per rotor), ``convection`` (pairs,) U_c,
     ``ambient_u`` (pairs, rows) U at the rows (0 where there is no flow), ``moment`` (pairs,)
-    3 or 1. Returns (pairs, n^2), as the kernel's ``removed``."""
-    # (the rows of each rotor's slots: this superposition integrates the shared strips)
-    blocks = combined.reshape(-1, cells.slots, cells.sub_y.shape[1])[pair, :cells.rows]
-    blocks = blocks.astype(float)
+    3 or 1. Returns (pairs, n^2), as the kernel's ``removed``. ``slots``: None (the shared
+    strips' rows), or per rotor and row slot (pairs, rows + 1) the strip whose sub-points it
+    takes and its share of that strip's area (plugin/rotor/strip_split.py ``pair_rows``: the
+    strip a layer top cuts as its two parts; ``ambient_u`` then (pairs, rows + 1))."""
+    blocks = combined.reshape(-1, cells.slots, cells.sub_y.shape[1])[pair]
+    if slots is not None:
+        strips, fraction = slots
+        wake = blocks.astype(float) / convection[:, None, None]
+        u = ambient_u[:, :, None]
+        after = u - wake
+        cubic = (moment == 3.0)[:, None, None]
+        removed = np.where(cubic, wake * (u * u + u * after + after * after), wake)
+        removed = (np.where(u > 0.0, removed, 0.0) * cells.weight[strips]
+                   * fraction[:, :, None])
+        cell = np.arange(pair.size)[:, None, None] * cells.n**2 + cells.cell_grid[strips]
+        return np.bincount(cell.ravel(), weights=removed.ravel(),
+                           minlength=pair.size * cells.n**2).reshape(pair.size, cells.n**2)
+    blocks = blocks[:, :cells.rows].astype(float)
     wake = blocks / convection[:, None, None]
     u = ambient_u[:, :, None]
     cubic = (moment == 3.0)[:, None, None]

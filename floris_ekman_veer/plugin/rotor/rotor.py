@@ -233,8 +233,8 @@ def reached_rotor_cell_deficit(
     ishihara_qian = track and model.wake_turbulence == "ishihara_qian"
     every_row = convecting or ishihara_qian
     # The strip a layer top cuts, integrated as its parts below and above the top
-    # (plugin/rotor/strip_split.py); not yet on the paths that read every row's centre.
-    split = rotor.split.any and not every_row
+    # (plugin/rotor/strip_split.py).
+    split = rotor.split.any
     if centre_table is None:
         # Another deflection model: its centre at the point rows, interpolated in height.
         # (A sum over the n points, not a matrix product: BLAS would block the product by
@@ -297,8 +297,9 @@ def reached_rotor_cell_deficit(
     removed, overlap, reached, centre = integrate_wake(
         table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
         kind, rotor, wakes, track, every_row=every_row, row_scale=row_scale, split=split)
-    # (the shared rows' centres: the cut strip's row holds its part below the top)
-    centre = centre[:, :cells.rows]
+    # (the centre at the row slots, for the paths that read every row; the shared rows'
+    # for the resolution check: the cut strip's row holds its part below the top)
+    slot_centre, centre = centre, centre[:, :cells.rows]
     reached = np.flatnonzero(reached)
     if reached.size == 0:
         return result.reshape(u_initial.shape), _NONE
@@ -307,7 +308,7 @@ def reached_rotor_cell_deficit(
                               lateral[reached], offsets[reached], height[reached])
     if convecting:
         removed = _momentum_conserving(
-            wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair, y_i, hub_height_i,
+            wakes, rotor, reached, flat, f, j, kind, moment, slot_centre, split, per_pair, y_i, hub_height_i,
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
     _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
@@ -317,7 +318,8 @@ def reached_rotor_cell_deficit(
     result.reshape(n_findex * n_turbines, -1)[rows] = wakes.cell_returns(
         rows, removed[reached], u_cell, moment[reached][:, None])
     if ishihara_qian:
-        added = _ishihara_qian(x_pair[reached], per_pair, reached, centre[reached],
+        added = _ishihara_qian(x_pair[reached], per_pair, reached, slot_centre[reached],
+                               split,
                                rotor, f[reached], j[reached], kind[reached],
                                hub_height_i[f[reached], 0, 0, 0],
                                ambient.floris_turbulence, x_i.shape[0])
@@ -365,27 +367,38 @@ def _columns(values, names, shape):
 CONVECTION_THRESHOLD = 0.01
 
 
-def _momentum_conserving(wakes, rotor, reached, flat, f, j, kind, moment, centre, per_pair,
-                         y_i, hub_height_i, width, centre_speed, wake_convection):
+def _momentum_conserving(wakes, rotor, reached, flat, f, j, kind, moment, centre, split,
+                         per_pair, y_i, hub_height_i, width, centre_speed, wake_convection):
     """The cells' removed moment (pairs, n^2), as the kernel returns it, of the rotors reached by
     turbine i's wake after Zong & Porte-Agel's superposition (plugin/rotor/convection.py): the
     wake's Gaussian equivalent (centre deficit, width k_w x + xi0 of the kernel's table, centre
     at the rows' mean) joins the rotor's where its deficit on the rotor exceeds
     CONVECTION_THRESHOLD U_0, U_c is updated and the whole rotor's moment recomputed, less what
-    the cells already removed."""
+    the cells already removed. ``centre`` (pairs, row slots); ``split``: the strip a layer top
+    cuts is integrated as its parts (plugin/rotor/strip_split.py)."""
+    cells = wakes.cells
     pick = lambda a: np.broadcast_to(a, flat.shape)[reached]  # noqa: E731
     pairs = flat[reached]
     f, j, kind = f[reached], j[reached], kind[reached]
     hub_speed, width = pick(per_pair["hub_speed"]), pick(width)
     centre_speed, wake_convection = pick(centre_speed), pick(wake_convection)
-    centre_y = y_i[f, 0, 0, 0] + centre[reached].mean(axis=1)
+    if split:
+        strips, fraction, heights, u, v = rotor.split.pair_rows(
+            cells, rotor.kind_heights, rotor.kind_u, rotor.kind_v, f, kind)
+        centre, chord = centre[reached], cells.row_chord[strips]
+    else:
+        centre, chord = centre[reached][:, :cells.rows], cells.row_chord
+        heights, u, v = rotor.kind_heights[kind], rotor.kind_u[f, kind], rotor.kind_v[f, kind]
+    centre_y = y_i[f, 0, 0, 0] + centre[:, :cells.rows].mean(axis=1)
     centre_z = hub_height_i[f, 0, 0, 0]
     # The rotor's nearest sub-point row to the wake's centre line (veer shears it row by row).
     radius_j = rotor.radius[f, j][:, None]
-    lateral = np.maximum(np.abs(pick(per_pair["offset"])[:, None] - centre[reached])
-                         - radius_j * wakes.cells.row_chord, 0.0)
-    gap_squared = np.min(lateral**2 + (rotor.kind_heights[kind] - centre_z[:, None]) ** 2,
-                         axis=1)
+    lateral = np.maximum(np.abs(pick(per_pair["offset"])[:, None] - centre)
+                         - radius_j * chord, 0.0)
+    gap_squared = lateral**2 + (heights - centre_z[:, None]) ** 2
+    if split:
+        gap_squared = np.where(fraction > 0.0, gap_squared, np.inf)  # (empty slots)
+    gap_squared = np.min(gap_squared, axis=1)
     joins = (centre_speed * np.exp(-gap_squared / (2.0 * width**2))
              > CONVECTION_THRESHOLD * hub_speed)
     state = wakes.convection
@@ -393,26 +406,33 @@ def _momentum_conserving(wakes, rotor, reached, flat, f, j, kind, moment, centre
               centre_y[joins], centre_z[joins], hub_speed[joins])
     # A rotor no wake has joined yet: its wakes add linearly (weight 1 for this one).
     convection = np.where(state.count[pairs] > 0, state.velocity[pairs], wake_convection)
-    u, v = rotor.kind_u[f, kind], rotor.kind_v[f, kind]
     flowing = u * pick(per_pair["cos"])[:, None] + v * pick(per_pair["sin"])[:, None] > 0.0
-    total = removed_moments(wakes.cells, wakes.combined, pairs, convection,
-                            np.where(flowing, u, 0.0), moment[reached])
-    removed = np.zeros((flat.size, wakes.cells.n**2))
-    removed[reached] = total - wakes.removed[pairs] / wakes.cells.n**2
+    total = removed_moments(cells, wakes.combined, pairs, convection,
+                            np.where(flowing, u, 0.0), moment[reached],
+                            (strips, fraction) if split else None)
+    removed = np.zeros((flat.size, cells.n**2))
+    removed[reached] = total - wakes.removed[pairs] / cells.n**2
     return removed
 
 
-def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
+def _ishihara_qian(x, per_pair, reached, centre, split, rotor, f, j, kind, hub_height,
                    ambient_turbulence, n_findex):
     """Ishihara & Qian's (2018) added turbulence of turbine i's wake at rotors (f, j), the mean
-    over each rotor's sub-points (the wake's centre at the rows, ``centre``: (pairs, rows)),
+    over each rotor's sub-points (the wake's centre at the row slots, ``centre``: (pairs,
+    slots); ``split``: the strip a layer top cuts as its parts, plugin/rotor/strip_split.py),
     not below 0 (the ground term lowers it below the hub), within 15 D downstream as FLORIS has
     Crespo-Hernandez (docs/coupling.md#wakes-deep-in-an-array)."""
     cells = rotor.cells
     radius_j = rotor.radius[f, j][:, None, None]
-    lateral = (per_pair["offset"][reached][:, None] - centre)[:, :, None] \
-        + radius_j * cells.sub_y
-    heights = rotor.kind_heights[kind][:, :, None]
+    if split:
+        strips, fraction, heights, _, _ = rotor.split.pair_rows(
+            cells, rotor.kind_heights, rotor.kind_u, rotor.kind_v, f, kind)
+        sub_y, heights = cells.sub_y[strips], heights[:, :, None]
+        weight = cells.weight[strips] * fraction[:, :, None]
+    else:
+        centre, sub_y = centre[:, :cells.rows], cells.sub_y
+        heights = rotor.kind_heights[kind][:, :, None]
+    lateral = (per_pair["offset"][reached][:, None] - centre)[:, :, None] + radius_j * sub_y
     r = np.hypot(lateral, heights - hub_height[:, None, None])
     diameter = 2.0 * per_pair["radius"][reached]
     ambient = np.broadcast_to(ambient_turbulence, (n_findex, 1, 1, 1))[f, 0, 0, 0]
@@ -420,7 +440,10 @@ def _ishihara_qian(x, per_pair, reached, centre, rotor, f, j, kind, hub_height,
     added = ishihara_qian_added_turbulence(
         column(x), r, np.broadcast_to(heights, r.shape), column(per_pair["ct"][reached]),
         column(ambient), column(diameter), column(hub_height))
-    mean = np.einsum("prs,rs->p", added, cells.weight)
+    if split:
+        mean = np.einsum("prs,prs->p", added, weight)
+    else:
+        mean = np.einsum("prs,rs->p", added, cells.weight)
     return np.maximum(mean, 0.0) * (x <= 15.0 * diameter)
 
 

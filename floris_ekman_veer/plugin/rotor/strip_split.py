@@ -66,6 +66,28 @@ class StripSplit:
         """Whether a layer top lies on a rotor of some condition."""
         return bool(np.any(self.row >= 0))
 
+    def pair_rows(self, cells: RotorCells, kind_heights, kind_u, kind_v, f, kind):
+        """The row slots of rotors (f, kind) as the kernel integrates them, (pairs, rows + 1)
+        each: the strip row whose sub-points each slot takes (the extra slot: the cut strip's,
+        or row 0 where nothing is cut), its share of that strip's area (0: an empty slot), its
+        height [m] and ambient (U, V) (``kind_heights`` (kinds, rows), ``kind_u``, ``kind_v``
+        (n_findex, kinds, rows): the shared rows')."""
+        pairs, rows = f.size, cells.rows
+        cut = self.row[f, kind]
+        strip = np.tile(np.arange(rows + 1), (pairs, 1))
+        strip[:, rows] = np.where(cut >= 0, cut, 0)
+        fraction = np.ones((pairs, rows + 1))
+        fraction[:, rows] = 0.0
+        slot = lambda values: np.concatenate([values, values[:, :1]], axis=1)  # noqa: E731
+        height, u, v = slot(kind_heights[kind]), slot(kind_u[f, kind]), slot(kind_v[f, kind])
+        split = np.flatnonzero(cut >= 0)
+        for part, column in enumerate((cut[split], rows)):
+            at = (f[split], kind[split], part)
+            fraction[split, column] = self.fraction[at]
+            height[split, column] = self.height[at]
+            u[split, column], v[split, column] = self.u[at], self.v[at]
+        return strip, fraction, height, u, v
+
     def at_rows(self, point_values, row_values, f, kind, n: int) -> np.ndarray:
         """Values held at the n grid-point heights of rotors (f, kind) (pairs, n) at their
         row slots (pairs, rows + 1): ``row_values`` (pairs, rows) at the shared rows, the

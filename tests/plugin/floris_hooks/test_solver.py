@@ -214,7 +214,7 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
     speeds, directions = rng.uniform(5.0, 13.0, n), rng.uniform(0.0, 360.0, n)
     yaw = rng.uniform(-25.0, 25.0, (n, 16))
     original = rotor_module.integrate_wake
-    checked = []
+    checked, cut = [], []
 
     def checking(*arguments, every_row=False, **options):
         # (options: the cumulative wake's row_scale, passed through)
@@ -230,19 +230,27 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
         f = (flat // rotor.x.shape[1])[reached]
         k = kind[reached]
         column = lambda name: per_condition[f, CONDITION_COLUMNS.index(name)][:, None]  # noqa: E731
-        u, v = rotor.kind_u[f, k], rotor.kind_v[f, k]
+        # (the row slots: the strip a layer top cuts as its two parts, the slots no part
+        # takes left out; plugin/rotor/strip_split.py)
+        assert options["split"] == rotor.split.any
+        _, fraction, heights, u, v = rotor.split.pair_rows(
+            rotor.cells, rotor.kind_heights, rotor.kind_u, rotor.kind_v, f, k)
         cos_a, sin_a = column("cos"), column("sin")
         exact = centre_offsets(
-            pair[reached, PAIR_COLUMNS.index("x")][:, None], rotor.kind_heights[k],
+            pair[reached, PAIR_COLUMNS.index("x")][:, None], heights,
             u * cos_a + v * sin_a, v * cos_a - u * sin_a, column("centre_strength"),
             column("centre_r_tube"), column("centre_image_height"), column("radius"),
             column("friction_velocity"))
-        np.testing.assert_array_equal(result[3][reached], exact)
-        skipped = bounded[3][reached] != exact
+        taken = fraction > 0.0
+        np.testing.assert_array_equal(result[3][reached][taken], exact[taken])
+        assert np.all(result[3][reached][~taken] == 0.0)
+        skipped = taken & (bounded[3][reached] != exact)
         assert np.all(bounded[3][reached][skipped] == 0.0)
         checked.append(np.count_nonzero(skipped))
+        cut.append(np.count_nonzero(taken[:, -1]))
         return result
 
     monkeypatch.setattr(rotor_module, "integrate_wake", checking)
     solve(config, speeds, directions, yaw, floris_own=False)
     assert len(checked) > 5 and sum(checked) > 0
+    assert sum(cut) > 0  # (some rotors have their strip cut by the layer top)

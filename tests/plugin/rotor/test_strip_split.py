@@ -177,3 +177,34 @@ def test_split_strips_give_the_same_bits_on_one_and_many_threads():
         numba.set_num_threads(before)
     for a, b in zip(one, many, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_momentum_conserving_moments_of_two_equal_parts_are_the_strips():
+    """plugin/rotor/convection.py ``removed_moments`` on row slots: a strip cut in two parts
+    (shares 0.3 and 0.7) that hold the same wake and inflow as the whole strip removes the
+    strip's moment from the same cells (the slot takes the strip's sub-points), to round-off;
+    an empty slot (share 0) removes nothing."""
+    from floris_ekman_veer.plugin.rotor.convection import removed_moments
+
+    cells = rotor_cells(3, *sub_quadrature(3, 2.0 * RADIUS))
+    rows, pairs = cells.rows, 3
+    rng = np.random.default_rng(5)
+    combined = rng.uniform(0.0, 2.0, (pairs * cells.slots, cells.sub_y.shape[1]))
+    combined = combined.astype(np.float32)
+    ambient_u = rng.uniform(6.0, 11.0, (pairs, rows))
+    strips = np.tile(np.arange(rows + 1), (pairs, 1))
+    strips[:, rows] = [7, 0, 15]
+    fraction = np.ones((pairs, rows + 1))
+    fraction[[0, 2], [7, 15]] = 0.3
+    fraction[:, rows] = [0.7, 0.0, 0.7]
+    blocks = combined.reshape(pairs, cells.slots, -1)
+    blocks[:, rows] = blocks[np.arange(pairs), strips[:, rows]]
+    slot_u = np.concatenate([ambient_u, ambient_u[np.arange(pairs), strips[:, rows]][:, None]],
+                            axis=1)
+    pair, convection, moment = np.arange(pairs), np.array([9.0, 8.5, 10.0]), np.array([3.0,
+                                                                                       1.0,
+                                                                                       3.0])
+    whole = removed_moments(cells, combined, pair, convection, ambient_u, moment)
+    parts = removed_moments(cells, combined, pair, convection, slot_u, moment,
+                            (strips, fraction))
+    np.testing.assert_allclose(parts, whole, rtol=1e-12)
