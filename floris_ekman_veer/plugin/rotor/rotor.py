@@ -308,7 +308,8 @@ def reached_rotor_cell_deficit(
                               lateral[reached], offsets[reached], height[reached])
     if convecting:
         removed = _momentum_conserving(
-            wakes, rotor, reached, flat, f, j, kind, moment, slot_centre, split, per_pair, y_i, hub_height_i,
+            wakes, rotor, reached, flat, f, j, kind, moment, slot_centre, split, per_pair, y_i,
+            hub_height_i,
             table[:, WAKE_TABLE.index("kx")] + table[:, WAKE_TABLE.index("xi0")], centre_speed,
             wake_convection)
     _check_resolution(x_pair, f, j, reached, source_wake, centre, rotor)
@@ -319,8 +320,7 @@ def reached_rotor_cell_deficit(
         rows, removed[reached], u_cell, moment[reached][:, None])
     if ishihara_qian:
         added = _ishihara_qian(x_pair[reached], per_pair, reached, slot_centre[reached],
-                               split,
-                               rotor, f[reached], j[reached], kind[reached],
+                               split, rotor, f[reached], j[reached], kind[reached],
                                hub_height_i[f[reached], 0, 0, 0],
                                ambient.floris_turbulence, x_i.shape[0])
         wakes.add_turbulence(f[reached], j[reached], added, np.broadcast_to(
