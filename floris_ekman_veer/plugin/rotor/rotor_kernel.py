@@ -50,26 +50,11 @@ CENTRE_COLUMNS = ("strength", "r_tube", "image_height", "veer", "ground_image")
 CONDITION_COLUMNS = ("cos", "sin", "friction_velocity", "radius", "hub_height",
                      *(f"centre_{k}" for k in CENTRE_COLUMNS))
 
-@numba.njit(inline="always", **JIT)
-def _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row, split_height, split_u,
-         split_v):
-    # Row slot r of kind kk at condition f: its height, ambient (U, V) and, for the parts of
-    # the strip the layer top cuts (plugin/rotor/strip_split.py), which part (0 below, 1
-    # above in the extra slot r = rows; -1: a whole strip).
-    part = -1
-    if r == rows:
-        part = 1
-    elif split_row.shape[0] > 0 and r == split_row[f, kk]:
-        part = 0
-    if part < 0:
-        return kind_heights[kk, r], kind_u[f, kk, r], kind_v[f, kk, r], part
-    return (split_height[f, kk, part], split_u[f, kk, part], split_v[f, kk, part], part)
-
-
 @numba.njit(**JIT)
 def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, split_row, split_height, split_u,
                 split_v, slowest, image, drift_ratio):
-    # Per condition and kind of rotor: the slowest U(z) > 0 over the row slots and the largest
+    # Per condition and kind of rotor: the slowest U(z) > 0 over the row slots (the strip a
+    # layer top cuts as its two parts, plugin/rotor/strip_split.py) and the largest
     # image factor, for rotor_centre_offset_bound (inf and 0 where no row flows), and per row
     # slot V/U of the veer's drift x V/U (NaN where U <= 0: no flow).
     rows = kind_u.shape[2]
@@ -77,10 +62,13 @@ def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, split_row, split_he
         (cos_a, sin_a, _, _, _, _, r_tube, image_height, _, ground_image) = per_condition[f]
         for kk in range(kind_u.shape[1]):
             lowest, factor = np.inf, 0.0
-            slots = rows + 1 if split_row.shape[0] > 0 and split_row[f, kk] >= 0 else rows
-            for r in range(slots):
-                z, u, v, _ = _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row,
-                                  split_height, split_u, split_v)
+            cut = split_row[f, kk] if split_row.shape[0] > 0 else -1
+            for r in range(rows + 1 if cut >= 0 else rows):
+                if r == rows or r == cut:  # (the parts above and below the layer top)
+                    part = 1 if r == rows else 0
+                    z, u, v = split_height[f, kk, part], split_u[f, kk, part], split_v[f, kk, part]
+                else:
+                    z, u, v = kind_heights[kk, r], kind_u[f, kk, r], kind_v[f, kk, r]
                 local_u = u * cos_a + v * sin_a
                 if local_u > 0.0:
                     lowest = min(lowest, local_u)
@@ -132,10 +120,21 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         # (``every_row``: the bound is not used).
         skipped_first = skipped_last = False
         for r in range(slots):
-            height, u, v, part = _row(f, kk, r, rows, kind_u, kind_v, kind_heights, split_row,
-                                      split_height, split_u, split_v)
-            # (the strip's sub-points, for either part of a cut strip)
-            g = cut if r == rows else r
+            # Slot r: a whole strip, or a part of the strip the layer top cuts (0 below the top,
+            # in the strip's row; 1 above it, in the extra slot), at the strip's sub-points g.
+            # (Written out here: an inlined helper returning the row's tuple cost the kernel
+            # 2.5 x its time, measured.)
+            g = r
+            part = -1
+            if r == rows:
+                part, g = 1, cut
+            elif r == cut:
+                part = 0
+            if part < 0:
+                height, u, v = kind_heights[kk, r], kind_u[f, kk, r], kind_v[f, kk, r]
+            else:
+                height = split_height[f, kk, part]
+                u, v = split_u[f, kk, part], split_v[f, kk, part]
             dz = height - hub_height
             if rotor_skip:
                 ratio = drift_ratio[f, kk, r]
@@ -208,7 +207,7 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
                 du = exponents[s] * row_amplitude
                 old = np.float64(combined[index, s]) if rule else 0.0
                 new = superposed(rule, old, du)
-                w = weight[g, s] * fraction if part >= 0 else weight[g, s]
+                w = weight[g, s] * fraction  # (x 1.0 for a whole strip: the same bits)
                 removed[k, cell[g, s]] += removed_moment(w, ambient_u, old, new, moment)
                 if rule:
                     combined[index, s] = new
@@ -221,8 +220,10 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         if reached[k] and (skipped_first or skipped_last):
             for r in (0, rows - 1):
                 if (r == 0 and skipped_first) or (r > 0 and skipped_last):
-                    height, u, v, _ = _row(f, kk, r, rows, kind_u, kind_v, kind_heights,
-                                           split_row, split_height, split_u, split_v)
+                    height, u, v = kind_heights[kk, r], kind_u[f, kk, r], kind_v[f, kk, r]
+                    if r == cut:  # (the part below the top)
+                        height = split_height[f, kk, 0]
+                        u, v = split_u[f, kk, 0], split_v[f, kk, 0]
                     centre[k, r] = centre_offset(x, height, u * cos_a + v * sin_a,
                                                  v * cos_a - u * sin_a, strength_c, r_tube,
                                                  image_height, radius, u_star, veer,
