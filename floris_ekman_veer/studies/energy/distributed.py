@@ -109,6 +109,11 @@ def _resolve_client(client):
         return client
     if isinstance(client, str):
         try:
+            # The form is checked before any Client exists: a Client whose constructor fails
+            # is left to the garbage collector, and its close() there can deadlock the next
+            # Client's start (both take distributed's loop-runner lock in the same thread).
+            if distributed.comm.parse_address(client)[0] in ("tcp", "tls"):
+                distributed.comm.get_address_host_port(client)
             return _connect(distributed, client)
         except (ValueError, TypeError) as error:
             # distributed's own answer ("missing port number in address 'x'") names neither

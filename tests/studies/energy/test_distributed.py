@@ -321,6 +321,22 @@ def test_dask_client_string_that_is_no_address_names_the_form(address):
         ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=address)
 
 
+@pytest.mark.parametrize("address", ["x", "tcp://scheduler", "tls://scheduler"])
+def test_a_client_string_without_a_port_builds_no_client(address, monkeypatch):
+    """The address's form is checked before a Client exists: a Client whose constructor failed
+    was left to the garbage collector, whose close() of it deadlocked the next Client's start
+    in the same thread (a CI run hung in the test above)."""
+    distributed = pytest.importorskip("distributed")
+
+    class NoClient:
+        def __init__(self, *args, **kwargs):
+            raise RuntimeError(f"a Client was built for {address!r}")
+
+    monkeypatch.setattr(distributed, "Client", NoClient)
+    with pytest.raises(ValueError, match="is not a Dask scheduler address"):
+        ParFlorisModel(REPOSITORY / "inputs" / "farm_sbl6.yaml", interface="dask", client=address)
+
+
 class _FakeClient:
     """What _check_workers reads of a Client: run() on every worker, the scheduler address."""
 
