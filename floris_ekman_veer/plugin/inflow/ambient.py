@@ -8,6 +8,7 @@ rotor cells (plugin/rotor/rotor.py), and the hub-height wind of each distinct hu
 from __future__ import annotations
 
 import weakref
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,7 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import (
     sorted_moments,
     sub_quadrature,
 )
+from floris_ekman_veer.plugin.rotor.upstream_wakes import DEFICIT_HEIGHTS
 
 #: The latest Ambient, keyed by the identities of its grid, flow field and inflow array.
 _AMBIENTS: dict = {}
@@ -136,7 +138,9 @@ class RotorAmbient:
     Per sorted turbine (n_findex, n_turbines): rotor centre ``x``, ``y``, hub height ``z``,
     radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
     (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
-    FLORIS's inflow component, V the lateral one).
+    FLORIS's inflow component, V the lateral one); the same at the heights where the cumulative
+    wake takes its centre deficits (plugin/rotor/upstream_wakes.py DEFICIT_HEIGHTS):
+    ``deficit_heights`` (kinds, K), ``deficit_u``, ``deficit_v`` (n_findex, kinds, K).
     """
 
     cells: RotorCells
@@ -149,6 +153,9 @@ class RotorAmbient:
     kind_heights: np.ndarray
     kind_u: np.ndarray
     kind_v: np.ndarray
+    deficit_heights: np.ndarray
+    deficit_u: np.ndarray
+    deficit_v: np.ndarray
     warned: set = field(factory=set)
 
     @classmethod
@@ -156,10 +163,13 @@ class RotorAmbient:
         cells = rotor_cells(grid.grid_resolution, *sub_quadrature(
             grid.grid_resolution, float(np.max(grid.turbine_diameters))))
         x, y, z, radius, _ = rotor_geometry(grid)
-        kind, heights, u, v = rows_profile(
-            lambda heights: ambient_velocity(abl, heights, reference_height), grid, cells
-        )
-        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v)
+        profile = lambda heights: ambient_velocity(abl, heights, reference_height)  # noqa: E731
+        kind, heights, u, v = rows_profile(profile, grid, cells)
+        # (rows_profile reads the rows' heights only.)
+        _, deficit_heights, deficit_u, deficit_v = rows_profile(
+            profile, grid, SimpleNamespace(row_z=DEFICIT_HEIGHTS))
+        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v,
+                   deficit_heights, deficit_u, deficit_v)
 
     def rows(self, f, j):
         """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""
