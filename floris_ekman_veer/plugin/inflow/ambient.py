@@ -8,6 +8,7 @@ rotor cells (plugin/rotor/rotor.py), and the hub-height wind of each distinct hu
 from __future__ import annotations
 
 import weakref
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,7 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import (
     sorted_moments,
     sub_quadrature,
 )
+from floris_ekman_veer.plugin.rotor.upstream_wakes import DEFICIT_HEIGHTS
 
 #: The latest Ambient, keyed by the identities of its grid, flow field and inflow array.
 _AMBIENTS: dict = {}
@@ -142,7 +144,9 @@ class RotorAmbient:
     radius and ``kind`` (distinct hub height and radius); per kind and sub-point row: height
     (kinds, rows) and the ambient (U, V) in FLORIS's frame (n_findex, kinds, rows; U is
     FLORIS's inflow component, V the lateral one); ``split`` the strip each condition's layer
-    top cuts on each kind (plugin/rotor/strip_split.py).
+    top cuts on each kind (plugin/rotor/strip_split.py); the same at the heights where the
+    cumulative wake takes its centre deficits (plugin/rotor/upstream_wakes.py DEFICIT_HEIGHTS):
+    ``deficit_heights`` (kinds, K), ``deficit_u``, ``deficit_v`` (n_findex, kinds, K).
     """
 
     cells: RotorCells
@@ -156,6 +160,9 @@ class RotorAmbient:
     kind_u: np.ndarray
     kind_v: np.ndarray
     split: StripSplit
+    deficit_heights: np.ndarray
+    deficit_u: np.ndarray
+    deficit_v: np.ndarray
     warned: set = field(factory=set)
 
     @classmethod
@@ -170,7 +177,11 @@ class RotorAmbient:
         top = np.where(abl.at_rest, np.inf, np.reshape(abl.boundary_layer_height, -1))
         split = StripSplit.of(cells, kinds[:, 0], kinds[:, 1],
                               np.broadcast_to(top, x.shape[:1]), profile)
-        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v, split)
+        # (rows_profile reads the rows' heights only.)
+        _, deficit_heights, deficit_u, deficit_v = rows_profile(
+            profile, grid, SimpleNamespace(row_z=DEFICIT_HEIGHTS))
+        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v, split,
+                   deficit_heights, deficit_u, deficit_v)
 
     def rows(self, f, j):
         """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""

@@ -16,7 +16,11 @@ import attrs
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.convection import removed_moments
-from floris_ekman_veer.plugin.rotor.rotor_cells import ROWS_PER_POINT, row_interpolation
+from floris_ekman_veer.plugin.rotor.rotor_cells import (
+    ROWS_PER_POINT,
+    grid_offsets,
+    row_interpolation,
+)
 from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401  (models.py's import)
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     CONDITION_COLUMNS,
@@ -29,6 +33,7 @@ from floris_ekman_veer.plugin.rotor.rotor_wakes import (
     crespo_hernandez_parameters,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
+from floris_ekman_veer.plugin.rotor.upstream_wakes import centres_at_heights
 from floris_ekman_veer.wake.added_turbulence import (
     crespo_hernandez_overlap,
     ishihara_qian_added_turbulence,
@@ -243,7 +248,7 @@ def reached_rotor_cell_deficit(
                         * row_interpolation(cells.n, cells.row_z), axis=1)
         if split:
             centre = rotor.split.at_rows(deflection_field_i[f, j, 0, :], centre, f,
-                                         rotor.kind[f, j], cells.n)
+                                         rotor.kind[f, j], grid_offsets(cells.n))
         centre_table = {"strength": 0.0, "r_tube": 1.0, "image_height": 0.0, "veer": 0.0,
                         "ground_image": 0.0}
     else:
@@ -255,6 +260,7 @@ def reached_rotor_cell_deficit(
                      "friction_velocity": source_wake["friction_velocity"],
                      "radius": source_wake["radius"], "hub_height": column(hub_height_i),
                      **{f"centre_{k}": v for k, v in centre_table.items()}}
+    condition_table = _columns(per_condition, CONDITION_COLUMNS, (n_findex,))
     scale, edge = PAIR_COLUMNS.index("velocity_scale"), PAIR_COLUMNS.index("overlap_edge")
     moment = pair[:, PAIR_COLUMNS.index("moment")]
     per_pair = {k: v[f] for k, v in source_wake.items()}
@@ -264,16 +270,17 @@ def reached_rotor_cell_deficit(
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
         # wakes kept at each rotor (plugin/rotor/upstream_wakes.py), evaluated where the
-        # deflection's centre is, at the grid's point heights (the veer-sheared centres differ
-        # with height), and interpolated to the kernel's sub-point rows as the centre is
-        # (rotor_cells.row_interpolation); the kernel scales the model's shape row by row to
-        # C_n at the row's height; the wakes are summed. FLORIS's other grids evaluate C_n
-        # point by point.
+        # deflection's centre is (the veer-sheared centres differ with height) at the store's
+        # fixed heights of the rotor, whatever n, and interpolated to the kernel's sub-point
+        # rows; the kernel scales the model's shape row by row to C_n at the row's height; the
+        # wakes are summed. FLORIS's other grids evaluate C_n point by point.
         single = model.centre_deficit(x_pair,
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
         width_squared = (table[:, WAKE_TABLE.index("kx")]
                          + table[:, WAKE_TABLE.index("xi0")]) ** 2
-        offsets = deflection_field_i[f, j, 0, :]
+        offsets = _centres_at_deficit_heights(
+            wakes.convection.heights, rotor, f, j, kind, x_pair, deflection_field_i, centre,
+            condition_table)
         lateral, height = y_i[f, 0, 0, 0], hub_height_i[f, 0, 0, 0]
         incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
         deficit, row_scale = wakes.convection.deficits(
@@ -284,7 +291,8 @@ def reached_rotor_cell_deficit(
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
         if split:
-            row_scale = rotor.split.at_rows(deficit, row_scale, f, kind, cells.n)
+            row_scale = rotor.split.at_rows(deficit, row_scale, f, kind,
+                                            wakes.convection.heights)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
@@ -295,7 +303,7 @@ def reached_rotor_cell_deficit(
         pair[:, scale] = pair[:, scale] * wake_convection
         pair[:, edge] = pair[:, edge] * wake_convection
     removed, overlap, reached, centre = integrate_wake(
-        table, pair, _columns(per_condition, CONDITION_COLUMNS, (n_findex,)), centre, flat,
+        table, pair, condition_table, centre, flat,
         kind, rotor, wakes, track, every_row=every_row, row_scale=row_scale, split=split)
     # (the centre at the row slots, for the paths that read every row; the shared rows'
     # for the resolution check: the cut strip's row holds its part below the top)
@@ -330,6 +338,21 @@ def reached_rotor_cell_deficit(
         _add_turbulence(wakes, f[reached], j[reached], x_i, radius_i,
                         axial_induction_i, overlap[reached], ambient, added_rule)
     return result.reshape(u_initial.shape), (f[reached], j[reached])
+
+
+def _centres_at_deficit_heights(heights, rotor, f, j, kind, x, deflection_field, centre,
+                                per_condition):
+    """The wake's centre offset [m] at the cumulative wake's ``heights`` (rotor radii) of the
+    rotors (f, j) it reaches, (pairs, K): the ekman_veer deflection's compiled centre there
+    (``centre`` None; the kernel's ``per_condition`` table, with the ambient at those heights,
+    RotorAmbient.deficit_u, deficit_v); another deflection model's, which FLORIS gives at its
+    points only, interpolated linearly from them in height as the rows' ``centre`` is (constant
+    beyond the outer points)."""
+    if centre is not None:
+        points = deflection_field[f, j, 0, :]
+        return np.sum(points[:, :, None] * row_interpolation(rotor.cells.n, heights), axis=1)
+    return centres_at_heights(x, f, kind, rotor.deficit_heights, rotor.deficit_u,
+                              rotor.deficit_v, per_condition)
 
 
 def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):

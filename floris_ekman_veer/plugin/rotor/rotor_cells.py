@@ -424,14 +424,22 @@ def rotor_kinds(grid) -> tuple[np.ndarray, np.ndarray]:
     return kinds, kind_of.ravel()[order]
 
 
-def row_interpolation(n: int, row_z: np.ndarray) -> np.ndarray:
+def height_interpolation(heights: np.ndarray, row_z) -> np.ndarray:
+    """(K, *row_z.shape) weights interpolating values at ``heights`` (K,) linearly to the
+    heights ``row_z`` (any shape; both in rotor radii from the hub, ``heights`` increasing;
+    constant beyond the outer heights)."""
+    heights = np.asarray(heights, dtype=float)
+    if heights.size == 1:
+        return np.ones((1, *np.shape(row_z)))
+    return np.stack([np.interp(row_z, heights, np.eye(heights.size)[k])
+                     for k in range(heights.size)])
+
+
+def row_interpolation(n: int, row_z) -> np.ndarray:
     """(n, rows) matrix interpolating values at the grid's point heights linearly to the rows
     (constant beyond the outer points): the wake centre of a deflection model that gives it at
     FLORIS's points only. (``row_z`` of any shape: (n, *row_z.shape).)"""
-    g = grid_offsets(n)
-    if n == 1:
-        return np.ones((1, *np.shape(row_z)))
-    return np.stack([np.interp(row_z, g, np.eye(n)[k]) for k in range(n)])
+    return height_interpolation(grid_offsets(n), row_z)
 
 
 def turbine_grid_inflow(profile, grid) -> np.ndarray:

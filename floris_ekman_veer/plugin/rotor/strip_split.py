@@ -18,7 +18,11 @@ from __future__ import annotations
 import attrs
 import numpy as np
 
-from floris_ekman_veer.plugin.rotor.rotor_cells import RotorCells, row_interpolation, strip_area
+from floris_ekman_veer.plugin.rotor.rotor_cells import (
+    RotorCells,
+    height_interpolation,
+    strip_area,
+)
 
 
 @attrs.define(frozen=True)
@@ -34,6 +38,7 @@ class StripSplit:
     fraction: np.ndarray
     u: np.ndarray
     v: np.ndarray
+    weights: dict = attrs.field(factory=dict, eq=False, repr=False)
 
     @classmethod
     def of(cls, cells: RotorCells, hub_height, radius, top, profile) -> StripSplit:
@@ -88,21 +93,29 @@ class StripSplit:
             u[split, column], v[split, column] = self.u[at], self.v[at]
         return strip, fraction, height, u, v
 
-    def at_rows(self, point_values, row_values, f, kind, n: int) -> np.ndarray:
-        """Values held at the n grid-point heights of rotors (f, kind) (pairs, n) at their
-        row slots (pairs, rows + 1): ``row_values`` (pairs, rows) at the shared rows, the
-        split strip's parts interpolated as the rows are (rotor_cells.row_interpolation), 0
-        in the slot of the rotors not split."""
+    def at_rows(self, values, row_values, f, kind, heights) -> np.ndarray:
+        """Values held at m ``heights`` (rotor radii from the hub, increasing) of rotors
+        (f, kind) (pairs, m) at their row slots (pairs, rows + 1): ``row_values`` (pairs, rows)
+        at the shared rows, the split strip's parts interpolated linearly from the heights as
+        the rows are (rotor_cells.height_interpolation: FLORIS's n point heights for the
+        centre, the cumulative wake's K for C_n), 0 in the slot of the rotors not split."""
         pairs, rows = row_values.shape
         out = np.zeros((pairs, rows + 1))
         out[:, :rows] = row_values
         row = self.row[f, kind]
         split = np.flatnonzero(row >= 0)
         if split.size:
-            weights = row_interpolation(n, self.offset[f[split], kind[split]])
-            parts = np.zeros((split.size, 2))
-            for q in range(n):  # (in the points' order, as the rows are summed)
-                parts += point_values[split, q, None] * weights[q]
+            weights = self._weights(heights)[f[split], kind[split]]
+            parts = np.einsum("sq,spq->sp", values[split], weights)
             out[split, row[split]] = parts[:, 0]
             out[split, rows] = parts[:, 1]
         return out
+
+    def _weights(self, heights) -> np.ndarray:
+        """The parts' interpolation weights from ``heights`` (n_findex, kinds, 2, m), once per
+        solve and set of heights (a wake step reads them for every rotor it splits)."""
+        heights = np.asarray(heights, dtype=float)
+        key = heights.tobytes()
+        if key not in self.weights:
+            self.weights[key] = np.moveaxis(height_interpolation(heights, self.offset), 0, -1)
+        return self.weights[key]

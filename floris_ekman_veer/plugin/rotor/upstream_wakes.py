@@ -4,13 +4,13 @@ docs/coupling.md#wakes-deep-in-an-array), and its centre deficits C_n in one com
 
 A new wake n reaching rotor j takes C_n = a - sqrt(a^2 - K U_n^2), a = U_0 - sum_i lambda_ni C_i,
 over the wakes i that reached rotor j before it. C_n is evaluated where the deflection's centre
-is, at FLORIS's n grid-point heights of the rotor (the veer-sheared centres differ with height),
-and interpolated to the kernel's sub-point rows as the centre is (rotor_cells.row_interpolation):
-n sums per wake and rotor, not one per row (docs/coupling.md#wakes-deep-in-an-array). A rotor
-keeps only the wakes that reached it, so the store is sparse: a pool of entries, one per
-(wake, rotor) reached, in blocks of BLOCK consecutive entries linked per rotor in the order of
-arrival (``head``/``tail``/``following``), each holding C_i and the centre's y at the n
-grid-point heights, sigma_i^2 and the centre's height. A rotor's blocks are returned to the pool when it becomes
+is (the veer-sheared centres differ with height), at the K = DEFICIT_HEIGHT_COUNT heights
+DEFICIT_HEIGHTS of the rotor, the same whatever FLORIS's grid, and interpolated linearly to the
+kernel's sub-point rows (:func:`height_interpolation`): K sums per wake and rotor, not one per
+row (docs/coupling.md#wakes-deep-in-an-array). A rotor keeps only the wakes that reached it, so
+the store is sparse: a pool of entries, one per (wake, rotor) reached, in blocks of BLOCK
+consecutive entries linked per rotor in the order of arrival (``head``/``tail``/``following``),
+each holding C_i and the centre's y at the K heights, sigma_i^2 and the centre's height. A rotor's blocks are returned to the pool when it becomes
 the source of a wake: the solver steps the turbines downstream, so no later wake reaches it. The
 memory is that of the wakes kept at the rotors still ahead of the sweep, not turbines^2 x rows
 per condition; the work is that of the pairs of wakes that meet at a rotor. The sum runs over
@@ -27,9 +27,18 @@ import attrs
 import numba
 import numpy as np
 
-from floris_ekman_veer.plugin.rotor.rotor_cells import row_interpolation
-from floris_ekman_veer.wake.fused import JIT
+from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
+from floris_ekman_veer.wake.fused import JIT, centre_offset
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
+
+#: The heights [rotor radii from the hub] at which C_n is evaluated, the same for every turbine
+#: grid: DEFICIT_HEIGHT_COUNT evenly over the whole rotor, z_h +- R, interpolated linearly to the
+#: sub-point rows (:func:`height_interpolation`). Not FLORIS's n point heights (z_h +- R/2, C_n
+#: constant beyond): with those a 2 x 2 grid had C_n at two heights, and the farm power of the
+#: veer-sheared nights moved with n through C_n alone (docs/coupling.md#wakes-deep-in-an-array
+#: gives the convergence in the count and its cost).
+DEFICIT_HEIGHT_COUNT = 9
+DEFICIT_HEIGHTS = np.linspace(-1.0, 1.0, DEFICIT_HEIGHT_COUNT)
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
 GROWTH = 1.0625
@@ -42,9 +51,9 @@ BLOCK = 8
 
 @numba.njit(**JIT)
 def _to_rows(values, interpolation, rows):
-    """``values`` at the n grid-point heights interpolated to the rows into ``rows``
-    (rotor_cells.row_interpolation (n, rows)), summed over the points in order (as numpy's sum
-    over them): at a row on a point's height, that point's value exactly."""
+    """``values`` at the K heights interpolated to the rows into ``rows``
+    (:func:`height_interpolation` (K, rows)), summed over the heights in order (as numpy's sum
+    over them): at a row on one of the heights, its value exactly."""
     for r in range(rows.size):
         rows[r] = 0.0
     for k in range(values.size):
@@ -57,9 +66,9 @@ def _to_rows(values, interpolation, rows):
 #: 1e-18): arithmetic and a table look-up only (math.exp is a libm call, measured 2-4 x
 #: slower). Within 2 units in the last place of numpy's exp
 #: (tests/plugin/rotor/test_upstream_wakes.py).
-EXP_STEPS = 8
+EXP_STEPS = 256
 EXP_TABLE = np.exp(-np.arange(int(OVERLAP_EXPONENT_LIMIT) * EXP_STEPS + 2) / EXP_STEPS)
-EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(12)])
+EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(7)])
 
 
 @numba.njit(**JIT)
@@ -77,14 +86,14 @@ def overlap_exp(x):
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, head, following, count, kept, deficit,
                          row_deficit):
-    """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the n grid-point heights
-    into ``deficit`` (k, n) and interpolated to the rows into ``row_deficit`` (k, rows): the
+    """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the K heights
+    into ``deficit`` (k, K) and interpolated to the rows into ``row_deficit`` (k, rows): the
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
     docstring) in their order of arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with
     the centres there, then Eq. 4.10 with the potential core's bound (wake/superposition.py
     ``overlap_weight``, ``cumulative_deficit``; exp to round-off, ``overlap_exp``), then the
-    rows' values as the centre's, sum_q C_n(z_q) interpolation[q, r] (rotor_cells.
-    row_interpolation, summed over the points in order). An entry whose overlap exponent is
+    rows' values, sum_q C_n(z_q) interpolation[q, r] (:func:`height_interpolation`, summed over
+    the heights in order). An entry whose overlap exponent is
     beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no exp."""
     n = deficit.shape[1]
     new_points = np.empty(n)
@@ -102,11 +111,13 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 record = kept[entry]
                 old_width_squared = record[2 * n]
                 total = width_squared[k] + old_width_squared
+                # (one division per entry, not one per height)
+                inverse = 0.5 / total
                 height_squared = (record[2 * n + 1] - height[k]) ** 2
                 least = np.inf
                 for q in range(n):
                     gap = record[n + q] - new_points[q]
-                    exponent[q] = (gap * gap + height_squared) / (2.0 * total)
+                    exponent[q] = (gap * gap + height_squared) * inverse
                     least = min(least, exponent[q])
                 if least >= OVERLAP_EXPONENT_LIMIT:
                     continue
@@ -178,9 +189,9 @@ class UpstreamWakes:
     arrival); ``following`` the next block of a block's rotor (or of the free list); ``free``
     [first free block (-1: none), first never-used block, entries in use, blocks in use]; per
     entry (block * BLOCK + slot) one record of ``kept`` (capacity, 2 n + 2), read together by
-    the sum: its C_i at the n grid-point heights [m/s], the centre's y there [m], sigma_i^2
-    [m^2] and the centre's height [m]; ``interpolation`` (n, rows)
-    rotor_cells.row_interpolation."""
+    the sum: its C_i at the K heights ``heights`` [m/s], the centre's y there [m], sigma_i^2
+    [m^2] and the centre's height [m]; ``interpolation`` (K, rows) :func:`height_interpolation`
+    from the heights to the cells' sub-point rows."""
 
     head: np.ndarray
     tail: np.ndarray
@@ -189,19 +200,23 @@ class UpstreamWakes:
     free: np.ndarray
     kept: np.ndarray
     interpolation: np.ndarray
+    heights: np.ndarray
 
     @classmethod
-    def start(cls, rotors: int, cells, capacity: int | None = None) -> UpstreamWakes:
+    def start(cls, rotors: int, cells, capacity: int | None = None,
+              heights: np.ndarray | None = None) -> UpstreamWakes:
         """An empty pool for ``rotors`` rotors on ``cells`` (RotorCells), room for ``capacity``
-        entries (default: one per rotor; it grows as needed)."""
+        entries (default: one per rotor; it grows as needed), C_n at ``heights`` [rotor radii
+        from the hub, increasing; default DEFICIT_HEIGHTS]."""
         blocks = -(-max(int(rotors if capacity is None else capacity), 1) // BLOCK)
-        interpolation = np.ascontiguousarray(row_interpolation(cells.n, cells.row_z))
-        n = interpolation.shape[0]
+        heights = np.asarray(DEFICIT_HEIGHTS if heights is None else heights, dtype=float)
+        interpolation = np.ascontiguousarray(height_interpolation(heights, cells.row_z))
+        n = heights.size
         entries = blocks * BLOCK
         empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
         return cls(empty(), empty(), np.full(blocks, -1, dtype=np.int64),
                    np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0, 0], dtype=np.int64),
-                   np.zeros((entries, 2 * n + 2)), interpolation)
+                   np.zeros((entries, 2 * n + 2)), interpolation, heights)
 
     @property
     def capacity(self) -> int:
@@ -219,9 +234,9 @@ class UpstreamWakes:
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
                  incoming, core) -> tuple[np.ndarray, np.ndarray]:
-        """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the n grid-point
-        heights (k, n) and interpolated to the rows (k, rows): their sigma_n^2, lateral position
-        and offsets at the grid-point heights ((k, n)), centre height, the model's C(x) / U_h of
+        """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the K heights
+        (k, K) and interpolated to the rows (k, rows): their sigma_n^2, lateral position
+        and the centre's offsets at the K heights ((k, K), :func:`centres_at_heights`), centre height, the model's C(x) / U_h of
         the wake alone, U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py
         ``cumulative_deficit``; all (k,) but ``offsets``)."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
@@ -238,7 +253,7 @@ class UpstreamWakes:
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
         """Keep one new wake at each rotor of ``rotor`` (flat indices, each once): its C_n at
-        the grid-point heights ((k, n)), sigma_n^2, lateral position, offsets ((k, n)) and
+        the K heights ((k, K)), sigma_n^2, lateral position, offsets ((k, K)) and
         height."""
         rotor = np.ascontiguousarray(rotor, dtype=np.int64)
         new_blocks = np.count_nonzero(self.count[rotor] % BLOCK == 0)
@@ -262,3 +277,37 @@ class UpstreamWakes:
         blocks = max(int(GROWTH * self.following.size), blocks)
         self.kept.resize((blocks * BLOCK, self.kept.shape[1]), refcheck=False)
         self.following.resize(blocks, refcheck=False)
+
+
+@numba.njit(**JIT)
+def _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, centres):
+    for k in range(x.size):
+        f, kk = condition[k], kind[k]
+        (cos_a, sin_a, u_star, radius, _, strength, r_tube, image_height, veer,
+         ground_image) = per_condition[f]
+        for q in range(heights.shape[1]):
+            u, v = kind_u[f, kk, q], kind_v[f, kk, q]
+            centres[k, q] = centre_offset(x[k], heights[kk, q], u * cos_a + v * sin_a,
+                                          v * cos_a - u * sin_a, strength, r_tube,
+                                          image_height, radius, u_star, veer, ground_image)
+
+
+def centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition) -> np.ndarray:
+    """The ekman_veer wake centre y_c(x, z) [m] (wake/fused.py ``centre_offset``, the rotor-cell
+    kernel's) of one wake at the K heights of the rotors it reaches, (pairs, K): ``x`` (pairs,)
+    behind the wake's rotor, the rotors' ``condition`` and ``kind`` (pairs,), the kinds'
+    ``heights`` [m] (kinds, K) and ambient (U, V) there in FLORIS's frame ``kind_u``,
+    ``kind_v`` (n_findex, kinds, K) (RotorAmbient.deficit_u, deficit_v); the wake's factors per
+    condition ``per_condition``, the rotor-cell kernel's table (n_findex, plugin/rotor/
+    rotor_kernel.py CONDITION_COLUMNS: the hub-height wind's direction, u*, the wake's radius
+    and hub height, the centre's t_hat prefactor, R sqrt(A*), the image vortex's hub height,
+    the veer and ground-image switches)."""
+    centres = np.empty((np.size(x), heights.shape[1]))
+    _centres_at_heights(np.ascontiguousarray(x, dtype=float),
+                        np.ascontiguousarray(condition, dtype=np.int64),
+                        np.ascontiguousarray(kind, dtype=np.int64),
+                        np.ascontiguousarray(heights, dtype=float),
+                        np.ascontiguousarray(kind_u, dtype=float),
+                        np.ascontiguousarray(kind_v, dtype=float),
+                        np.ascontiguousarray(per_condition, dtype=float), centres)
+    return centres

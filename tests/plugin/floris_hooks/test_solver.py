@@ -173,13 +173,15 @@ def test_full_flow_solver_gives_the_same_values(monkeypatch):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=0.0)
 
 
-@pytest.mark.parametrize("threads", [2, 3])
-def test_threads_give_the_same_bits(threads):
+@pytest.mark.parametrize("threads, combination", [(2, "sosfs"), (3, "sosfs"), (2, "fls")])
+def test_threads_give_the_same_bits(threads, combination):
     """The rotor-cell kernel on 1 or N of numba's threads (plugin/rotor/rotor_kernel.py): bitwise
-    equal (each rotor's sums in the same order on any thread)."""
+    equal (each rotor's sums in the same order on any thread); with fls the input's cumulative
+    wake, whose C_n at its heights feeds the kernel's rows (plugin/rotor/upstream_wakes.py)."""
     import numba
 
-    config = farm_config("farm_sbl6", "ekman_veer", True, "sosfs", "local_turbulence", 7, 16)
+    config = farm_config("farm_sbl6", "ekman_veer", True, combination, "local_turbulence", 7,
+                         16)
     rng = np.random.default_rng(8)
     n = 10
     speeds, directions = rng.uniform(5.0, 13.0, n), rng.uniform(0.0, 360.0, n)

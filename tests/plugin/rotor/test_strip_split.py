@@ -20,6 +20,7 @@ from floris_ekman_veer.plugin.rotor.rotor_kernel import (
 from floris_ekman_veer.plugin.rotor.rotor_threads import ROTOR_BLOCK
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes
 from floris_ekman_veer.plugin.rotor.strip_split import StripSplit
+from floris_ekman_veer.plugin.rotor.upstream_wakes import DEFICIT_HEIGHTS
 from floris_ekman_veer.wake.fused import GAUSSIAN_SHAPE, WAKE_TABLE
 
 HUB, RADIUS = 90.0, 63.0
@@ -145,18 +146,20 @@ def test_parts_lie_either_side_of_the_top_with_their_exact_areas():
     assert split.row[3, 0] == -1
 
 
-def test_parts_interpolated_from_the_grid_points_as_the_rows():
-    """``at_rows``: the shared rows as given, the cut strip's row and the extra slot the point
-    values linearly interpolated to the parts' heights (as rotor_cells.row_interpolation), 0 in
-    the slot where nothing is cut."""
+@pytest.mark.parametrize("heights", [np.array([-0.5, 0.0, 0.5]), DEFICIT_HEIGHTS],
+                         ids=["grid points", "cumulative wake's heights"])
+def test_parts_interpolated_from_the_held_heights_as_the_rows(heights):
+    """``at_rows``: the shared rows as given, the cut strip's row and the extra slot the values
+    held at some heights (FLORIS's 3 point heights, the cumulative wake's K) linearly
+    interpolated to the parts' heights, 0 in the slot where nothing is cut."""
     cells = rotor_cells(3, *sub_quadrature(3, 2.0 * RADIUS))
     tops = HUB + RADIUS * np.array([0.3, 5.0])
     split = StripSplit.of(cells, np.array([HUB]), np.array([RADIUS]), tops, step_profile(tops))
-    points = np.array([[1.0, 2.0, 4.0], [3.0, 3.0, 3.0]])
+    held = np.stack([1.0 + heights + 2.0 * heights ** 2, np.full(heights.size, 3.0)])
     rows = np.arange(2 * cells.rows, dtype=float).reshape(2, cells.rows)
-    out = split.at_rows(points, rows, np.array([0, 1]), np.array([0, 0]), 3)
+    out = split.at_rows(held, rows, np.array([0, 1]), np.array([0, 0]), heights)
     r = split.row[0, 0]
-    expected = np.interp(split.offset[0, 0], [-0.5, 0.0, 0.5], points[0])
+    expected = np.interp(split.offset[0, 0], heights, held[0])
     np.testing.assert_allclose(out[0, [r, cells.rows]], expected, rtol=1e-15)
     np.testing.assert_array_equal(np.delete(out[0], [r, cells.rows]),
                                   np.delete(rows[0], r))

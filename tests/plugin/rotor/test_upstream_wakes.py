@@ -1,8 +1,9 @@
 """The cumulative wake's sparse store of upstream wakes (plugin/rotor/upstream_wakes.py) against
 a dense numpy reference of Bastankhah et al.'s (2021) Eqs. 4.9-4.10 (wake/superposition.py's
 ``overlap_weight`` and ``cumulative_deficit`` over every rotor's wakes in order of arrival, at
-each of the grid's point heights, then interpolated to the rows as the centre is);
-its exp against numpy's; its memory on a farm against the dense tables it replaced."""
+each of the store's heights, then interpolated linearly to the rows); its exp against numpy's;
+the wake centres at its heights against the kernel's at the rows; C_n on a farm the same
+whatever FLORIS's grid; its memory on a farm against the dense tables it replaced."""
 
 from __future__ import annotations
 
@@ -16,13 +17,17 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from benchmarks import bench_models
-from floris_ekman_veer.plugin.rotor.rotor_cells import grid_offsets, row_interpolation, rotor_cells
+from floris_ekman_veer.plugin.rotor.rotor_cells import rotor_cells
+from floris_ekman_veer.plugin.rotor.rotor_kernel import CONDITION_COLUMNS
 from floris_ekman_veer.plugin.rotor.upstream_wakes import (
     BLOCK,
+    DEFICIT_HEIGHTS,
     GROWTH,
     UpstreamWakes,
+    centres_at_heights,
     overlap_exp,
 )
+from floris_ekman_veer.wake.fused import centre_offsets
 from floris_ekman_veer.wake.superposition import (
     OVERLAP_EXPONENT_LIMIT,
     cumulative_deficit,
@@ -30,20 +35,23 @@ from floris_ekman_veer.wake.superposition import (
 )
 
 CELLS = rotor_cells(3, 24, 2)
+#: The store's heights [rotor radii from the hub].
+HEIGHTS = DEFICIT_HEIGHTS.size
 
 
 class DenseReference:
-    """Every rotor's kept wakes as numpy rows, in order of arrival, per grid-point height (the
-    upstream sum over them in order at each height, then Eq. 4.10, then the rows'
-    interpolation), written independently of the store."""
+    """Every rotor's kept wakes as numpy rows, in order of arrival, per height of the store
+    (the upstream sum over them in order at each height, then Eq. 4.10, then numpy's linear
+    interpolation to the rows, constant beyond the outer heights), written independently of the
+    store."""
 
     def __init__(self, rotors, cells):
         self.kept = [[] for _ in range(rotors)]
-        self.interpolation = row_interpolation(cells.n, cells.row_z)
+        self.row_z = cells.row_z
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
                  incoming, core):
-        centre_y = lateral[:, None] + offsets  # (k, n): the centres at the grid's heights
+        centre_y = lateral[:, None] + offsets  # (k, K): the centres at the store's heights
         upstream = np.zeros(centre_y.shape)
         for k, j in enumerate(rotor):
             for c, w, y, z in self.kept[j]:
@@ -51,7 +59,7 @@ class DenseReference:
                                               (y - centre_y[k]) ** 2 + (z - height[k]) ** 2) * c
         points = cumulative_deficit(single[:, None], ambient[:, None], incoming[:, None],
                                     upstream, core[:, None])
-        return points, np.sum(points[:, :, None] * self.interpolation, axis=1)
+        return points, np.array([np.interp(self.row_z, DEFICIT_HEIGHTS, p) for p in points])
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height):
         for k, j in enumerate(rotor):
@@ -65,11 +73,11 @@ class DenseReference:
 
 def _wakes(rng, rotor, diameter=126.0):
     """Random wakes at ``rotor``: widths 0.2-0.8 D, centres within 2 D of the rotors' (veer
-    offsets up to 0.5 D at the grid's heights), hub heights 80-100 m, C(x) 0.05-0.5."""
+    offsets up to 0.5 D at the store's heights), hub heights 80-100 m, C(x) 0.05-0.5."""
     k = rotor.size
     width_squared = (diameter * rng.uniform(0.2, 0.8, k)) ** 2
     lateral = diameter * rng.uniform(-2.0, 2.0, k)
-    offsets = diameter * rng.uniform(-0.5, 0.5, (k, CELLS.n))
+    offsets = diameter * rng.uniform(-0.5, 0.5, (k, HEIGHTS))
     height = rng.uniform(80.0, 100.0, k)
     single = rng.uniform(0.05, 0.5, k)
     ambient = rng.uniform(6.0, 12.0, k)
@@ -83,7 +91,7 @@ def _wakes(rng, rotor, diameter=126.0):
 def test_store_matches_the_dense_reference(seed, rotors, steps):
     """Random arrivals (each step a random set of rotors, in random order, each once), random
     releases, a pool that starts with room for one block and grows: every step's C_n at every
-    grid-point height and every row equals the dense reference's to 1e-12 relative; the entries and blocks in use are those
+    height of the store and every row equals the dense reference's to 1e-12 relative; the entries and blocks in use are those
     the reference holds, and freed blocks are taken again before the pool grows."""
     rng = np.random.default_rng(seed)
     store = UpstreamWakes.start(rotors, CELLS, capacity=1)
@@ -116,18 +124,18 @@ def test_store_matches_the_dense_reference(seed, rotors, steps):
 
 def test_wakes_at_the_overlap_limit():
     """Kept wakes whose centres lie just inside and just outside lambda's limit
-    (exponent OVERLAP_EXPONENT_LIMIT) at some grid heights, and a centre line that crosses the
-    new wake's between two grid heights: the store's sum skips only what the reference sets to
-    0."""
+    (exponent OVERLAP_EXPONENT_LIMIT) at some heights, and a centre line that crosses the
+    new wake's between two heights: the store's sum skips only what the reference sets to 0."""
     rotor = np.array([0])
     width_squared = np.array([50.0**2])
     limit = np.sqrt(2.0 * OVERLAP_EXPONENT_LIMIT * 2.0 * 50.0**2)  # equal widths: total 2 s^2
     store = UpstreamWakes.start(1, CELLS)
     reference = DenseReference(1, CELLS)
-    for lateral, offsets in ((limit * (1.0 - 1e-9), [0.0, 0.0, 0.0]),
-                             (limit * (1.0 + 1e-9), [0.0, 0.0, 0.0]),
-                             (limit, [-40.0, 0.0, 40.0]),
-                             (0.0, [-2.0 * limit, 0.0, 2.0 * limit])):
+    # (Veer-sheared centre lines: offsets linear in height, crossing the first line.)
+    for lateral, offsets in ((limit * (1.0 - 1e-9), 0.0 * DEFICIT_HEIGHTS),
+                             (limit * (1.0 + 1e-9), 0.0 * DEFICIT_HEIGHTS),
+                             (limit, 40.0 * DEFICIT_HEIGHTS),
+                             (0.0, 2.0 * limit * DEFICIT_HEIGHTS)):
         wake = (width_squared, np.array([lateral]), np.array([offsets]), np.array([90.0]),
                 np.array([0.3]), np.array([9.0]), np.array([8.0]), np.array([6.0]))
         expected = reference.deficits(rotor, *wake)
@@ -137,7 +145,7 @@ def test_wakes_at_the_overlap_limit():
         reference.keep(rotor, got, *wake[:4])
         store.keep(rotor, got, *wake[:4])
     # A new wake on the first centre line reaches all four: each sum differs from the next.
-    wake = (width_squared, np.array([0.0]), np.zeros((1, 3)), np.array([90.0]),
+    wake = (width_squared, np.array([0.0]), np.zeros((1, HEIGHTS)), np.array([90.0]),
             np.array([0.3]), np.array([9.0]), np.array([8.0]), np.array([6.0]))
     for got, expected in zip(store.deficits(rotor, *wake), reference.deficits(rotor, *wake)):
         np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0.0)
@@ -150,7 +158,7 @@ def test_lone_wake_is_the_model_and_a_wake_ahead_deepens_it():
     by hand."""
     store = UpstreamWakes.start(1, CELLS)
     rotor = np.array([0])
-    geometry = (np.array([2500.0]), np.array([0.0]), np.zeros((1, 3)), np.array([90.0]),
+    geometry = (np.array([2500.0]), np.array([0.0]), np.zeros((1, HEIGHTS)), np.array([90.0]),
                 np.array([0.3]), np.array([8.0]))
     first, first_rows = store.deficits(rotor, *geometry, np.array([8.0]), np.array([8.0]))
     np.testing.assert_allclose(first, 2.4, rtol=1e-14)
@@ -161,13 +169,13 @@ def test_lone_wake_is_the_model_and_a_wake_ahead_deepens_it():
                                rtol=1e-14)
 
 
-def test_the_rows_take_c_n_exactly_at_the_grid_heights_and_linearly_between():
-    """C_n handed to rows on the grid's point heights is C_n there, bit for bit; at rows between
-    two heights it is their linear interpolation, and beyond the outer heights the outer value
-    (as the wake centre's, rotor_cells.row_interpolation)."""
-    heights = grid_offsets(CELLS.n)
-    between = np.array([-0.25, 0.125, 0.4])
-    outer = np.array([-0.9, 0.8])
+def test_the_rows_take_c_n_exactly_at_the_store_heights_and_linearly_between():
+    """C_n handed to rows on the store's heights is C_n there, bit for bit; at rows between
+    two heights it is their linear interpolation, and beyond the outer heights (a rotor's rows
+    lie within them) the outer value."""
+    heights = DEFICIT_HEIGHTS
+    between = np.array([-0.9, -0.3, 0.125, 0.4, 0.99])
+    outer = np.array([-1.1, 1.2])
     cells = SimpleNamespace(n=CELLS.n, row_z=np.concatenate([heights, between, outer]))
     store = UpstreamWakes.start(1, cells)
     rotor = np.array([0])
@@ -217,3 +225,89 @@ def test_farm_memory_is_far_below_the_dense_tables():
     dense = 4 * 20 * 100 * 100 * CELLS.rows * 8 / 1e6
     assert peaks["cumulative"] < dense / 10
     assert peaks["cumulative"] < 3.0 * peaks["combination_model"]
+
+
+def _row_c_n(monkeypatch, points, rows=96):
+    """The C_n [m/s] that the store hands the kernel's rows for each wake reaching a rotor that
+    has one already, (rotor, rows) per wake step, on an n x n grid whose cells have ``rows``
+    sub-point rows whatever n: three NREL 5 MW in the night's veer-sheared inflow
+    (inputs/farm_night.yaml, 8 m/s from the west), the second 1.5 D beside the first and
+    1.5 D behind it (at the edge of its wake), the third 10 D behind the first, between the
+    two: the two wakes reach it shifted differently with height (the veer's x V/U grows with
+    x), so they overlap at some heights and hardly at others."""
+    from floris import FlorisModel
+    from floris.utilities import load_yaml
+
+    import floris_ekman_veer.plugin.inflow.ambient as ambient_module
+
+    monkeypatch.setattr(ambient_module, "sub_quadrature", lambda n, diameter=0.0: (rows, 2))
+    seen = []
+    deficits = UpstreamWakes.deficits
+
+    def spy(store, rotor, *args):
+        points_values, row_values = deficits(store, rotor, *args)
+        waked = store.count[rotor] > 0
+        seen.append(row_values[waked])
+        return points_values, row_values
+
+    monkeypatch.setattr(UpstreamWakes, "deficits", spy)
+    config = load_yaml(bench_models.REPOSITORY / "inputs" / "farm_night.yaml")
+    config["farm"]["layout_x"] = [0.0, 189.0, 1260.0]
+    config["farm"]["layout_y"] = [0.0, 189.0, 95.0]
+    fmodel = FlorisModel(config)
+    fmodel.set(solver_settings={"type": "turbine_grid", "turbine_grid_points": points},
+               wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the night's shallow-layer summary
+        fmodel.run()
+    return [s for s in seen if s.size]
+
+
+def test_c_n_on_a_farm_no_longer_depends_on_the_grid(monkeypatch):
+    """The third rotor meets the second wake behind the first: its C_n varies with height (the
+    two wakes' veer-sheared centres cross the rotor at different heights). On 2 x 2 and 4 x 4
+    grids whose cells share one fine sub-quadrature, the C_n the rows take agrees to 5e-4
+    relative (4e-5: what is left is the second rotor's incoming speed, a mean over its cells);
+    with C_n at the grid's point heights, constant beyond +-R/2 (before), the two differed by
+    4.5e-3 and C_n varied half as much over the rotor."""
+    coarse, fine = _row_c_n(monkeypatch, 2), _row_c_n(monkeypatch, 4)
+    assert len(coarse) == len(fine) == 1 and coarse[0].shape == fine[0].shape == (1, 96)
+    assert np.ptp(fine[0]) > 0.04 * np.max(fine[0])  # C_n varies over the rotor
+    np.testing.assert_allclose(coarse[0], fine[0], rtol=5e-4, atol=0.0)
+
+
+def test_centres_at_the_heights_are_the_kernels_centre():
+    """The wake centre at the store's heights of the rotors a wake reaches, gathered per rotor
+    (its condition, its kind's heights and ambient) from the rotor-cell kernel's per-condition
+    table (rotor_kernel.CONDITION_COLUMNS), is wake/fused.py's centre_offset (tested against the
+    readable Eq. yc_xz in test_rotor_average.py) of each pair's own values, bit for bit: random
+    conditions, two kinds of rotor, veer and ground image on and off."""
+    rng = np.random.default_rng(3)
+    n_findex, kinds, pairs = 4, 2, 30
+    heights = np.array([[90.0], [120.0]]) + np.array([[63.0], [80.0]]) * DEFICIT_HEIGHTS
+    kind_u = rng.uniform(4.0, 12.0, (n_findex, kinds, HEIGHTS))
+    kind_v = rng.uniform(-2.0, 2.0, (n_findex, kinds, HEIGHTS))
+    condition = rng.integers(0, n_findex, pairs)
+    kind = rng.integers(0, kinds, pairs)
+    x = rng.uniform(300.0, 2500.0, pairs)
+    for veer, image in ((1.0, 1.0), (0.0, 1.0), (1.0, 0.0)):
+        values = {"cos": rng.uniform(0.9, 1.0, n_findex), "sin": rng.uniform(-0.3, 0.3, n_findex),
+                  "friction_velocity": rng.uniform(0.2, 0.5, n_findex),
+                  "radius": rng.uniform(60.0, 80.0, n_findex),
+                  "hub_height": rng.uniform(80.0, 130.0, n_findex),
+                  "centre_strength": rng.uniform(-1.0, 1.0, n_findex),
+                  "centre_r_tube": rng.uniform(60.0, 90.0, n_findex),
+                  "centre_image_height": rng.uniform(80.0, 130.0, n_findex),
+                  "centre_veer": np.full(n_findex, veer),
+                  "centre_ground_image": np.full(n_findex, image)}
+        table = np.stack([values[name] for name in CONDITION_COLUMNS], axis=1)
+        got = centres_at_heights(x, condition, kind, heights, kind_u, kind_v, table)
+        column = lambda name: values[name][condition][:, None]  # noqa: E731
+        u, v = kind_u[condition, kind], kind_v[condition, kind]
+        cos_a, sin_a = column("cos"), column("sin")
+        expected = centre_offsets(
+            x[:, None], heights[kind], u * cos_a + v * sin_a, v * cos_a - u * sin_a,
+            column("centre_strength"), column("centre_r_tube"), column("centre_image_height"),
+            column("radius"), column("friction_velocity"), veer, image)
+        np.testing.assert_array_equal(got, expected)
+        assert np.ptp(got, axis=1).min() > 1.0 or veer == 0.0  # the veer shears the centre
