@@ -283,16 +283,18 @@ def reached_rotor_cell_deficit(
             condition_table)
         lateral, height = y_i[f, 0, 0, 0], hub_height_i[f, 0, 0, 0]
         incoming_speed = per_pair["hub_speed"] * per_pair["speed_fraction"]
+        # (with a split, the cut strip's parts interpolated from the heights in the same pass)
+        slots = ((rotor.split.row[f, kind],
+                  rotor.split.weights_from(wakes.convection.heights)[f, kind])
+                 if split else (None, None))
         deficit, row_scale = wakes.convection.deficits(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
             incoming_speed,
-            model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed)
+            model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed,
+            *slots)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
-            pair[:, edge] = np.exp(-2.0) * row_scale.mean(axis=1)
-        if split:
-            row_scale = rotor.split.at_rows(deficit, row_scale, f, kind,
-                                            wakes.convection.heights)
+            pair[:, edge] = np.exp(-2.0) * row_scale[:, :cells.rows].mean(axis=1)
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.

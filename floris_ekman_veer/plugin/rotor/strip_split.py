@@ -105,13 +105,13 @@ class StripSplit:
         row = self.row[f, kind]
         split = np.flatnonzero(row >= 0)
         if split.size:
-            weights = self._weights(heights)[f[split], kind[split]]
+            weights = self.weights_from(heights)[f[split], kind[split]]
             parts = np.einsum("sq,spq->sp", values[split], weights)
             out[split, row[split]] = parts[:, 0]
             out[split, rows] = parts[:, 1]
         return out
 
-    def _weights(self, heights) -> np.ndarray:
+    def weights_from(self, heights) -> np.ndarray:
         """The parts' interpolation weights from ``heights`` (n_findex, kinds, 2, m), once per
         solve and set of heights (a wake step reads them for every rotor it splits)."""
         heights = np.asarray(heights, dtype=float)

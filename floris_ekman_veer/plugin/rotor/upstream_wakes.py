@@ -41,7 +41,7 @@ DEFICIT_HEIGHT_COUNT = 9
 DEFICIT_HEIGHTS = np.linspace(-1.0, 1.0, DEFICIT_HEIGHT_COUNT)
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
-GROWTH = 1.0625
+GROWTH = 1.25
 
 #: A rotor's entries lie in blocks of this many consecutive entries (its first block holds its
 #: first BLOCK wakes, and so on), so that the sum over them reads the pool in runs, not entry by
@@ -84,8 +84,8 @@ def overlap_exp(x):
 
 @numba.njit(**JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
-                         incoming, core, interpolation, head, following, count, kept, deficit,
-                         row_deficit):
+                         incoming, core, interpolation, slot_row, slot_weights, head, following,
+                         count, kept, deficit, row_deficit):
     """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the K heights
     into ``deficit`` (k, K) and interpolated to the rows into ``row_deficit`` (k, rows): the
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
@@ -93,14 +93,22 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     the centres there, then Eq. 4.10 with the potential core's bound (wake/superposition.py
     ``overlap_weight``, ``cumulative_deficit``; exp to round-off, ``overlap_exp``), then the
     rows' values, sum_q C_n(z_q) interpolation[q, r] (:func:`height_interpolation`, summed over
-    the heights in order). An entry whose overlap exponent is
-    beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no exp."""
+    the heights in order). With a strip cut by the layer top (``slot_row`` (k,) its row, -1:
+    none; empty: no split in the step; plugin/rotor/strip_split.py), that row takes the part
+    below the top and the extra row slot ``row_deficit[k, rows]`` the part above, each
+    sum_q C_n(z_q) slot_weights[k, part, q]; the slot is 0 where nothing is cut. An entry whose
+    overlap exponent is beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no
+    exp."""
     n = deficit.shape[1]
+    rows = interpolation.shape[1]
     new_points = np.empty(n)
     exponent = np.empty(n)
     for k in range(rotor.size):
+        lowest, highest = np.inf, -np.inf
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
+            lowest = min(lowest, new_points[q])
+            highest = max(highest, new_points[q])
         upstream = deficit[k]
         for q in range(n):
             upstream[q] = 0.0
@@ -114,6 +122,11 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 # (one division per entry, not one per height)
                 inverse = 0.5 / total
                 height_squared = (record[2 * n + 1] - height[k]) ** 2
+                # (a bound first: the centres' lateral ranges at least this far apart at every
+                # height, the entry beyond the limit at each, as the heights' loop would find)
+                apart = max(0.0, record[2 * n + 2] - highest, lowest - record[2 * n + 3])
+                if (apart * apart + height_squared) * inverse >= OVERLAP_EXPONENT_LIMIT:
+                    continue
                 least = np.inf
                 for q in range(n):
                     gap = record[n + q] - new_points[q]
@@ -130,7 +143,17 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
         for q in range(n):
             upstream[q] = cumulative_deficit(single[k], ambient[k], incoming[k], upstream[q],
                                              core[k])
-        _to_rows(upstream, interpolation, row_deficit[k])
+        _to_rows(upstream, interpolation, row_deficit[k, :rows])
+        if slot_row.size:
+            row_deficit[k, rows] = 0.0
+            if slot_row[k] >= 0:
+                below = 0.0
+                above = 0.0
+                for q in range(n):
+                    below += upstream[q] * slot_weights[k, 0, q]
+                    above += upstream[q] * slot_weights[k, 1, q]
+                row_deficit[k, slot_row[k]] = below
+                row_deficit[k, rows] = above
 
 
 @numba.njit(**JIT)
@@ -158,11 +181,16 @@ def _keep(rotor, deficit, width_squared, lateral, offsets, height, head, tail, f
             tail[j] = block
             free[3] += 1
         record = kept[tail[j] * BLOCK + slot]
+        lowest, highest = np.inf, -np.inf
         for q in range(n):
             record[q] = deficit[k, q]
             record[n + q] = lateral[k] + offsets[k, q]
+            lowest = min(lowest, record[n + q])
+            highest = max(highest, record[n + q])
         record[2 * n] = width_squared[k]
         record[2 * n + 1] = height[k]
+        record[2 * n + 2] = lowest
+        record[2 * n + 3] = highest
         count[j] += 1
     free[2] += rotor.size
 
@@ -188,7 +216,7 @@ class UpstreamWakes:
     none), ``count`` its entries (the first ``count`` of its blocks' slots, in order of
     arrival); ``following`` the next block of a block's rotor (or of the free list); ``free``
     [first free block (-1: none), first never-used block, entries in use, blocks in use]; per
-    entry (block * BLOCK + slot) one record of ``kept`` (capacity, 2 n + 2), read together by
+    entry (block * BLOCK + slot) one record of ``kept`` (capacity, 2 n + 4), read together by
     the sum: its C_i at the K heights ``heights`` [m/s], the centre's y there [m], sigma_i^2
     [m^2] and the centre's height [m]; ``interpolation`` (K, rows) :func:`height_interpolation`
     from the heights to the cells' sub-point rows."""
@@ -216,7 +244,7 @@ class UpstreamWakes:
         empty = lambda: np.full(rotors, -1, dtype=np.int64)  # noqa: E731
         return cls(empty(), empty(), np.full(blocks, -1, dtype=np.int64),
                    np.zeros(rotors, dtype=np.int64), np.array([-1, 0, 0, 0], dtype=np.int64),
-                   np.zeros((entries, 2 * n + 2)), interpolation, heights)
+                   np.zeros((entries, 2 * n + 4)), interpolation, heights)
 
     @property
     def capacity(self) -> int:
@@ -233,22 +261,32 @@ class UpstreamWakes:
         return int(self.free[3])
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
-                 incoming, core) -> tuple[np.ndarray, np.ndarray]:
+                 incoming, core, slot_row=None, slot_weights=None
+                 ) -> tuple[np.ndarray, np.ndarray]:
         """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the K heights
-        (k, K) and interpolated to the rows (k, rows): their sigma_n^2, lateral position
-        and the centre's offsets at the K heights ((k, K), :func:`centres_at_heights`), centre height, the model's C(x) / U_h of
-        the wake alone, U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py
-        ``cumulative_deficit``; all (k,) but ``offsets``)."""
+        (k, K) and interpolated to the rows (k, rows; with ``slot_row`` (k,), the strip the
+        layer top cuts, -1: none, and ``slot_weights`` (k, 2, K), its parts' weights from the
+        heights: (k, rows + 1), the row slots of plugin/rotor/strip_split.py): their sigma_n^2,
+        lateral position and the centre's offsets at the K heights ((k, K),
+        :func:`centres_at_heights`), centre height, the model's C(x) / U_h of the wake alone,
+        U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py ``cumulative_deficit``;
+        all (k,) but ``offsets``)."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), np.shape(rotor)))
         n, rows = self.interpolation.shape
+        if slot_row is None:
+            slot_row, slot_weights = np.zeros(0, dtype=np.int64), np.zeros((0, 2, n))
+        else:
+            rows += 1
         deficit = np.empty((np.size(rotor), n))
         row_deficit = np.empty((np.size(rotor), rows))
         _cumulative_deficits(
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
-            vector(ambient), vector(incoming), vector(core), self.interpolation, self.head,
-            self.following, self.count, self.kept, deficit, row_deficit)
+            vector(ambient), vector(incoming), vector(core), self.interpolation,
+            np.ascontiguousarray(slot_row, dtype=np.int64),
+            np.ascontiguousarray(slot_weights, dtype=float), self.head, self.following,
+            self.count, self.kept, deficit, row_deficit)
         return deficit, row_deficit
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:

@@ -17,7 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from benchmarks import bench_models
-from floris_ekman_veer.plugin.rotor.rotor_cells import rotor_cells
+from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation, rotor_cells
 from floris_ekman_veer.plugin.rotor.rotor_kernel import CONDITION_COLUMNS
 from floris_ekman_veer.plugin.rotor.upstream_wakes import (
     BLOCK,
@@ -91,7 +91,8 @@ def _wakes(rng, rotor, diameter=126.0):
 def test_store_matches_the_dense_reference(seed, rotors, steps):
     """Random arrivals (each step a random set of rotors, in random order, each once), random
     releases, a pool that starts with room for one block and grows: every step's C_n at every
-    height of the store and every row equals the dense reference's to 1e-12 relative; the entries and blocks in use are those
+    height of the store and every row equals the dense reference's to 1e-12 relative (also with
+    a strip cut by a layer top: its parts at their mid-heights); the entries and blocks in use are those
     the reference holds, and freed blocks are taken again before the pool grows."""
     rng = np.random.default_rng(seed)
     store = UpstreamWakes.start(rotors, CELLS, capacity=1)
@@ -104,6 +105,17 @@ def test_store_matches_the_dense_reference(seed, rotors, steps):
         got, got_rows = store.deficits(rotor, *wakes)
         np.testing.assert_allclose(got, expected[0], rtol=1e-12, atol=0.0)
         np.testing.assert_allclose(got_rows, expected[1], rtol=1e-12, atol=0.0)
+        # A strip cut by a layer top at some rotors: its row the part below, the extra slot
+        # the part above, each C_n interpolated from the heights at the part's mid-height.
+        cut = np.where(rng.random(rotor.size) < 0.5, rng.integers(0, CELLS.rows, rotor.size), -1)
+        parts = rng.uniform(-1.0, 1.0, (rotor.size, 2))
+        weights = np.moveaxis(height_interpolation(DEFICIT_HEIGHTS, parts), 0, -1)
+        _, slotted = store.deficits(rotor, *wakes, cut, weights)
+        expected_slots = np.concatenate([expected[1], np.zeros((rotor.size, 1))], axis=1)
+        for k in np.flatnonzero(cut >= 0):
+            expected_slots[k, [cut[k], CELLS.rows]] = np.interp(parts[k], DEFICIT_HEIGHTS,
+                                                                 expected[0][k])
+        np.testing.assert_allclose(slotted, expected_slots, rtol=1e-12, atol=1e-300)
         kept = rng.random(rotor.size) < 0.8  # the rotors the kernel reached
         keep_args = (rotor[kept], got[kept], *(w[kept] for w in wakes[:4]))
         reference.keep(*keep_args)
