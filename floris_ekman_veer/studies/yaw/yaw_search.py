@@ -47,7 +47,8 @@ class BothSignsRefinement:
     their best so far, on grids that end ``(upper - lower) / (Ny_passes[0] - 1) /
     prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg and [5, 4]). Started from zero yaw it
     misses the optimum where steering pays only when upstream turbines turn together (the
-    neutral day's row at 4 D, 8 m/s: no single turbine's move gains), and it stops on the ridge
+    neutral day's row at 4 D, 8 m/s on the wakes of the time the seeds were introduced, before
+    the array coupling of docs/coupling.md#wakes-deep-in-an-array), and it stops on the ridge
     between coupled yaws. Here, all conditions in one FLORIS evaluation per stage, as the
     serial refine evaluates its grids (its ``_calc_powers_with_memory``, which skips yaws
     already evaluated):
