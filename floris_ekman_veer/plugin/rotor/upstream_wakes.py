@@ -42,7 +42,7 @@ DEFICIT_HEIGHT_COUNT = 9
 DEFICIT_HEIGHTS = np.linspace(-1.0, 1.0, DEFICIT_HEIGHT_COUNT)
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
-GROWTH = 1.25
+GROWTH = 1.0625
 
 #: A rotor's entries lie in blocks of this many consecutive entries (its first block holds its
 #: first BLOCK wakes, and so on), so that the sum over them reads the pool in runs, not entry by
