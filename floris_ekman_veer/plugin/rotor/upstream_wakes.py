@@ -28,6 +28,7 @@ import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
+from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
 from floris_ekman_veer.wake.fused import JIT, centre_offset
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
@@ -41,7 +42,7 @@ DEFICIT_HEIGHT_COUNT = 9
 DEFICIT_HEIGHTS = np.linspace(-1.0, 1.0, DEFICIT_HEIGHT_COUNT)
 
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
-GROWTH = 1.25
+GROWTH = 1.0625
 
 #: A rotor's entries lie in blocks of this many consecutive entries (its first block holds its
 #: first BLOCK wakes, and so on), so that the sum over them reads the pool in runs, not entry by
@@ -82,10 +83,10 @@ def overlap_exp(x):
     return EXP_TABLE[int(step)] * value
 
 
-@numba.njit(**JIT)
+@numba.njit(nogil=True, **JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, slot_row, slot_weights, head, following,
-                         count, kept, deficit, row_deficit):
+                         count, kept, deficit, row_deficit, first, stride):
     """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the K heights
     into ``deficit`` (k, K) and interpolated to the rows into ``row_deficit`` (k, rows): the
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
@@ -98,12 +99,15 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     below the top and the extra row slot ``row_deficit[k, rows]`` the part above, each
     sum_q C_n(z_q) slot_weights[k, part, q]; the slot is 0 where nothing is cut. An entry whose
     overlap exponent is beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no
-    exp."""
+    exp. The new wakes of share ``first`` of ``stride`` (plugin/rotor/rotor_threads.py; each
+    wake's arithmetic is the same on any thread: the same bits)."""
     n = deficit.shape[1]
     rows = interpolation.shape[1]
     new_points = np.empty(n)
     exponent = np.empty(n)
     for k in range(rotor.size):
+        if not in_share(k, first, stride):
+            continue
         lowest, highest = np.inf, -np.inf
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
@@ -280,7 +284,8 @@ class UpstreamWakes:
             rows += 1
         deficit = np.empty((np.size(rotor), n))
         row_deficit = np.empty((np.size(rotor), rows))
-        _cumulative_deficits(
+        split_over_threads(
+            _cumulative_deficits, np.size(rotor),
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation,
@@ -317,9 +322,12 @@ class UpstreamWakes:
         self.following.resize(blocks, refcheck=False)
 
 
-@numba.njit(**JIT)
-def _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, centres):
+@numba.njit(nogil=True, **JIT)
+def _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, centres,
+                        first, stride):
     for k in range(x.size):
+        if not in_share(k, first, stride):
+            continue
         f, kk = condition[k], kind[k]
         (cos_a, sin_a, u_star, radius, _, strength, r_tube, image_height, veer,
          ground_image) = per_condition[f]
@@ -341,11 +349,10 @@ def centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_conditio
     and hub height, the centre's t_hat prefactor, R sqrt(A*), the image vortex's hub height,
     the veer and ground-image switches)."""
     centres = np.empty((np.size(x), heights.shape[1]))
-    _centres_at_heights(np.ascontiguousarray(x, dtype=float),
-                        np.ascontiguousarray(condition, dtype=np.int64),
-                        np.ascontiguousarray(kind, dtype=np.int64),
-                        np.ascontiguousarray(heights, dtype=float),
-                        np.ascontiguousarray(kind_u, dtype=float),
-                        np.ascontiguousarray(kind_v, dtype=float),
-                        np.ascontiguousarray(per_condition, dtype=float), centres)
+    split_over_threads(
+        _centres_at_heights, np.size(x), np.ascontiguousarray(x, dtype=float),
+        np.ascontiguousarray(condition, dtype=np.int64),
+        np.ascontiguousarray(kind, dtype=np.int64), np.ascontiguousarray(heights, dtype=float),
+        np.ascontiguousarray(kind_u, dtype=float), np.ascontiguousarray(kind_v, dtype=float),
+        np.ascontiguousarray(per_condition, dtype=float), centres)
     return centres
