@@ -31,12 +31,8 @@ import numpy as np
 import pandas as pd
 
 from floris_ekman_veer.studies.validation import metrics, models
-from floris_ekman_veer.studies.validation.cases import (
-    HORNS_REV,
-    LILLGRUND,
-    SINGLE_WAKE_CASES,
-    constant_thrust_turbine,
-)
+from floris_ekman_veer.studies.validation.cases import HORNS_REV, LILLGRUND, SINGLE_WAKE_CASES
+from floris_ekman_veer.studies.validation.turbines import constant_thrust_turbine
 
 #: Sample spacing of the direction-uncertainty average [deg] (as examples/validate.py).
 SAMPLE_STEP = 1.0

@@ -47,7 +47,8 @@ class BothSignsRefinement:
     their best so far, on grids that end ``(upper - lower) / (Ny_passes[0] - 1) /
     prod(Ny_passes[1:])`` apart (3.1 deg for +-25 deg and [5, 4]). Started from zero yaw it
     misses the optimum where steering pays only when upstream turbines turn together (the
-    neutral day's row at 4 D, 8 m/s: no single turbine's move gains), and it stops on the ridge
+    neutral day's row at 4 D, 8 m/s on the wakes of the time the seeds were introduced, before
+    the array coupling of docs/coupling.md#wakes-deep-in-an-array), and it stops on the ridge
     between coupled yaws. Here, all conditions in one FLORIS evaluation per stage, as the
     serial refine evaluates its grids (its ``_calc_powers_with_memory``, which skips yaws
     already evaluated):
@@ -63,7 +64,8 @@ class BothSignsRefinement:
        best yaws: in the first, two points along each turbine's yaw and one along each pair of
        steering turbines one in the other's wake (gradient and Hessian); in the later ones one
        point along each yaw (the gradient, with the first's Hessian); and the model's maximum,
-       limited to 4 h in each yaw and to the bounds, together with each yaw's own move;
+       limited to 4 h in each steering turbine's yaw (in the others' only by the bounds: their
+       yaw moves their own power alone) and to the bounds, together with each yaw's own move;
     4. the mirror of the serial refine's result (every sign flipped, clipped to the bounds),
        refined by the same steps beside it where its power is within :data:`MIRROR_WINDOW` of
        the best (a veered atmosphere makes the two signs differ by little where steering pays
@@ -136,6 +138,12 @@ class BothSignsRefinement:
         steering = wakes.any(axis=2)
         coupled = (wakes | np.swapaxes(wakes, 1, 2)) & steering[:, :, None] & steering[:, None, :]
         coupled = np.concatenate([coupled, coupled])
+        # The Newton moves go at most 4 steps in a steering turbine's yaw (its farm power couples
+        # to the others' yaws), but across its whole range in the yaw of a turbine that wakes
+        # none: that yaw moves its own power alone, a smooth single-rotor curve the model fits,
+        # and on a veered night its optimum lies up to 8 deg from the start (the last turbine
+        # of the held-out row at 273 deg), beyond the two steps' 4 + 2 deg.
+        steers = np.concatenate([steering, steering])
         hessian = None
         for k, step in enumerate(QUADRATIC_STEPS):
             centre, centre_power = tracks.yaws.copy(), tracks.power.copy()
@@ -147,7 +155,8 @@ class BothSignsRefinement:
             with np.errstate(invalid="ignore"):  # the inactive mirrors' -inf: no move
                 gradient, hessian = stencil.fit(values - centre_power, hessian)
             moves = _newton_moves(gradient, hessian, centre, tracks.lower, tracks.upper,
-                                  4.0 * step)
+                                  np.where(steers, 4.0 * step,
+                                           np.maximum(tracks.upper - tracks.lower, 4.0 * step)))
             tracks.keep_best(np.clip(centre + moves, tracks.lower, tracks.upper), self._evaluate)
 
     def _wake_pairs(self):
@@ -284,7 +293,8 @@ class _QuadraticStencil:
 def _newton_moves(gradient, hessian, centre, lower, upper, radius):
     """(2, n_findex, n) moves towards the maximum of the quadratic model: the full Newton move
     and the move of each yaw alone (the Hessian's diagonal), both over the yaws not held at a
-    bound and at most ``radius`` along each direction of the Hessian (or each yaw).
+    bound and at most ``radius`` ((n_findex, n) per yaw) along each yaw, and along each direction
+    of the Hessian the radii weighted by the direction's squared components.
 
     The full move solves the model along the Hessian's eigenvectors, an eigenvalue that would
     move further than ``radius`` (or is not negative: no maximum) being lowered until the move
@@ -296,7 +306,8 @@ def _newton_moves(gradient, hessian, centre, lower, upper, radius):
         both = free[:, :, None] & free[:, None, :]
         values, vectors = np.linalg.eigh(np.where(both, hessian, -np.eye(n)))
         along = np.einsum("fkj,fk->fj", vectors, np.where(free, gradient, 0.0))
-        values = np.minimum(values, -np.abs(along) / radius - 1e-300)
+        reach = np.einsum("fkj,fk->fj", vectors ** 2, radius)
+        values = np.minimum(values, -np.abs(along) / reach - 1e-300)
         move = -np.einsum("fij,fj->fi", vectors, along / values)
         held = free & (((centre <= lower) & (move < 0.0)) | ((centre >= upper) & (move > 0.0)))
         if not held.any():
