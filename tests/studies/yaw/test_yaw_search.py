@@ -170,8 +170,8 @@ def test_night_rows_within_0_05_percent_of_refined_brute_force(spec):
     """The held-out night rows: within 0.05 % of the 1-degree grid refined by Nelder-Mead, and
     not below FLORIS's own serial refine by more than 0.02 % (measured with the cumulative wake:
     above it by 0.015 % at 273 deg, [13.8, 10.6, -6.0] against its [12.5, 9.4, -9.4] deg, 0.013 %
-    below it with the wakes summed; above it by 0.11 and 0.08 % at 268 and 263 deg), evaluating at most twice its conditions (the first row in the fast suite,
-    all three in the study run)."""
+    below it with the wakes summed; above it by 0.11 and 0.08 % at 268 and 263 deg), evaluating
+    at most twice its conditions (the first row in the fast suite, all three in the study run)."""
     pairs, angles, (table,) = brute_force_tables([spec])
     _, reference = refined_brute_force(spec, table, pairs, angles)
     with counting_conditions() as count:
