@@ -151,7 +151,8 @@ def sharing_interpolant(original):
             entry = shared.get(key)
         except TypeError:  # an unhashable setting: not shared
             return original(x, y, **kwargs)
-        if entry is None or entry[0] is not x or entry[1] is not y:
+        if entry is None:
+            # (x and y are held with it: their ids cannot be reused while the context lasts)
             entry = shared[key] = (x, y, original(x, y, **kwargs))
         return entry[2]
 
