@@ -356,7 +356,7 @@ def cell_mean(u, index, moment: float, cells: RotorCells) -> np.ndarray:
 #: Sub-quadrature of the wake cells per point of FLORIS's n x n grid: ROWS_PER_POINT n strips
 #: and NODES_PER_INTERVAL points on each cell's stretch of every strip, so that a finer turbine
 #: grid (``solver.turbine_grid_points``) also refines the cells' quadrature.
-ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
+ROWS_PER_POINT, NODES_PER_INTERVAL = 6, 2
 
 #: ...and strips, on the shipped 3 x 3 grid, no thicker than this [m] (a finer or coarser grid
 #: refines or coarsens them in proportion, as above): the stable layer's features (its top,
@@ -365,7 +365,7 @@ ROWS_PER_POINT, NODES_PER_INTERVAL = 8, 2
 #: 5 MW's 126 m (5.25 m) give its single wakes within 0.04 % of the converged reference; the IEA
 #: 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its
 #: 150 m hub), with 48 by 0.15 % (tests/plugin/rotor/test_multiwake.py).
-MAX_ROW_SPACING = 126.0 / 24.0
+MAX_ROW_SPACING = 126.0 / 18.0
 
 
 def sub_quadrature(n: int, diameter: float = 0.0) -> tuple[int, int]:

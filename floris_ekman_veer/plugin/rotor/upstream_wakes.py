@@ -21,14 +21,13 @@ round-off.
 
 from __future__ import annotations
 
-import math
-
 import attrs
 import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
+from floris_ekman_veer.wake.exp_table import negative_exp
 from floris_ekman_veer.wake.fused import JIT, centre_offset
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
@@ -62,28 +61,6 @@ def _to_rows(values, interpolation, rows):
             rows[r] += values[k] * interpolation[k, r]
 
 
-#: exp(x) for -OVERLAP_EXPONENT_LIMIT <= x <= 0 as exp(-m / EXP_STEPS) (a table, numpy's exp)
-#: times exp(y) on -1 / EXP_STEPS < y <= 0 by its Taylor polynomial (EXP_TAYLOR, truncation below
-#: 1e-18): arithmetic and a table look-up only (math.exp, a libm call, was measured 2-4 x
-#: slower with C_n at the grid's 3 heights; at the 9 heights a whole 10 x 10 x 100 run on 2 x 2
-#: cells timed the same with either, 0.72-0.73 s on one thread). Within 2 units in the last
-#: place of numpy's exp (tests/plugin/rotor/test_upstream_wakes.py).
-EXP_STEPS = 256
-EXP_TABLE = np.exp(-np.arange(int(OVERLAP_EXPONENT_LIMIT) * EXP_STEPS + 2) / EXP_STEPS)
-EXP_TAYLOR = np.array([1.0 / math.factorial(k) for k in range(7)])
-
-
-@numba.njit(**JIT)
-def overlap_exp(x):
-    """exp(x) on [-OVERLAP_EXPONENT_LIMIT, 0] (EXP_STEPS)."""
-    step = math.floor(-x * EXP_STEPS)
-    y = x + step * (1.0 / EXP_STEPS)
-    value = EXP_TAYLOR[-1]
-    for term in range(EXP_TAYLOR.size - 2, -1, -1):
-        value = value * y + EXP_TAYLOR[term]
-    return EXP_TABLE[int(step)] * value
-
-
 @numba.njit(nogil=True, **JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, slot_row, slot_weights, head, following,
@@ -93,7 +70,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
     docstring) in their order of arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with
     the centres there, then Eq. 4.10 with the potential core's bound (wake/superposition.py
-    ``overlap_weight``, ``cumulative_deficit``; exp to round-off, ``overlap_exp``), then the
+    ``overlap_weight``, ``cumulative_deficit``; exp to round-off, wake/exp_table.py), then the
     rows' values, sum_q C_n(z_q) interpolation[q, r] (:func:`height_interpolation`, summed over
     the heights in order). With a strip cut by the layer top (``slot_row`` (k,) its row, -1:
     none; empty: no split in the step; plugin/rotor/strip_split.py), that row takes the part
@@ -142,7 +119,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 share = 2.0 * old_width_squared / total
                 for q in range(n):
                     if exponent[q] < OVERLAP_EXPONENT_LIMIT:
-                        upstream[q] += share * overlap_exp(-exponent[q]) * record[q]
+                        upstream[q] += share * negative_exp(exponent[q]) * record[q]
             remaining -= BLOCK
             block = following[block]
         for q in range(n):

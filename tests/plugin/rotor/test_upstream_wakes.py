@@ -25,7 +25,6 @@ from floris_ekman_veer.plugin.rotor.upstream_wakes import (
     GROWTH,
     UpstreamWakes,
     centres_at_heights,
-    overlap_exp,
 )
 from floris_ekman_veer.wake.fused import centre_offsets
 from floris_ekman_veer.wake.superposition import (
@@ -205,14 +204,6 @@ def test_the_rows_take_c_n_exactly_at_the_store_heights_and_linearly_between():
         np.testing.assert_array_equal(rows[0, -outer.size:], points[0, [0, -1]])
         store.keep(rotor, points, *wake[:4])
     assert np.ptp(points) > 0.0  # the heights' values differ (the test is about them)
-
-
-def testoverlap_exp_is_numpys_to_round_off():
-    """The table exp on [-OVERLAP_EXPONENT_LIMIT, 0] within 2 units in the last place of numpy's."""
-    x = np.concatenate([np.linspace(-OVERLAP_EXPONENT_LIMIT, 0.0, 20001),
-                        -np.geomspace(1e-12, 1.0, 101)])
-    got = np.array([overlap_exp(v) for v in x])
-    np.testing.assert_allclose(got, np.exp(x), rtol=4.5e-16, atol=0.0)
 
 
 def test_farm_memory_is_far_below_the_dense_tables():
