@@ -111,9 +111,9 @@ def optimize_yaw(
         ...            wind_directions=[270.0], wind_speeds=[8.0], turbulence_intensities=[0.06])
         >>> df_opt = floris_ekman_veer.optimize_yaw(fmodel, YawOptimizationSR, progress=False)
         >>> df_opt.yaw_angles_opt[0].round(1).tolist()      # deg, both signs searched
-        [12.5, -21.6, -6.1]
+        [12.5, -21.5, -6.1]
         >>> round(float(df_opt.farm_power_opt[0] / df_opt.farm_power_baseline[0]), 3)
-        1.022
+        1.021
     """
     optimizer_kwargs = checked_options(fmodel, optimizer_class, progress, optimizer_kwargs)
     if search not in SEARCHES:
