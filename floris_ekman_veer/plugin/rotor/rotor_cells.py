@@ -27,7 +27,7 @@ integral over the disk, whatever the cells.
 
 Why equal strips (measured for issue 41, docs/coupling.md#rotor-average): a smooth band of
 deficit is integrated with an error falling as h^2 (the exact strip areas against the chord at
-mid-height; order 2.00 from 24 to 96 strips), below 1.2e-4 of the disk mean at the shipped 8 n
+mid-height; order 2.00 from 24 to 96 strips), below 2.1e-4 of the disk mean at the shipped 6 n
 strips for n >= 2 [``test_wake_cell_strips_converge_as_the_square_of_their_height``]. That is
 not what sets the rotor points a farm's power needs. In the stable layers whose top lies on the
 rotor (the SBL-6 farm input: h from 57 to 102 m at 7-11 m/s) the inflow's jet nose there (U
@@ -355,16 +355,20 @@ def cell_mean(u, index, moment: float, cells: RotorCells) -> np.ndarray:
 
 #: Sub-quadrature of the wake cells per point of FLORIS's n x n grid: ROWS_PER_POINT n strips
 #: and NODES_PER_INTERVAL points on each cell's stretch of every strip, so that a finer turbine
-#: grid (``solver.turbine_grid_points``) also refines the cells' quadrature.
+#: grid (``solver.turbine_grid_points``) also refines the cells' quadrature. 6 strips per point
+#: since the strip split integrates the layer top's step (8 before, when the step set the count):
+#: the worst farm power of benchmarks/matched_accuracy.py's 16 cases against its own 20 x 20
+#: answer is 0.79 % on 2 x 2 cells and 0.60 % on 3 x 3 (8: 0.62 % and 0.66 %), for about a tenth
+#: less CPU (docs/coupling.md#rotor-average, docs/performance.md).
 ROWS_PER_POINT, NODES_PER_INTERVAL = 6, 2
 
 #: ...and strips, on the shipped 3 x 3 grid, no thicker than this [m] (a finer or coarser grid
 #: refines or coarsens them in proportion, as above): the stable layer's features (its top,
 #: where the inflow turns geostrophic, and the veer-sheared wake bands) are tens of metres
-#: whatever the rotor, so a larger rotor needs more strips per point. 24 strips over the NREL
-#: 5 MW's 126 m (5.25 m) give its single wakes within 0.04 % of the converged reference; the IEA
-#: 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % (SBL-6, layer top 135 m below its
-#: 150 m hub), with 48 by 0.15 % (tests/plugin/rotor/test_multiwake.py).
+#: whatever the rotor, so a larger rotor needs more strips per point. 18 strips over the NREL
+#: 5 MW's 126 m (7 m); the IEA 15 MW's 242 m with 24 strips (10 m) erred by up to 1.1 % before
+#: the strip split (SBL-6, layer top 135 m below its 150 m hub), with 36 (6.7 m) now by 0.12 %
+#: on single wakes and 0.25 % on its 4 x 4 farm (tests/plugin/rotor/test_multiwake.py).
 MAX_ROW_SPACING = 126.0 / 18.0
 
 

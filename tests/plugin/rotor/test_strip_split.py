@@ -115,7 +115,7 @@ def test_split_strip_integrates_a_step_at_the_top_exactly(n, top_offset):
                                  HUB + 0.5 * RADIUS])
 def test_top_off_the_rotor_or_on_an_edge_leaves_the_slot_empty_and_the_bits(top):
     """A layer top above or below the rotor, none, or on a strip edge (h = hub + R/2 is one
-    for 8 n strips): no strip split, the extra slot weightless, the same bits as the shared
+    for 6 n and 8 n strips): no strip split, the extra slot weightless, the same bits as the shared
     strips."""
     cells, rotor, *_ = step_rotors(2, [top], 1.0)
     assert np.all(rotor.split.row == -1)
