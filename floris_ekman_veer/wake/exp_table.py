@@ -31,6 +31,14 @@ def negative_exp(e):
     """exp(-e) to round-off for 0 <= e < EXP_RANGE, 0 from EXP_RANGE on (module docstring)."""
     if not 0.0 <= e < EXP_RANGE:
         return 0.0 if e >= EXP_RANGE else np.exp(-e)
+    return table_exp(e)
+
+
+@numba.njit(inline="always", **JIT)
+def table_exp(e):
+    """exp(-e) for 0 <= e < EXP_RANGE, unchecked: for a caller that has bounded e already (the
+    cumulative sum's exponents lie below OVERLAP_EXPONENT_LIMIT = 16); :func:`negative_exp`
+    otherwise."""
     step = math.floor(e * EXP_STEPS)
     y = step * (1.0 / EXP_STEPS) - e
     value = EXP_TAYLOR[-1]

@@ -27,7 +27,7 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
-from floris_ekman_veer.wake.exp_table import negative_exp
+from floris_ekman_veer.wake.exp_table import table_exp
 from floris_ekman_veer.wake.fused import JIT, centre_offset
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
@@ -119,7 +119,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 share = 2.0 * old_width_squared / total
                 for q in range(n):
                     if exponent[q] < OVERLAP_EXPONENT_LIMIT:
-                        upstream[q] += share * negative_exp(exponent[q]) * record[q]
+                        upstream[q] += share * table_exp(exponent[q]) * record[q]
             remaining -= BLOCK
             block = following[block]
         for q in range(n):
