@@ -1,27 +1,25 @@
-"""The compiled kernels' exp(-e) (wake/exp_table.py, docs/performance.md#the-exponential)."""
+"""The compiled functions' exp(-e) (wake/fused.py, docs/performance.md#the-exponential)."""
 
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-from floris_ekman_veer.wake.exp_table import EXP_RANGE, EXP_STEPS, negative_exp, table_exp
+from floris_ekman_veer.wake.fused import EXP_RANGE, EXP_STEPS, negative_exp, table_exp
 
 
-@numba.njit
-def _on(values):
-    out = np.empty(values.size)
-    for k in range(values.size):
-        out[k] = negative_exp(values[k])
-    return out
+def _elementwise(scalar):
+    """The compiled scalar function ``scalar`` on every element of an array (compiled)."""
+    @numba.njit
+    def on(values):
+        out = np.empty(values.size)
+        for k in range(values.size):
+            out[k] = scalar(values[k])
+        return out
+    return on
 
 
-@numba.njit
-def _unchecked(values):
-    out = np.empty(values.size)
-    for k in range(values.size):
-        out[k] = table_exp(values[k])
-    return out
+_on, _unchecked = _elementwise(negative_exp), _elementwise(table_exp)
 
 
 def test_the_table_exp_is_numpys_to_round_off():

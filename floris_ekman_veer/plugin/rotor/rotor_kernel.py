@@ -21,7 +21,6 @@ import numpy as np
 from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
-from floris_ekman_veer.wake.exp_table import negative_exp
 from floris_ekman_veer.wake.fused import (
     GAUSSIAN_SHAPE,
     JIT,
@@ -33,6 +32,7 @@ from floris_ekman_veer.wake.fused import (
     image_factor,
     point_exponent,
     rotor_centre_offset_bound,
+    shaped_deficit,
     time_growth,
 )
 
@@ -194,13 +194,12 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
                 dy = lateral + radius_j * sub_y[g, s]
                 exponents[s] = point_exponent(dy, dz, dy + polar_shift, kx, xi0, sin2b,
                                               q0, q1, q2, q3, q4)
-            # (wake/fused.py shaped_deficit with the table exp, wake/exp_table.py)
             if shape == GAUSSIAN_SHAPE:  # (the branch out of the loop)
                 for s in range(width[g]):
-                    exponents[s] = amplitude * negative_exp(exponents[s])
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, GAUSSIAN_SHAPE)
             else:
                 for s in range(width[g]):
-                    exponents[s] = amplitude * negative_exp(exponents[s] ** (0.5 * shape))
+                    exponents[s] = shaped_deficit(exponents[s], amplitude, shape)
             # The cumulative wake's amplitude at the row's height (plugin/rotor/rotor.py).
             row_amplitude = scale * row_scale[k, r] if per_row else scale
             for s in range(width[g]):

@@ -27,8 +27,7 @@ import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
 from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
-from floris_ekman_veer.wake.exp_table import table_exp
-from floris_ekman_veer.wake.fused import JIT, centre_offset
+from floris_ekman_veer.wake.fused import JIT, centre_offset, table_exp
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
 #: The heights [rotor radii from the hub] at which C_n is evaluated, the same for every turbine
@@ -70,7 +69,7 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
     docstring) in their order of arrival (Bastankhah et al. 2021, Eq. 4.9) at each height, with
     the centres there, then Eq. 4.10 with the potential core's bound (wake/superposition.py
-    ``overlap_weight``, ``cumulative_deficit``; exp to round-off, wake/exp_table.py), then the
+    ``overlap_weight``, ``cumulative_deficit``; exp to round-off, wake/fused.py ``table_exp``), then the
     rows' values, sum_q C_n(z_q) interpolation[q, r] (:func:`height_interpolation`, summed over
     the heights in order). With a strip cut by the layer top (``slot_row`` (k,) its row, -1:
     none; empty: no split in the step; plugin/rotor/strip_split.py), that row takes the part
