@@ -33,7 +33,6 @@ from floris_ekman_veer.plugin.rotor.rotor_wakes import (
     crespo_hernandez_parameters,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import RotorWakes  # noqa: F401  (models.py's import)
-from floris_ekman_veer.plugin.rotor.upstream_wakes import centres_at_heights
 from floris_ekman_veer.wake.added_turbulence import (
     crespo_hernandez_overlap,
     ishihara_qian_added_turbulence,
@@ -278,7 +277,7 @@ def reached_rotor_cell_deficit(
                                       *(per_pair[k] for k in ("k_w", "radius", "ct", "yaw")))
         width_squared = (table[:, WAKE_TABLE.index("kx")]
                          + table[:, WAKE_TABLE.index("xi0")]) ** 2
-        offsets = _centres_at_deficit_heights(
+        offsets, centres = _centres_at_deficit_heights(
             wakes.convection.heights, rotor, f, j, kind, x_pair, deflection_field_i, centre,
             condition_table)
         lateral, height = y_i[f, 0, 0, 0], hub_height_i[f, 0, 0, 0]
@@ -291,7 +290,7 @@ def reached_rotor_cell_deficit(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
             incoming_speed,
             model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed,
-            *slots)
+            *slots, centres=centres)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
         if track and model.turbulence_overlap == "wake_radius":
             pair[:, edge] = np.exp(-2.0) * row_scale[:, :cells.rows].mean(axis=1)
@@ -345,16 +344,19 @@ def reached_rotor_cell_deficit(
 def _centres_at_deficit_heights(heights, rotor, f, j, kind, x, deflection_field, centre,
                                 per_condition):
     """The wake's centre offset [m] at the cumulative wake's ``heights`` (rotor radii) of the
-    rotors (f, j) it reaches, (pairs, K): the ekman_veer deflection's compiled centre there
-    (``centre`` None; the kernel's ``per_condition`` table, with the ambient at those heights,
-    RotorAmbient.deficit_u, deficit_v); another deflection model's, which FLORIS gives at its
-    points only, interpolated linearly from them in height as the rows' ``centre`` is (constant
-    beyond the outer points)."""
+    rotors (f, j) it reaches, (pairs, K), and the inputs of the pass that evaluates it: the
+    ekman_veer deflection's compiled centre there (``centre`` None; the kernel's
+    ``per_condition`` table, with the ambient at those heights, RotorAmbient.deficit_u,
+    deficit_v), evaluated by the upstream sums' pass into the array returned (the inputs:
+    those of upstream_wakes.centres_at_heights); another deflection model's,
+    which FLORIS gives at its points only, interpolated linearly from them in height as the
+    rows' ``centre`` is (constant beyond the outer points; the inputs None)."""
     if centre is not None:
         points = deflection_field[f, j, 0, :]
-        return np.sum(points[:, :, None] * row_interpolation(rotor.cells.n, heights), axis=1)
-    return centres_at_heights(x, f, kind, rotor.deficit_heights, rotor.deficit_u,
-                              rotor.deficit_v, per_condition)
+        return np.sum(points[:, :, None] * row_interpolation(rotor.cells.n, heights),
+                      axis=1), None
+    return (np.empty((f.size, np.size(heights))),
+            (x, f, kind, rotor.deficit_heights, rotor.deficit_u, rotor.deficit_v, per_condition))
 
 
 def _add_turbulence(wakes, f, j, x_i, radius_i, axial_induction_i, overlap, ambient, rule):

@@ -53,6 +53,16 @@ def in_share(rotor, first, stride):
     return (rotor // ROTOR_BLOCK) % stride == first
 
 
+@numba.njit(inline="always")
+def next_in_share(rotor, first, stride):
+    """The rotor index after ``rotor`` in share ``first`` of ``stride`` (``rotor`` in it): the
+    next one, or past the other shares' blocks where ``rotor`` ends its block."""
+    following = rotor + 1
+    if in_share(following, first, stride):
+        return following
+    return following + (stride - 1) * ROTOR_BLOCK
+
+
 def shares(rotors: int) -> int:
     """The threads a pass over ``rotors`` rotors runs on: numba's thread count, at most one per
     block of rotors."""

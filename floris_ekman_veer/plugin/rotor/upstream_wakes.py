@@ -24,9 +24,12 @@ from __future__ import annotations
 import attrs
 import numba
 import numpy as np
+from llvmlite import ir
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation
-from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
+from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, next_in_share, split_over_threads
 from floris_ekman_veer.wake.fused import JIT, centre_offset, table_exp
 from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulative_deficit
 
@@ -60,6 +63,47 @@ def _to_rows(values, interpolation, rows):
             rows[r] += values[k] * interpolation[k, r]
 
 
+@intrinsic
+def _prefetch(typingctx, array, index):
+    """A hint to bring ``array[index]``'s cache line in for reading (LLVM's prefetch: no
+    effect on any value; a no-op where the processor has no such instruction)."""
+    if not (isinstance(array, types.Array) and array.ndim == 1
+            and isinstance(index, types.Integer)):
+        return None
+
+    def codegen(context, builder, signature, arguments):
+        array_type = signature.args[0]
+        view = context.make_array(array_type)(context, builder, arguments[0])
+        pointer = cgutils.get_item_pointer(context, builder, array_type, view, [arguments[1]],
+                                           wraparound=False, boundscheck=False)
+        word = ir.IntType(32)
+        hint = cgutils.get_or_insert_function(
+            builder.module, ir.FunctionType(ir.VoidType(), [cgutils.voidptr_t, word, word, word]),
+            "llvm.prefetch.p0")
+        # (read, the highest temporal locality, the data cache)
+        builder.call(hint, [builder.bitcast(pointer, cgutils.voidptr_t), ir.Constant(word, 0),
+                            ir.Constant(word, 3), ir.Constant(word, 1)])
+        return context.get_dummy_value()
+
+    return types.void(array, index), codegen
+
+
+#: Values of the pool per cache line of 64 bytes: one hint per line.
+_LINE = 8
+
+
+@numba.njit(inline="always", **JIT)
+def _fetch_entries(pool, width, block, remaining, following):
+    """Prefetch hints for a rotor's entries (its blocks from ``block``, ``remaining`` entries) in
+    the flat pool (``width`` values per entry)."""
+    while block >= 0:
+        start = block * BLOCK * width
+        for value in range(start, start + min(BLOCK, remaining) * width, _LINE):
+            _prefetch(pool, value)
+        remaining -= BLOCK
+        block = following[block]
+
+
 @numba.njit(nogil=True, **JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
                          incoming, core, interpolation, slot_row, slot_weights, head, following,
@@ -81,10 +125,17 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     n = deficit.shape[1]
     rows = interpolation.shape[1]
     new_points = np.empty(n)
-    exponent = np.empty(n)
+    pool = kept.reshape(-1)
     for k in range(rotor.size):
         if not in_share(k, first, stride):
             continue
+        # The next wake's rotor's entries are fetched while this one's are summed: the pool is
+        # read a rotor at a time, scattered over memory far larger than the cache, and the sum
+        # waited on memory about 2 / 3 of its time (docs/performance.md#the-cumulative-default).
+        ahead = next_in_share(k, first, stride)
+        if ahead < rotor.size:
+            _fetch_entries(pool, kept.shape[1], head[rotor[ahead]], count[rotor[ahead]],
+                           following)
         lowest, highest = np.inf, -np.inf
         for q in range(n):
             new_points[q] = lateral[k] + offsets[k, q]
@@ -108,17 +159,12 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
                 apart = max(0.0, record[2 * n + 2] - highest, lowest - record[2 * n + 3])
                 if (apart * apart + height_squared) * inverse >= OVERLAP_EXPONENT_LIMIT:
                     continue
-                least = np.inf
-                for q in range(n):
-                    gap = record[n + q] - new_points[q]
-                    exponent[q] = (gap * gap + height_squared) * inverse
-                    least = min(least, exponent[q])
-                if least >= OVERLAP_EXPONENT_LIMIT:
-                    continue
                 share = 2.0 * old_width_squared / total
                 for q in range(n):
-                    if exponent[q] < OVERLAP_EXPONENT_LIMIT:
-                        upstream[q] += share * table_exp(exponent[q]) * record[q]
+                    gap = record[n + q] - new_points[q]
+                    exponent = (gap * gap + height_squared) * inverse
+                    if exponent < OVERLAP_EXPONENT_LIMIT:
+                        upstream[q] += share * table_exp(exponent) * record[q]
             remaining -= BLOCK
             block = following[block]
         for q in range(n):
@@ -242,7 +288,7 @@ class UpstreamWakes:
         return int(self.free[3])
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
-                 incoming, core, slot_row=None, slot_weights=None
+                 incoming, core, slot_row=None, slot_weights=None, centres=None
                  ) -> tuple[np.ndarray, np.ndarray]:
         """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the K heights
         (k, K) and interpolated to the rows (k, rows; with ``slot_row`` (k,), the strip the
@@ -251,7 +297,9 @@ class UpstreamWakes:
         lateral position and the centre's offsets at the K heights ((k, K),
         :func:`centres_at_heights`), centre height, the model's C(x) / U_h of the wake alone,
         U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py ``cumulative_deficit``;
-        all (k,) but ``offsets``)."""
+        all (k,) but ``offsets``). With ``centres``, the arguments of :func:`centres_at_heights`,
+        the offsets are evaluated into ``offsets`` (k, K), C-contiguous, in the same pass (each thread its own wakes' first: one hand-over to the threads, not
+        two)."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), np.shape(rotor)))
         n, rows = self.interpolation.shape
@@ -261,14 +309,21 @@ class UpstreamWakes:
             rows += 1
         deficit = np.empty((np.size(rotor), n))
         row_deficit = np.empty((np.size(rotor), rows))
-        split_over_threads(
-            _cumulative_deficits, np.size(rotor),
+        arguments = (
             np.ascontiguousarray(rotor, dtype=np.int64), vector(width_squared), vector(lateral),
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation,
             np.ascontiguousarray(slot_row, dtype=np.int64),
             np.ascontiguousarray(slot_weights, dtype=float), self.head, self.following,
             self.count, self.kept, deficit, row_deficit)
+        if centres is None:
+            split_over_threads(_cumulative_deficits, np.size(rotor), *arguments)
+        else:
+            if arguments[3] is not offsets:
+                raise ValueError("offsets: the centres are written into it, so it must be a "
+                                 "C-contiguous float array")
+            split_over_threads(_centres_and_deficits, np.size(rotor),
+                               *_centre_arguments(np.size(rotor), *centres), *arguments)
         return deficit, row_deficit
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
@@ -326,10 +381,29 @@ def centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_conditio
     and hub height, the centre's t_hat prefactor, R sqrt(A*), the image vortex's hub height,
     the veer and ground-image switches)."""
     centres = np.empty((np.size(x), heights.shape[1]))
-    split_over_threads(
-        _centres_at_heights, np.size(x), np.ascontiguousarray(x, dtype=float),
-        np.ascontiguousarray(condition, dtype=np.int64),
-        np.ascontiguousarray(kind, dtype=np.int64), np.ascontiguousarray(heights, dtype=float),
-        np.ascontiguousarray(kind_u, dtype=float), np.ascontiguousarray(kind_v, dtype=float),
-        np.ascontiguousarray(per_condition, dtype=float), centres)
+    split_over_threads(_centres_at_heights, np.size(x),
+                       *_centre_arguments(np.size(x), x, condition, kind, heights, kind_u,
+                                          kind_v, per_condition), centres)
     return centres
+
+
+def _centre_arguments(pairs, x, condition, kind, heights, kind_u, kind_v, per_condition):
+    """:func:`centres_at_heights`'s arguments as its compiled pass takes them (one signature)."""
+    index = lambda a: np.ascontiguousarray(np.broadcast_to(a, pairs), dtype=np.int64)  # noqa: E731
+    return (np.ascontiguousarray(np.broadcast_to(x, pairs), dtype=float), index(condition),
+            index(kind), *(np.ascontiguousarray(a, dtype=float)
+                           for a in (heights, kind_u, kind_v, per_condition)))
+
+
+@numba.njit(nogil=True, **JIT)
+def _centres_and_deficits(x, condition, kind, heights, kind_u, kind_v, per_condition, rotor,
+                          width_squared, lateral, offsets, height, single, ambient, incoming,
+                          core, interpolation, slot_row, slot_weights, head, following, count,
+                          kept, deficit, row_deficit, first, stride):
+    """:func:`_centres_at_heights` into ``offsets``, then :func:`_cumulative_deficits` with
+    them, on one share (each new wake reads its own offsets only)."""
+    _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, offsets,
+                        first, stride)
+    _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
+                         incoming, core, interpolation, slot_row, slot_weights, head, following,
+                         count, kept, deficit, row_deficit, first, stride)

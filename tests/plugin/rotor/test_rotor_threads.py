@@ -20,6 +20,7 @@ from floris_ekman_veer.plugin.rotor import rotor_threads
 from floris_ekman_veer.plugin.rotor.rotor_threads import (
     ROTOR_BLOCK,
     in_share,
+    next_in_share,
     shares,
     split_over_threads,
 )
@@ -46,6 +47,29 @@ def test_every_rotor_is_in_exactly_one_share_of_whole_blocks(stride):
     assert np.all(owner >= 0)
     # Block-cyclic: block b (ROTOR_BLOCK consecutive rotors) belongs to share b mod stride.
     np.testing.assert_array_equal(owner, (np.arange(rotors) // ROTOR_BLOCK) % stride)
+
+
+@numba.njit
+def _next_in_shares(first, stride, rotors):
+    following = np.full(rotors, -1)
+    for k in range(rotors):
+        if in_share(k, first, stride):
+            following[k] = next_in_share(k, first, stride)
+    return following
+
+
+@pytest.mark.parametrize("stride", [1, 2, 3, 5])
+def test_the_next_rotor_of_a_share_is_its_next_member(stride):
+    # (the cumulative pass prefetches the next wake's entries of its own share)
+    rotors = 7 * ROTOR_BLOCK + 5
+    owner = (np.arange(3 * rotors) // ROTOR_BLOCK) % stride
+    for first in range(stride):
+        members = np.flatnonzero(owner == first)
+        following = _next_in_shares(first, stride, rotors)
+        inside = members[members < rotors]
+        np.testing.assert_array_equal(following[inside],
+                                      members[np.searchsorted(members, inside) + 1])
+        assert np.all(following[owner[:rotors] != first] == -1)
 
 
 def test_shares_follow_numbas_thread_count_and_the_blocks():

@@ -11,6 +11,7 @@ import tracemalloc
 import warnings
 from types import SimpleNamespace
 
+import numba
 import numpy as np
 import pytest
 from hypothesis import given
@@ -19,6 +20,7 @@ from hypothesis import strategies as st
 from benchmarks import bench_models
 from floris_ekman_veer.plugin.rotor.rotor_cells import height_interpolation, rotor_cells
 from floris_ekman_veer.plugin.rotor.rotor_kernel import CONDITION_COLUMNS
+from floris_ekman_veer.plugin.rotor.rotor_threads import ROTOR_BLOCK
 from floris_ekman_veer.plugin.rotor.upstream_wakes import (
     BLOCK,
     DEFICIT_HEIGHTS,
@@ -247,8 +249,8 @@ def _row_c_n(monkeypatch, points, rows=96):
     seen = []
     deficits = UpstreamWakes.deficits
 
-    def spy(store, rotor, *args):
-        points_values, row_values = deficits(store, rotor, *args)
+    def spy(store, rotor, *args, **kwargs):
+        points_values, row_values = deficits(store, rotor, *args, **kwargs)
         waked = store.count[rotor] > 0
         seen.append(row_values[waked])
         return points_values, row_values
@@ -279,6 +281,20 @@ def test_c_n_on_a_farm_no_longer_depends_on_the_grid(monkeypatch):
     np.testing.assert_allclose(coarse[0], fine[0], rtol=5e-4, atol=0.0)
 
 
+def _centre_table(rng, n_findex, veer, image):
+    """Random per-condition values of the kernel's centre columns, by name and as its table."""
+    values = {"cos": rng.uniform(0.9, 1.0, n_findex), "sin": rng.uniform(-0.3, 0.3, n_findex),
+              "friction_velocity": rng.uniform(0.2, 0.5, n_findex),
+              "radius": rng.uniform(60.0, 80.0, n_findex),
+              "hub_height": rng.uniform(80.0, 130.0, n_findex),
+              "centre_strength": rng.uniform(-1.0, 1.0, n_findex),
+              "centre_r_tube": rng.uniform(60.0, 90.0, n_findex),
+              "centre_image_height": rng.uniform(80.0, 130.0, n_findex),
+              "centre_veer": np.full(n_findex, veer),
+              "centre_ground_image": np.full(n_findex, image)}
+    return values, np.stack([values[name] for name in CONDITION_COLUMNS], axis=1)
+
+
 def test_centres_at_the_heights_are_the_kernels_centre():
     """The wake centre at the store's heights of the rotors a wake reaches, gathered per rotor
     (its condition, its kind's heights and ambient) from the rotor-cell kernel's per-condition
@@ -294,16 +310,7 @@ def test_centres_at_the_heights_are_the_kernels_centre():
     kind = rng.integers(0, kinds, pairs)
     x = rng.uniform(300.0, 2500.0, pairs)
     for veer, image in ((1.0, 1.0), (0.0, 1.0), (1.0, 0.0)):
-        values = {"cos": rng.uniform(0.9, 1.0, n_findex), "sin": rng.uniform(-0.3, 0.3, n_findex),
-                  "friction_velocity": rng.uniform(0.2, 0.5, n_findex),
-                  "radius": rng.uniform(60.0, 80.0, n_findex),
-                  "hub_height": rng.uniform(80.0, 130.0, n_findex),
-                  "centre_strength": rng.uniform(-1.0, 1.0, n_findex),
-                  "centre_r_tube": rng.uniform(60.0, 90.0, n_findex),
-                  "centre_image_height": rng.uniform(80.0, 130.0, n_findex),
-                  "centre_veer": np.full(n_findex, veer),
-                  "centre_ground_image": np.full(n_findex, image)}
-        table = np.stack([values[name] for name in CONDITION_COLUMNS], axis=1)
+        values, table = _centre_table(rng, n_findex, veer, image)
         got = centres_at_heights(x, condition, kind, heights, kind_u, kind_v, table)
         column = lambda name: values[name][condition][:, None]  # noqa: E731
         u, v = kind_u[condition, kind], kind_v[condition, kind]
@@ -314,3 +321,42 @@ def test_centres_at_the_heights_are_the_kernels_centre():
             column("radius"), column("friction_velocity"), veer, image)
         np.testing.assert_array_equal(got, expected)
         assert np.ptp(got, axis=1).min() > 1.0 or veer == 0.0  # the veer shears the centre
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_the_sums_evaluate_the_centres_as_the_centres_pass(threads):
+    """Given the centres' inputs, the upstream sums' pass evaluates the wakes' centres at the
+    heights itself (one hand-over to the threads per wake step, not two): the same centres and
+    the same C_n, bit for bit, as the centres' own pass followed by the sums, over several
+    blocks of rotors on 1 and 2 threads; an offsets array it cannot write into is refused."""
+    rng = np.random.default_rng(11)
+    n_findex, kinds, rotors = 3, 2, 3 * ROTOR_BLOCK + 7
+    store = UpstreamWakes.start(rotors, CELLS)
+    for _ in range(4):  # wakes kept before
+        rotor = rng.permutation(rotors)[: rotors // 2]
+        wakes = _wakes(rng, rotor)
+        store.keep(rotor, store.deficits(rotor, *wakes)[0], *wakes[:4])
+    heights = np.array([[90.0], [120.0]]) + np.array([[63.0], [80.0]]) * DEFICIT_HEIGHTS
+    centres = (rng.uniform(300.0, 2500.0, rotors), rng.integers(0, n_findex, rotors),
+               rng.integers(0, kinds, rotors), heights,
+               rng.uniform(4.0, 12.0, (n_findex, kinds, HEIGHTS)),
+               rng.uniform(-2.0, 2.0, (n_findex, kinds, HEIGHTS)),
+               _centre_table(rng, n_findex, 1.0, 1.0)[1])
+    rotor = rng.permutation(rotors)
+    width_squared, lateral, _, height, *rest = _wakes(rng, rotor)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+        offsets = centres_at_heights(*centres)
+        expected = store.deficits(rotor, width_squared, lateral, offsets, height, *rest)
+        into = np.empty_like(offsets)
+        got = store.deficits(rotor, width_squared, lateral, into, height, *rest,
+                             centres=centres)
+    finally:
+        numba.set_num_threads(before)
+    np.testing.assert_array_equal(into, offsets)
+    for value, reference in zip(got, expected):
+        np.testing.assert_array_equal(value, reference)
+    with pytest.raises(ValueError, match="offsets"):
+        store.deficits(rotor, width_squared, lateral, np.empty_like(offsets, order="F"),
+                       height, *rest, centres=centres)
