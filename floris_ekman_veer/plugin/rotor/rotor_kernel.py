@@ -80,18 +80,63 @@ def _rotor_rows(per_condition, kind_u, kind_v, kind_heights, split_row, split_he
             slowest[f, kk], image[f, kk] = lowest, factor
 
 
+@numba.njit(inline="always", **JIT)
+def _beyond_rotor_bound(ratio, veer, x, offset, rotor_bound, half_chord, dz, reach_squared):
+    """Whether a row slot lies out of a wake's reach whatever its exact centre, by the rotor's
+    bound of the centre (wake/fused.py ``rotor_centre_offset_bound``) beside the veer's drift
+    x (V/U) at the slot (``ratio`` V/U; NaN where no flow: never), the drift's rounding
+    otherwise than x V / U covered by a billionth of it; ``half_chord`` the slot's half-width
+    on the rotor [m], ``dz`` its height above the wake's centre [m]."""
+    if not ratio == ratio:
+        return False
+    drift = veer * (x * ratio)
+    nearest = max(abs(offset - drift) - 1e-9 * abs(drift) - rotor_bound - half_chord, 0.0)
+    # (NaN, from an overflow, skips nothing)
+    return nearest * nearest + dz * dz >= reach_squared
+
+
+@numba.njit(**JIT)
+def _may_reach(pair, per_condition, condition, kind, kind_heights, split_row, split_height,
+               row_chord, slowest, image, drift_ratio, may_reach, rotor_bound):
+    # Per pair: the rotor's bound of the centre and whether a row slot lies within the wake's
+    # reach by it, as the kernel tests its slots before the rows' own bounds (``_integrate``).
+    split = split_row.shape[0] > 0
+    rows = row_chord.size
+    for k in range(pair.shape[0]):
+        x, offset, radius_j, _, reach_squared, _, _ = pair[k]
+        f, kk = condition[k], kind[k]
+        (_, _, u_star, radius, hub_height, strength_c, r_tube, _, veer, _) = per_condition[f]
+        rotor_bound[k] = rotor_centre_offset_bound(x, slowest[f, kk], strength_c, r_tube, radius,
+                                                   u_star, image[f, kk])
+        cut = split_row[f, kk] if split else -1
+        may_reach[k] = False
+        for r in range(rows + 1 if cut >= 0 else rows):
+            # (the slots as the kernel takes them: the extra slot is the cut strip's part
+            # above the layer top, the strip's row its part below)
+            g = cut if r == rows else r
+            height = (kind_heights[kk, r] if r != cut and r != rows
+                      else split_height[f, kk, 1 if r == rows else 0])
+            if not _beyond_rotor_bound(drift_ratio[f, kk, r], veer, x, offset, rotor_bound[k],
+                                       radius_j * row_chord[g], height - hub_height,
+                                       reach_squared):
+                may_reach[k] = True
+                break
+
+
 @numba.njit(nogil=True, **JIT)
 def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, condition, kind,
                kind_u, kind_v, kind_heights, split_row, split_height, split_u, split_v,
                split_fraction, row_chord, sub_y, weight, cell, width, rule, combined, block,
-               track, row_scale, slowest, image, drift_ratio, removed, overlap, reached, first,
-               stride):
+               track, row_scale, slowest, image, drift_ratio, may_reach, rotor_bounds, removed,
+               overlap, reached, first, stride):
     per_row = row_scale.shape[0] > 0
+    # (the rotors' bounds of the centre and the rotors they leave in reach given: empty, none)
+    given = may_reach.shape[0] > 0
     split = split_row.shape[0] > 0
     rows = row_chord.size
     exponents = np.empty(sub_y.shape[1])
     for k in range(wake.shape[0]):
-        if not in_share(k, first, stride):
+        if not in_share(k, first, stride) or (given and not may_reach[k]):
             continue
         amplitude, kx, xi0, sin2b = wake[k, 0], wake[k, 1], wake[k, 2], wake[k, 3]
         strength, polar_veer, shape = wake[k, 4], wake[k, 5], wake[k, 6]
@@ -112,8 +157,8 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
         rotor_bound = 0.0
         rotor_skip = compute_centre and not every_row
         if rotor_skip:
-            rotor_bound = rotor_centre_offset_bound(x, slowest[f, kk], strength_c, r_tube, radius,
-                                                    u_star, image[f, kk])
+            rotor_bound = (rotor_bounds[k] if given else rotor_centre_offset_bound(
+                x, slowest[f, kk], strength_c, r_tube, radius, u_star, image[f, kk]))
         # Rows whose centre the cheap bound put out of reach: their exact centre is evaluated
         # only if the rotor is reached (the first and last rows', for the resolution check of
         # plugin/rotor/rotor.py), or at every row where the caller reads them all
@@ -136,17 +181,12 @@ def _integrate(wake, pair, per_condition, compute_centre, every_row, centre, con
                 height = split_height[f, kk, part]
                 u, v = split_u[f, kk, part], split_v[f, kk, part]
             dz = height - hub_height
-            if rotor_skip:
-                ratio = drift_ratio[f, kk, r]
-                if ratio == ratio:
-                    drift = veer * (x * ratio)
-                    nearest = max(abs(offset - drift) - 1e-9 * abs(drift) - rotor_bound
-                                  - radius_j * row_chord[g], 0.0)
-                    # (NaN, from an overflow, skips nothing)
-                    if nearest * nearest + dz * dz >= reach_squared:
-                        skipped_first |= r == 0
-                        skipped_last |= r == rows - 1
-                        continue
+            if rotor_skip and _beyond_rotor_bound(drift_ratio[f, kk, r], veer, x, offset,
+                                                  rotor_bound, radius_j * row_chord[g], dz,
+                                                  reach_squared):
+                skipped_first |= r == 0
+                skipped_last |= r == rows - 1
+                continue
             local_u = u * cos_a + v * sin_a
             local_v = v * cos_a - u * sin_a
             # No flow (at and below z0): no wake, no t_hat.
@@ -287,8 +327,44 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     return keep[:count], pair[:count]
 
 
+def _split_arrays(rotor, split):
+    """The layer top's cut strip per condition and kind (plugin/rotor/strip_split.py) as the
+    compiled passes take them: its row, the parts' heights, U, V and area fractions; empty
+    without a split."""
+    if split:
+        parts = rotor.split
+        return parts.row, parts.height, parts.u, parts.v, parts.fraction
+    return np.zeros((0, 0), dtype=np.int64), *(np.zeros((0, 0, 0)),) * 4
+
+
+def rotor_row_bounds(per_condition, rotor, slots, split):
+    """Per condition and kind of rotor (the wake's step): the slowest U(z) > 0 over the row
+    slots, the largest ground-image factor and V/U per slot, for the rotor's bound of the centre
+    (``rotor_centre_offset_bound``, the kernel's and :func:`may_reach`'s)."""
+    slowest, image = np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2])
+    drift_ratio = np.empty((*rotor.kind_u.shape[:2], slots))
+    _rotor_rows(np.ascontiguousarray(per_condition), rotor.kind_u, rotor.kind_v,
+                rotor.kind_heights, *_split_arrays(rotor, split)[:4], slowest, image,
+                drift_ratio)
+    return slowest, image, drift_ratio
+
+
+def may_reach(pair, per_condition, condition, kind, rotor, cells, split, bounds):
+    """(pairs,) whether the wake may reach a row of each rotor: False where the rotor's bound of
+    the wake's centre (:func:`rotor_row_bounds` ``bounds``) puts every row slot out of its
+    reach, as the kernel's own first test finds (the ekman_veer deflection's centre; the
+    kernel then reaches none of its rows, so a pass whose results serve only the rows reached
+    may skip it); and (pairs,) that bound [m]. :func:`integrate_wake` takes both (``reach``)
+    and skips those rotors: the same results."""
+    reach, rotor_bound = np.empty(pair.shape[0], dtype=bool), np.empty(pair.shape[0])
+    row, height = _split_arrays(rotor, split)[:2]
+    _may_reach(pair, np.ascontiguousarray(per_condition), condition, kind, rotor.kind_heights,
+               row, height, cells.row_chord, *bounds, reach, rotor_bound)
+    return reach, rotor_bound
+
+
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                   every_row=False, row_scale=None, split=False):
+                   every_row=False, row_scale=None, split=False, bounds=None, reach=None):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -309,7 +385,9 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     None: a factor of the pair's ``velocity_scale`` per row slot (the cumulative wake's C_n at
     the row's height). ``split``: the strip a layer top cuts is integrated as its two parts
     (``rotor.split``, plugin/rotor/strip_split.py; ``centre`` and ``row_scale`` then hold the
-    parts at the cut strip's row and the extra slot); else the shared strips.
+    parts at the cut strip's row and the extra slot); else the shared strips. ``bounds``: the
+    step's :func:`rotor_row_bounds` where the caller has them already; ``reach``: the step's
+    :func:`may_reach` with them (the rotors it leaves out are not visited).
     """
     cells = wakes.cells
     n_pairs = flat.size
@@ -319,16 +397,13 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     compute_centre = centre is None
     centre = np.zeros((n_pairs, cells.slots)) if compute_centre else np.ascontiguousarray(centre)
     per_condition = np.ascontiguousarray(per_condition)
-    parts = rotor.split
-    if split:
-        split_arrays = (parts.row, parts.height, parts.u, parts.v, parts.fraction)
-    else:
-        split_arrays = (np.zeros((0, 0), dtype=np.int64), *(np.zeros((0, 0, 0)),) * 4)
-    slowest, image = np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2])
-    drift_ratio = np.empty((*rotor.kind_u.shape[:2], cells.slots))
-    if compute_centre and not every_row:
-        _rotor_rows(per_condition, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
-                    *split_arrays[:4], slowest, image, drift_ratio)
+    split_arrays = _split_arrays(rotor, split)
+    if bounds is None and compute_centre and not every_row:
+        bounds = rotor_row_bounds(per_condition, rotor, cells.slots, split)
+    elif bounds is None:  # (not read)
+        bounds = (np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2]),
+                  np.empty((*rotor.kind_u.shape[:2], cells.slots)))
+    slowest, image, drift_ratio = bounds
     split_over_threads(
         _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
         per_condition, compute_centre, bool(every_row), centre,
@@ -336,5 +411,6 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
         *split_arrays, cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid,
         cells.row_width, wakes.rule_code, wakes.combined, flat * cells.slots, bool(track),
         np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), slowest,
-        image, drift_ratio, removed, overlap, reached)
+        image, drift_ratio, *((np.zeros(0, dtype=bool), np.zeros(0)) if reach is None else reach),
+        removed, overlap, reached)
     return removed, overlap, reached, centre

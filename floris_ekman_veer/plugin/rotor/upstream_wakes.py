@@ -42,6 +42,9 @@ from floris_ekman_veer.wake.superposition import OVERLAP_EXPONENT_LIMIT, cumulat
 DEFICIT_HEIGHT_COUNT = 9
 DEFICIT_HEIGHTS = np.linspace(-1.0, 1.0, DEFICIT_HEIGHT_COUNT)
 
+#: No new wake left out (an empty mask of the passes' ``reach``).
+_EVERY = np.zeros(0, dtype=np.bool_)
+
 #: The pool grows by this factor when full (in place: ndarray.resize, no second copy alive).
 GROWTH = 1.0625
 
@@ -106,8 +109,8 @@ def _fetch_entries(pool, width, block, remaining, following):
 
 @numba.njit(nogil=True, **JIT)
 def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
-                         incoming, core, interpolation, slot_row, slot_weights, head, following,
-                         count, kept, deficit, row_deficit, first, stride):
+                         incoming, core, interpolation, slot_row, slot_weights, reach, head,
+                         following, count, kept, deficit, row_deficit, first, stride):
     """C_n [m/s] of the new wakes (k, one per rotor ``rotor[k]``) at the K heights
     into ``deficit`` (k, K) and interpolated to the rows into ``row_deficit`` (k, rows): the
     upstream sum sum_i lambda_ni C_i over the kept entries of the rotor (``kept``, the class
@@ -120,19 +123,28 @@ def _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single,
     below the top and the extra row slot ``row_deficit[k, rows]`` the part above, each
     sum_q C_n(z_q) slot_weights[k, part, q]; the slot is 0 where nothing is cut. An entry whose
     overlap exponent is beyond OVERLAP_EXPONENT_LIMIT at every height adds nothing and costs no
-    exp. The new wakes of share ``first`` of ``stride`` (plugin/rotor/rotor_threads.py; each
-    wake's arithmetic is the same on any thread: the same bits)."""
+    exp. A new wake that cannot reach its rotor (``reach[k]`` False; empty: all may) gets 0:
+    the kernel reaches none of its rows, and only the rows reached read C_n. The new wakes of
+    share ``first`` of ``stride`` (plugin/rotor/rotor_threads.py; each wake's arithmetic is
+    the same on any thread: the same bits)."""
     n = deficit.shape[1]
     rows = interpolation.shape[1]
     new_points = np.empty(n)
     pool = kept.reshape(-1)
+    every = reach.size == 0
     for k in range(rotor.size):
         if not in_share(k, first, stride):
+            continue
+        if not (every or reach[k]):
+            deficit[k] = 0.0
+            row_deficit[k] = 0.0
             continue
         # The next wake's rotor's entries are fetched while this one's are summed: the pool is
         # read a rotor at a time, scattered over memory far larger than the cache, and the sum
         # waited on memory about 2 / 3 of its time (docs/performance.md#the-cumulative-default).
         ahead = next_in_share(k, first, stride)
+        while ahead < rotor.size and not (every or reach[ahead]):
+            ahead = next_in_share(ahead, first, stride)
         if ahead < rotor.size:
             _fetch_entries(pool, kept.shape[1], head[rotor[ahead]], count[rotor[ahead]],
                            following)
@@ -288,7 +300,7 @@ class UpstreamWakes:
         return int(self.free[3])
 
     def deficits(self, rotor, width_squared, lateral, offsets, height, single, ambient,
-                 incoming, core, slot_row=None, slot_weights=None, centres=None
+                 incoming, core, slot_row=None, slot_weights=None, centres=None, reach=None
                  ) -> tuple[np.ndarray, np.ndarray]:
         """C_n [m/s] of new wakes at rotors ``rotor`` (k,) (flat indices) at the K heights
         (k, K) and interpolated to the rows (k, rows; with ``slot_row`` (k,), the strip the
@@ -298,8 +310,10 @@ class UpstreamWakes:
         :func:`centres_at_heights`), centre height, the model's C(x) / U_h of the wake alone,
         U_0, U_n and the core bound 2a U_n [m/s] (wake/superposition.py ``cumulative_deficit``;
         all (k,) but ``offsets``). With ``centres``, the arguments of :func:`centres_at_heights`,
-        the offsets are evaluated into ``offsets`` (k, K), C-contiguous, in the same pass (each thread its own wakes' first: one hand-over to the threads, not
-        two)."""
+        the offsets are evaluated into ``offsets`` (k, K), C-contiguous, in the same pass (each
+        thread its own wakes' first: one hand-over to the threads, not two). ``reach`` (k,): the
+        new wakes that may reach a row of their rotor (plugin/rotor/rotor_kernel.py
+        ``may_reach``); the others get 0 (and 0 offsets where evaluated here); None: all may."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), np.shape(rotor)))
         n, rows = self.interpolation.shape
@@ -314,8 +328,9 @@ class UpstreamWakes:
             np.ascontiguousarray(offsets, dtype=float), vector(height), vector(single),
             vector(ambient), vector(incoming), vector(core), self.interpolation,
             np.ascontiguousarray(slot_row, dtype=np.int64),
-            np.ascontiguousarray(slot_weights, dtype=float), self.head, self.following,
-            self.count, self.kept, deficit, row_deficit)
+            np.ascontiguousarray(slot_weights, dtype=float),
+            _EVERY if reach is None else np.ascontiguousarray(reach, dtype=np.bool_), self.head,
+            self.following, self.count, self.kept, deficit, row_deficit)
         if centres is None:
             split_over_threads(_cumulative_deficits, np.size(rotor), *arguments)
         else:
@@ -355,10 +370,14 @@ class UpstreamWakes:
 
 
 @numba.njit(nogil=True, **JIT)
-def _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, centres,
-                        first, stride):
+def _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, reach,
+                        centres, first, stride):
+    every = reach.size == 0
     for k in range(x.size):
         if not in_share(k, first, stride):
+            continue
+        if not (every or reach[k]):
+            centres[k] = 0.0
             continue
         f, kk = condition[k], kind[k]
         (cos_a, sin_a, u_star, radius, _, strength, r_tube, image_height, veer,
@@ -383,7 +402,7 @@ def centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_conditio
     centres = np.empty((np.size(x), heights.shape[1]))
     split_over_threads(_centres_at_heights, np.size(x),
                        *_centre_arguments(np.size(x), x, condition, kind, heights, kind_u,
-                                          kind_v, per_condition), centres)
+                                          kind_v, per_condition), _EVERY, centres)
     return centres
 
 
@@ -398,12 +417,12 @@ def _centre_arguments(pairs, x, condition, kind, heights, kind_u, kind_v, per_co
 @numba.njit(nogil=True, **JIT)
 def _centres_and_deficits(x, condition, kind, heights, kind_u, kind_v, per_condition, rotor,
                           width_squared, lateral, offsets, height, single, ambient, incoming,
-                          core, interpolation, slot_row, slot_weights, head, following, count,
-                          kept, deficit, row_deficit, first, stride):
+                          core, interpolation, slot_row, slot_weights, reach, head, following,
+                          count, kept, deficit, row_deficit, first, stride):
     """:func:`_centres_at_heights` into ``offsets``, then :func:`_cumulative_deficits` with
     them, on one share (each new wake reads its own offsets only)."""
-    _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, offsets,
-                        first, stride)
+    _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, reach,
+                        offsets, first, stride)
     _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,
-                         incoming, core, interpolation, slot_row, slot_weights, head, following,
-                         count, kept, deficit, row_deficit, first, stride)
+                         incoming, core, interpolation, slot_row, slot_weights, reach, head,
+                         following, count, kept, deficit, row_deficit, first, stride)

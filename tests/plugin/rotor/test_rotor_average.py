@@ -436,3 +436,46 @@ def test_rotor_centre_bound_holds_at_every_row():
         if not image:
             slowest = rows[int(np.argmin(speeds))]
             assert bound <= slowest * (1.0 + 2e-6) + 2e-6
+
+
+@pytest.mark.parametrize("input_name", ["farm_sbl6.yaml", "farm_night.yaml"])
+def test_rotors_left_out_by_the_rotor_bound_are_never_reached(monkeypatch, input_name):
+    """rotor_kernel.may_reach leaves out of a wake step (the cumulative wake's sums and the
+    kernel) only rotors none of whose rows the kernel reaches: at every step of a 5 x 5 farm
+    at 5 D x 12 random yawed conditions (the layer top cutting some rotors' strips), the kernel
+    given the step's may_reach returns the same bits as without it (removed moments, overlaps,
+    centres, the rotors reached, the stored combination), and it reaches none of the rotors
+    left out, of which there are some."""
+    from floris_ekman_veer.plugin.rotor import rotor as rotor_module
+    from floris_ekman_veer.plugin.rotor import rotor_kernel
+
+    original = rotor_kernel.integrate_wake
+    left_out = []
+
+    def compared(*args, **kwargs):
+        wakes = args[7]
+        before = wakes.combined.copy()
+        alone = original(*args, **{**kwargs, "reach": None})
+        combined = wakes.combined.copy()
+        wakes.combined[...] = before
+        given = original(*args, **kwargs)
+        for a, b in zip(alone, given, strict=True):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(wakes.combined, combined)
+        reach = kwargs.get("reach")
+        if reach is not None:
+            assert not np.any(given[2][~reach[0]])
+            left_out.append(np.count_nonzero(~reach[0]))
+        return given
+
+    monkeypatch.setattr(rotor_module, "integrate_wake", compared)
+    config = load_yaml(INPUTS / input_name)
+    x, y = np.meshgrid(np.arange(5) * 630.0, np.arange(5) * 630.0)
+    config["farm"]["layout_x"], config["farm"]["layout_y"] = x.ravel().tolist(), y.ravel().tolist()
+    rng = np.random.default_rng(17)
+    fmodel = FlorisModel(config)
+    fmodel.set(wind_directions=rng.uniform(0.0, 360.0, 12), wind_speeds=rng.uniform(6.0, 12.0, 12),
+               turbulence_intensities=np.full(12, 0.06),
+               yaw_angles=rng.uniform(-20.0, 20.0, (12, 25)))
+    fmodel.run()
+    assert len(left_out) == 24 and sum(left_out) > 100

@@ -357,6 +357,17 @@ def test_the_sums_evaluate_the_centres_as_the_centres_pass(threads):
     np.testing.assert_array_equal(into, offsets)
     for value, reference in zip(got, expected):
         np.testing.assert_array_equal(value, reference)
+    # The wakes left out (rotor_kernel.may_reach: none of their rows reached) get 0, the others
+    # the same bits, their neighbours' prefetched entries notwithstanding.
+    reach = rng.random(rotors) < 0.6
+    into = np.empty_like(offsets)
+    left = store.deficits(rotor, width_squared, lateral, into, height, *rest, centres=centres,
+                          reach=reach)
+    np.testing.assert_array_equal(into[reach], offsets[reach])
+    assert not np.any(into[~reach])
+    for value, reference in zip(left, expected):
+        np.testing.assert_array_equal(value[reach], reference[reach])
+        assert not np.any(value[~reach])
     with pytest.raises(ValueError, match="offsets"):
         store.deficits(rotor, width_squared, lateral, np.empty_like(offsets, order="F"),
                        height, *rest, centres=centres)
