@@ -25,10 +25,9 @@ from floris_ekman_veer.plugin.rotor.rotor_cells import WAKE_MODELS  # noqa: F401
 from floris_ekman_veer.plugin.rotor.rotor_kernel import (
     CONDITION_COLUMNS,
     PAIR_COLUMNS,
+    cumulative_step,
     integrate_wake,
-    may_reach,
     near_pairs,
-    rotor_row_bounds,
 )
 from floris_ekman_veer.plugin.rotor.rotor_wakes import (
     WAKE_OVERLAP_VELOCITY,
@@ -267,13 +266,6 @@ def reached_rotor_cell_deficit(
     per_pair = {k: v[f] for k, v in source_wake.items()}
     per_pair.update(speed_fraction=speed_fraction[f], cos=column(cos_a)[f],
                     sin=column(sin_a)[f], offset=pair[:, PAIR_COLUMNS.index("offset")])
-    row_scale = None
-    # The rotor's bound of the centre per condition and kind (the kernel's first test of a row),
-    # with the ekman_veer deflection's centre where the bound is used.
-    bounds = reach = None
-    if centre is None and not every_row:
-        bounds = rotor_row_bounds(condition_table, rotor, cells.slots, split)
-        reach = may_reach(pair, condition_table, f, kind, rotor, cells, split, bounds)
     if cumulative:
         # Bastankhah et al. (2021): the wake's centre deficit C_n [m/s] through the upstream
         # wakes kept at each rotor (plugin/rotor/upstream_wakes.py), evaluated where the
@@ -294,17 +286,21 @@ def reached_rotor_cell_deficit(
         slots = ((rotor.split.row[f, kind],
                   rotor.split.weights_from(wakes.convection.heights)[f, kind])
                  if split else (None, None))
-        # (only the rotors whose rows the wake may reach: the kernel reaches none of the others'
-        # rows by the bound of their centre, and only the rows reached read C_n; about a quarter
-        # of a step's rotors on the 10 x 10 farm)
-        deficit, row_scale = wakes.convection.deficits(
+        sums = wakes.convection.sum_arguments(
             flat, width_squared, lateral, offsets, height, single, per_pair["hub_speed"],
             incoming_speed,
             model.core_deficit(source_wake["ct"], source_wake["yaw"])[f] * incoming_speed,
-            *slots, centres=centres, reach=None if reach is None else reach[0])
+            *slots, centres=centres)
         pair[:, scale] = 1.0 / np.where(single > 0.0, single, 1.0)
-        if track and model.turbulence_overlap == "wake_radius":
-            pair[:, edge] = np.exp(-2.0) * row_scale[:, :cells.rows].mean(axis=1)
+        # The sums and the kernel in one pass over the rotors (plugin/rotor/rotor_kernel.py);
+        # only the rotors whose rows the wake may reach: the kernel reaches none of the others'
+        # rows by the bound of their centre, and only the rows reached read C_n (about a
+        # quarter of a step's rotors on the 10 x 10 farm). The overlap's edge: the wake's
+        # velocity at its radius, exp(-2) C_n, with C_n the mean over the rows.
+        (deficit, _), (removed, overlap, reached, centre), _ = cumulative_step(
+            table, pair, condition_table, centre, flat, kind, rotor, wakes, track, every_row,
+            split, sums, edge_factor=(np.exp(-2.0) if track and model.turbulence_overlap
+                                      == "wake_radius" else None))
     if convecting:
         # Zong & Porte-Agel (2020): the sub-points sum U_c,i u_i (plugin/rotor/convection.py),
         # U_c,i = U_in,i - u_c,i / 2 with the wake's centre deficit u_c,i.
@@ -314,10 +310,10 @@ def reached_rotor_cell_deficit(
         wake_convection = pair[:, scale] - 0.5 * centre_speed
         pair[:, scale] = pair[:, scale] * wake_convection
         pair[:, edge] = pair[:, edge] * wake_convection
-    removed, overlap, reached, centre = integrate_wake(
-        table, pair, condition_table, centre, flat,
-        kind, rotor, wakes, track, every_row=every_row, row_scale=row_scale, split=split,
-        bounds=bounds, reach=reach)
+    if not cumulative:
+        removed, overlap, reached, centre = integrate_wake(
+            table, pair, condition_table, centre, flat, kind, rotor, wakes, track,
+            every_row=every_row, split=split)
     # (the centre at the row slots, for the paths that read every row; the shared rows'
     # for the resolution check: the cut strip's row holds its part below the top)
     slot_centre, centre = centre, centre[:, :cells.rows]

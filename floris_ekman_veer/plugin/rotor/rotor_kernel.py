@@ -15,11 +15,14 @@ results are the same bit for bit with 1 or N threads. Compiled once per installa
 
 from __future__ import annotations
 
+import inspect
+
 import numba
 import numpy as np
 
 from floris_ekman_veer.plugin.rotor.rotor_threads import in_share, split_over_threads
 from floris_ekman_veer.plugin.rotor.rotor_wakes import removed_moment, superposed
+from floris_ekman_veer.plugin.rotor.upstream_wakes import centres_and_deficits
 from floris_ekman_veer.wake.deficit import CURL_ALPHA
 from floris_ekman_veer.wake.fused import (
     GAUSSIAN_SHAPE,
@@ -95,14 +98,17 @@ def _beyond_rotor_bound(ratio, veer, x, offset, rotor_bound, half_chord, dz, rea
     return nearest * nearest + dz * dz >= reach_squared
 
 
-@numba.njit(**JIT)
+@numba.njit(nogil=True, **JIT)
 def _may_reach(pair, per_condition, condition, kind, kind_heights, split_row, split_height,
-               row_chord, slowest, image, drift_ratio, may_reach, rotor_bound):
-    # Per pair: the rotor's bound of the centre and whether a row slot lies within the wake's
-    # reach by it, as the kernel tests its slots before the rows' own bounds (``_integrate``).
+               row_chord, slowest, image, drift_ratio, may_reach, rotor_bound, first, stride):
+    # Per pair of the share: the rotor's bound of the centre and whether a row slot lies within
+    # the wake's reach by it, as the kernel tests its slots before the rows' own bounds
+    # (``_integrate``).
     split = split_row.shape[0] > 0
     rows = row_chord.size
     for k in range(pair.shape[0]):
+        if not in_share(k, first, stride):
+            continue
         x, offset, radius_j, _, reach_squared, _, _ = pair[k]
         f, kk = condition[k], kind[k]
         (_, _, u_star, radius, hub_height, strength_c, r_tube, _, veer, _) = per_condition[f]
@@ -327,6 +333,11 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     return keep[:count], pair[:count]
 
 
+
+#: No rotor left out by the rotor's bound (the kernel evaluates the bound itself).
+_NO_REACH = (np.zeros(0, dtype=np.bool_), np.zeros(0))
+
+
 def _split_arrays(rotor, split):
     """The layer top's cut strip per condition and kind (plugin/rotor/strip_split.py) as the
     compiled passes take them: its row, the parts' heights, U, V and area fractions; empty
@@ -340,7 +351,7 @@ def _split_arrays(rotor, split):
 def rotor_row_bounds(per_condition, rotor, slots, split):
     """Per condition and kind of rotor (the wake's step): the slowest U(z) > 0 over the row
     slots, the largest ground-image factor and V/U per slot, for the rotor's bound of the centre
-    (``rotor_centre_offset_bound``, the kernel's and :func:`may_reach`'s)."""
+    (``rotor_centre_offset_bound``, the kernel's and ``_may_reach``'s)."""
     slowest, image = np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2])
     drift_ratio = np.empty((*rotor.kind_u.shape[:2], slots))
     _rotor_rows(np.ascontiguousarray(per_condition), rotor.kind_u, rotor.kind_v,
@@ -349,22 +360,8 @@ def rotor_row_bounds(per_condition, rotor, slots, split):
     return slowest, image, drift_ratio
 
 
-def may_reach(pair, per_condition, condition, kind, rotor, cells, split, bounds):
-    """(pairs,) whether the wake may reach a row of each rotor: False where the rotor's bound of
-    the wake's centre (:func:`rotor_row_bounds` ``bounds``) puts every row slot out of its
-    reach, as the kernel's own first test finds (the ekman_veer deflection's centre; the
-    kernel then reaches none of its rows, so a pass whose results serve only the rows reached
-    may skip it); and (pairs,) that bound [m]. :func:`integrate_wake` takes both (``reach``)
-    and skips those rotors: the same results."""
-    reach, rotor_bound = np.empty(pair.shape[0], dtype=bool), np.empty(pair.shape[0])
-    row, height = _split_arrays(rotor, split)[:2]
-    _may_reach(pair, np.ascontiguousarray(per_condition), condition, kind, rotor.kind_heights,
-               row, height, cells.row_chord, *bounds, reach, rotor_bound)
-    return reach, rotor_bound
-
-
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                   every_row=False, row_scale=None, split=False, bounds=None, reach=None):
+                   every_row=False, row_scale=None, split=False):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -385,10 +382,21 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     None: a factor of the pair's ``velocity_scale`` per row slot (the cumulative wake's C_n at
     the row's height). ``split``: the strip a layer top cuts is integrated as its two parts
     (``rotor.split``, plugin/rotor/strip_split.py; ``centre`` and ``row_scale`` then hold the
-    parts at the cut strip's row and the extra slot); else the shared strips. ``bounds``: the
-    step's :func:`rotor_row_bounds` where the caller has them already; ``reach``: the step's
-    :func:`may_reach` with them (the rotors it leaves out are not visited).
+    parts at the cut strip's row and the extra slot); else the shared strips.
     """
+    arguments, outputs = _kernel_arguments(wake, pair, per_condition, centre, flat, kind, rotor,
+                                           wakes, track, every_row, row_scale, split)
+    split_over_threads(_integrate, flat.size, *arguments)
+    return outputs
+
+
+def _kernel_arguments(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
+                      every_row, row_scale, split, bounds=None, reach=_NO_REACH):
+    """The kernel's arguments (but the share's) and its outputs (:func:`integrate_wake`);
+    ``bounds`` the step's :func:`rotor_row_bounds` where the caller has them; ``reach`` the
+    rotors the rotor's bound leaves in reach and that bound, (pairs,) each, from
+    ``_may_reach`` (empty: the kernel evaluates the bound; else the rotors left out are not
+    visited: the same results)."""
     cells = wakes.cells
     n_pairs = flat.size
     removed = np.zeros((n_pairs, cells.n**2))
@@ -404,13 +412,100 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
         bounds = (np.empty(rotor.kind_u.shape[:2]), np.empty(rotor.kind_u.shape[:2]),
                   np.empty((*rotor.kind_u.shape[:2], cells.slots)))
     slowest, image, drift_ratio = bounds
+    arguments = (
+        np.ascontiguousarray(wake), np.ascontiguousarray(pair), per_condition, compute_centre,
+        bool(every_row), centre, flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v,
+        rotor.kind_heights, *split_arrays, cells.row_chord, cells.sub_y, cells.weight,
+        cells.cell_grid, cells.row_width, wakes.rule_code, wakes.combined, flat * cells.slots,
+        bool(track), np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale),
+        slowest, image, drift_ratio, *reach, removed, overlap, reached)
+    return arguments, (removed, overlap, reached, centre)
+
+
+@numba.njit(inline="always", **JIT)
+def _row_mean(values, rows):
+    """The mean of ``values[:rows]`` summed as numpy sums a row (its pairwise sum: below 8 values
+    in turn, else eight running sums combined pairwise, then the rest in turn), so that it is
+    ``values[:rows].mean()``'s bits (rows <= 128)."""
+    if rows < 8:
+        total = 0.0
+        for r in range(rows):
+            total += values[r]
+        return total / rows
+    s0, s1, s2, s3 = values[0], values[1], values[2], values[3]
+    s4, s5, s6, s7 = values[4], values[5], values[6], values[7]
+    r = 8
+    while r < rows - rows % 8:
+        s0 += values[r]
+        s1 += values[r + 1]
+        s2 += values[r + 2]
+        s3 += values[r + 3]
+        s4 += values[r + 4]
+        s5 += values[r + 5]
+        s6 += values[r + 6]
+        s7 += values[r + 7]
+        r += 8
+    total = ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
+    while r < rows:
+        total += values[r]
+        r += 1
+    return total / rows
+
+
+@numba.njit(nogil=True, **JIT)
+def _cumulative_step(bounds, sums, edge_column, edge_factor, kernel, first, stride):
+    # One wake step with the cumulative wake on one share of its rotors, in one hand-over to
+    # the threads: the rotors the rotor's bound leaves in reach (``bounds``, ``_may_reach``'s
+    # arguments; none with its mask empty), the centres at the K heights and the upstream sums
+    # (``sums``, upstream_wakes.centres_and_deficits), the overlap edge from C_n at the rows
+    # (``edge_column`` of the kernel's pair table, -1: none), the kernel (``kernel``). Each
+    # rotor's work reads what its own share wrote before.
+    if bounds[11].size:
+        _may_reach(*bounds, first, stride)
+    centres_and_deficits(*sums, first, stride)
+    if edge_column >= 0:
+        pair, row_deficit, rows = bounds[0], sums[-1], bounds[7].size
+        for k in range(pair.shape[0]):
+            if in_share(k, first, stride):
+                pair[k, edge_column] = edge_factor * _row_mean(row_deficit[k], rows)
+    _integrate(*kernel, first, stride)
+
+
+# The compiled passes' arguments by name (but the share's), for the step's one hand-over.
+_KERNEL = list(inspect.signature(_integrate.py_func).parameters)[:-2]
+_BOUNDS = list(inspect.signature(_may_reach.py_func).parameters)[:-2]
+_SUMS = list(inspect.signature(centres_and_deficits.py_func).parameters)[:-2]
+
+
+def cumulative_step(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
+                    every_row, split, sums, edge_factor=None, leave_out=True):
+    """:func:`integrate_wake` after the cumulative wake's upstream sums, in one hand-over to the
+    threads (a wake step's other passes need none of the rows' results): ``sums`` the sums'
+    pass (``UpstreamWakes.sum_arguments``: its arguments and outputs, C_n at the heights and
+    at the row slots, which scale the kernel's rows); with ``edge_factor``, the pair's overlap
+    edge that factor times the mean of C_n over the rows (the wake-radius overlap, per rotor:
+    plugin/rotor/rotor.py). With the ekman_veer deflection's centre (``centre`` None) and not
+    ``every_row``, the rotors the rotor's bound of the centre puts wholly out of reach (the
+    kernel's own first test; ``leave_out``) are left out of the sums and the kernel: C_n 0 there
+    and the same results elsewhere. Returns the sums' outputs, :func:`integrate_wake`'s, and the
+    rotors left in (None: all)."""
+    cells = wakes.cells
+    (sum_arguments, (deficit, row_deficit)) = sums
+    bounds = None
+    reach = _NO_REACH
+    if leave_out and centre is None and not every_row:
+        bounds = rotor_row_bounds(per_condition, rotor, cells.slots, split)
+        reach = (np.empty(flat.size, dtype=np.bool_), np.empty(flat.size))
+        # (the sums read the mask the share's bounds wrote: their ``reach`` argument)
+        at = _SUMS.index("reach")
+        sum_arguments = (*sum_arguments[:at], reach[0], *sum_arguments[at + 1:])
+    kernel, outputs = _kernel_arguments(wake, pair, per_condition, centre, flat, kind, rotor,
+                                        wakes, track, every_row, row_scale=row_deficit,
+                                        split=split, bounds=bounds, reach=reach)
+    named = dict(zip(_KERNEL, kernel))
+    bound_arguments = tuple(named[name] for name in _BOUNDS[:-2]) + reach
     split_over_threads(
-        _integrate, n_pairs, np.ascontiguousarray(wake), np.ascontiguousarray(pair),
-        per_condition, compute_centre, bool(every_row), centre,
-        flat // rotor.x.shape[1], kind, rotor.kind_u, rotor.kind_v, rotor.kind_heights,
-        *split_arrays, cells.row_chord, cells.sub_y, cells.weight, cells.cell_grid,
-        cells.row_width, wakes.rule_code, wakes.combined, flat * cells.slots, bool(track),
-        np.zeros((0, 0)) if row_scale is None else np.ascontiguousarray(row_scale), slowest,
-        image, drift_ratio, *((np.zeros(0, dtype=bool), np.zeros(0)) if reach is None else reach),
-        removed, overlap, reached)
-    return removed, overlap, reached, centre
+        _cumulative_step, flat.size, bound_arguments, sum_arguments,
+        -1 if edge_factor is None else PAIR_COLUMNS.index("overlap_edge"),
+        0.0 if edge_factor is None else float(edge_factor), kernel)
+    return (deficit, row_deficit), outputs, (None if bounds is None else reach[0])

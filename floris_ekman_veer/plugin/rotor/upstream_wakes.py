@@ -314,6 +314,19 @@ class UpstreamWakes:
         thread its own wakes' first: one hand-over to the threads, not two). ``reach`` (k,): the
         new wakes that may reach a row of their rotor (plugin/rotor/rotor_kernel.py
         ``may_reach``); the others get 0 (and 0 offsets where evaluated here); None: all may."""
+        arguments, outputs = self.sum_arguments(
+            rotor, width_squared, lateral, offsets, height, single, ambient, incoming, core,
+            slot_row, slot_weights, centres, reach)
+        split_over_threads(centres_and_deficits, np.size(rotor), *arguments)
+        return outputs
+
+    def sum_arguments(self, rotor, width_squared, lateral, offsets, height, single, ambient,
+                      incoming, core, slot_row=None, slot_weights=None, centres=None,
+                      reach=None) -> tuple[tuple, tuple[np.ndarray, np.ndarray]]:
+        """:meth:`deficits`'s compiled pass, :func:`centres_and_deficits`: its arguments (but
+        the share's) and its outputs, C_n at the heights and at the row slots (for a caller
+        that runs it in one hand-over to the threads with other work; ``reach`` may then be
+        written by that work before the pass reads it, wake by wake)."""
         vector = lambda a: np.ascontiguousarray(np.broadcast_to(  # noqa: E731
             np.asarray(a, dtype=float), np.shape(rotor)))
         n, rows = self.interpolation.shape
@@ -332,14 +345,11 @@ class UpstreamWakes:
             _EVERY if reach is None else np.ascontiguousarray(reach, dtype=np.bool_), self.head,
             self.following, self.count, self.kept, deficit, row_deficit)
         if centres is None:
-            split_over_threads(_cumulative_deficits, np.size(rotor), *arguments)
-        else:
-            if arguments[3] is not offsets:
-                raise ValueError("offsets: the centres are written into it, so it must be a "
-                                 "C-contiguous float array")
-            split_over_threads(_centres_and_deficits, np.size(rotor),
-                               *_centre_arguments(np.size(rotor), *centres), *arguments)
-        return deficit, row_deficit
+            return _NO_CENTRES + arguments, (deficit, row_deficit)
+        if arguments[3] is not offsets:
+            raise ValueError("offsets: the centres are written into it, so it must be a "
+                             "C-contiguous float array")
+        return _centre_arguments(np.size(rotor), *centres) + arguments, (deficit, row_deficit)
 
     def keep(self, rotor, deficit, width_squared, lateral, offsets, height) -> None:
         """Keep one new wake at each rotor of ``rotor`` (flat indices, each once): its C_n at
@@ -414,13 +424,19 @@ def _centre_arguments(pairs, x, condition, kind, heights, kind_u, kind_v, per_co
                            for a in (heights, kind_u, kind_v, per_condition)))
 
 
+#: No centres to evaluate (:func:`centres_and_deficits` with the offsets given).
+_NO_CENTRES = (np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+               np.zeros((0, 0)), np.zeros((0, 0, 0)), np.zeros((0, 0, 0)), np.zeros((0, 0)))
+
+
 @numba.njit(nogil=True, **JIT)
-def _centres_and_deficits(x, condition, kind, heights, kind_u, kind_v, per_condition, rotor,
-                          width_squared, lateral, offsets, height, single, ambient, incoming,
-                          core, interpolation, slot_row, slot_weights, reach, head, following,
-                          count, kept, deficit, row_deficit, first, stride):
-    """:func:`_centres_at_heights` into ``offsets``, then :func:`_cumulative_deficits` with
-    them, on one share (each new wake reads its own offsets only)."""
+def centres_and_deficits(x, condition, kind, heights, kind_u, kind_v, per_condition, rotor,
+                         width_squared, lateral, offsets, height, single, ambient, incoming,
+                         core, interpolation, slot_row, slot_weights, reach, head, following,
+                         count, kept, deficit, row_deficit, first, stride):
+    """:func:`_centres_at_heights` into ``offsets`` (none with ``x`` empty: the offsets given),
+    then :func:`_cumulative_deficits` with them, on one share (each new wake reads its own
+    offsets only)."""
     _centres_at_heights(x, condition, kind, heights, kind_u, kind_v, per_condition, reach,
                         offsets, first, stride)
     _cumulative_deficits(rotor, width_squared, lateral, offsets, height, single, ambient,

@@ -246,16 +246,21 @@ def _row_c_n(monkeypatch, points, rows=96):
     import floris_ekman_veer.plugin.inflow.ambient as ambient_module
 
     monkeypatch.setattr(ambient_module, "sub_quadrature", lambda n, diameter=0.0: (rows, 2))
+    from floris_ekman_veer.plugin.rotor import rotor as rotor_module
+
     seen = []
-    deficits = UpstreamWakes.deficits
+    step = rotor_module.cumulative_step
 
-    def spy(store, rotor, *args, **kwargs):
-        points_values, row_values = deficits(store, rotor, *args, **kwargs)
+    def spy(*args, **kwargs):
+        # (a wake step's sums and kernel: the C_n at the rows of the rotors it reaches that
+        # have a wake already; the step's rotors by flat index, args[4])
+        store, rotor = args[7].convection, args[4]
         waked = store.count[rotor] > 0
-        seen.append(row_values[waked])
-        return points_values, row_values
+        result = step(*args, **kwargs)
+        seen.append(result[0][1][waked & result[1][2]])
+        return result
 
-    monkeypatch.setattr(UpstreamWakes, "deficits", spy)
+    monkeypatch.setattr(rotor_module, "cumulative_step", spy)
     config = load_yaml(bench_models.REPOSITORY / "inputs" / "farm_night.yaml")
     config["farm"]["layout_x"] = [0.0, 189.0, 1260.0]
     config["farm"]["layout_y"] = [0.0, 189.0, 95.0]
