@@ -10,7 +10,10 @@ the rotor cells and the wake's overlap as the area of the disk (FLORIS's count, 
 inside the wake radius). The rotors are shared among threads
 (plugin/rotor/rotor_threads.py); each rotor's sums run in the same order on any thread, so the
 results are the same bit for bit with 1 or N threads. Compiled once per installation
-(``cache=True``, wake/fused.py ``JIT``).
+(``cache=True``, wake/fused.py ``JIT``). With the cumulative wake, :func:`cumulative_step` runs
+the step's upstream sums (plugin/rotor/upstream_wakes.py) and the kernel in one hand-over to
+the threads, leaving out the rotors the rotor's bound of the centre puts out of reach
+(docs/performance.md#the-cumulative-default).
 """
 
 from __future__ import annotations

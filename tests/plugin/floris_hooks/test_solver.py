@@ -216,16 +216,10 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
     speeds, directions = rng.uniform(5.0, 13.0, n), rng.uniform(0.0, 360.0, n)
     yaw = rng.uniform(-25.0, 25.0, (n, 16))
     original = rotor_module.integrate_wake
+    original_step = rotor_module.cumulative_step
     checked, cut = [], []
 
-    def checking(*arguments, every_row=False, **options):
-        # (options: the cumulative wake's row_scale, passed through)
-        wake, pair, per_condition, centre, flat, kind, rotor, wakes = arguments[:8]
-        assert every_row and centre is None
-        combined = wakes.combined.copy()
-        bounded = original(*arguments, **options)
-        wakes.combined[...] = combined
-        result = original(*arguments, every_row=True, **options)
+    def compare(bounded, result, pair, per_condition, flat, kind, rotor, split):
         for a, b in zip(bounded[:3], result[:3], strict=True):
             np.testing.assert_array_equal(a, b)
         reached = result[2]
@@ -234,7 +228,7 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
         column = lambda name: per_condition[f, CONDITION_COLUMNS.index(name)][:, None]  # noqa: E731
         # (the row slots: the strip a layer top cuts as its two parts, the slots no part
         # takes left out; plugin/rotor/strip_split.py)
-        assert options["split"] == rotor.split.any
+        assert split == rotor.split.any
         _, fraction, heights, u, v = rotor.split.pair_rows(
             rotor.cells, rotor.kind_heights, rotor.kind_u, rotor.kind_v, f, k)
         cos_a, sin_a = column("cos"), column("sin")
@@ -250,9 +244,32 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
         assert np.all(bounded[3][reached][skipped] == 0.0)
         checked.append(np.count_nonzero(skipped))
         cut.append(np.count_nonzero(taken[:, -1]))
+
+    def checking(*arguments, every_row=False, **options):
+        # (the wakes summed: the kernel alone)
+        wake, pair, per_condition, centre, flat, kind, rotor, wakes = arguments[:8]
+        assert every_row and centre is None
+        combined = wakes.combined.copy()
+        bounded = original(*arguments, **options)
+        wakes.combined[...] = combined
+        result = original(*arguments, every_row=True, **options)
+        compare(bounded, result, pair, per_condition, flat, kind, rotor, options["split"])
+        return result
+
+    def checking_step(*arguments, **options):
+        # (the cumulative wake: its sums and the kernel in one step, rotor_kernel.cumulative_step)
+        wake, pair, per_condition, centre, flat, kind, rotor, wakes, track, every_row, split = (
+            arguments[:11])
+        assert every_row and centre is None
+        combined = wakes.combined.copy()
+        bounded = original_step(*arguments[:9], False, *arguments[10:], **options)[1]
+        wakes.combined[...] = combined
+        result = original_step(*arguments, **options)
+        compare(bounded, result[1], pair, per_condition, flat, kind, rotor, split)
         return result
 
     monkeypatch.setattr(rotor_module, "integrate_wake", checking)
+    monkeypatch.setattr(rotor_module, "cumulative_step", checking_step)
     solve(config, speeds, directions, yaw, floris_own=False)
     assert len(checked) > 5 and sum(checked) > 0
     assert sum(cut) > 0  # (some rotors have their strip cut by the layer top)
