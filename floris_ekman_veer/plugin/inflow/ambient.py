@@ -180,8 +180,11 @@ class RotorAmbient:
         # (rows_profile reads the rows' heights only.)
         _, deficit_heights, deficit_u, deficit_v = rows_profile(
             profile, grid, SimpleNamespace(row_z=DEFICIT_HEIGHTS))
-        return cls(cells, sorted_moments(grid), x, y, z, radius, kind, heights, u, v, split,
-                   deficit_heights, deficit_u, deficit_v)
+        # (contiguous: every wake step's compiled passes and gathers read them)
+        contiguous = np.ascontiguousarray
+        return cls(cells, sorted_moments(grid), contiguous(x), y, z, radius, kind, heights,
+                   contiguous(u), contiguous(v), split, deficit_heights, contiguous(deficit_u),
+                   contiguous(deficit_v))
 
     def rows(self, f, j):
         """Heights and ambient (U, V) at the sub-point rows of rotors (f, j): (pairs, rows)."""

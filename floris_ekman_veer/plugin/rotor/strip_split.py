@@ -117,5 +117,8 @@ class StripSplit:
         heights = np.asarray(heights, dtype=float)
         key = heights.tobytes()
         if key not in self.weights:
-            self.weights[key] = np.moveaxis(height_interpolation(heights, self.offset), 0, -1)
+            # (contiguous: a wake step gathers its rotors' rows, ten times faster than from
+            # the axis-moved view)
+            self.weights[key] = np.ascontiguousarray(
+                np.moveaxis(height_interpolation(heights, self.offset), 0, -1))
         return self.weights[key]
