@@ -150,7 +150,7 @@ def _solve(farm, flow_field, grid, model_manager) -> None:
         )
         wakes = deficit_model_args.get("wakes")
         if wakes is not None:
-            wakes.reached = None
+            wakes.reached, wakes.source = None, i
         velocity_deficit = model_manager.velocity_model.function(
             x_i, y_i, z_i, axial_induction_i, deflection_field, yaw_angle_i,
             turbulence_intensity_i, ct_i, hub_height_i, rotor_diameter_i,

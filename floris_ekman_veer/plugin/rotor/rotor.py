@@ -165,9 +165,11 @@ def reached_rotor_cell_deficit(
     incoming = ((model.deficit_velocity == "incoming" or cumulative)
                 and wakes.rule is not None)
     if track or incoming:
-        # Turbine i among the rotors, per condition.
-        source = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
-                           axis=1)
+        # Turbine i among the rotors, per condition (the solver's sorted index where it hands
+        # it: the rotor at turbine i's centre).
+        source = (np.full(n_findex, wakes.source) if wakes.source is not None else
+                  np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2,
+                            axis=1))
         if cumulative:
             # No later wake reaches turbine i (the solver steps downstream): free its kept wakes.
             wakes.convection.release(np.arange(n_findex) * n_turbines + source)

@@ -153,6 +153,8 @@ class RotorWakes:
         superposition: the velocity model's ``wake_superposition``.
         reached: the rotors (f, j) the latest wake reached (plugin/rotor/rotor.py), a superset
             of those where its deficit is not 0, or None.
+        source: the sorted index of the turbine whose wake the package's solver is stepping
+            (plugin/floris_hooks/solver.py), or None (another solver: the model finds it).
     """
 
     cells: RotorCells
@@ -165,6 +167,7 @@ class RotorWakes:
     convection: WakeConvection | UpstreamWakes | None = None
     superposition: str = "combination_model"
     reached: tuple | None = None
+    source: int | None = None
 
     @classmethod
     def start(cls, cells: RotorCells, n_findex: int, n_turbines: int, wake_models,

@@ -273,3 +273,27 @@ def test_kernel_centre_at_every_row_where_it_is_read(monkeypatch, option):
     solve(config, speeds, directions, yaw, floris_own=False)
     assert len(checked) > 5 and sum(checked) > 0
     assert sum(cut) > 0  # (some rotors have their strip cut by the layer top)
+
+
+def test_the_solver_hands_the_wakes_source_the_rotor_at_its_centre(monkeypatch):
+    """The package's solver hands the model the sorted index of the turbine it steps
+    (RotorWakes.source), which the model takes for the rotor at that turbine's centre: in every
+    condition of a random farm with raised hubs, the rotor nearest the turbine's centre."""
+    from floris_ekman_veer.plugin.rotor import rotor as rotor_module
+
+    original = rotor_module.reached_rotor_cell_deficit
+    checked = []
+
+    def checking(model, x_i, y_i, *arguments):
+        wakes, rotor = arguments[-1], arguments[-2].rotor
+        nearest = np.argmin((rotor.x - x_i[:, 0, 0]) ** 2 + (rotor.y - y_i[:, 0, 0]) ** 2, axis=1)
+        np.testing.assert_array_equal(nearest, wakes.source)
+        checked.append(wakes.source)
+        return original(model, x_i, y_i, *arguments)
+
+    monkeypatch.setattr(rotor_module, "reached_rotor_cell_deficit", checking)
+    config = farm_config("farm_night", "ekman_veer", True, "fls", "array_turbulence", 5, 9)
+    rng = np.random.default_rng(5)
+    solve(config, rng.uniform(5.0, 13.0, 6), rng.uniform(0.0, 360.0, 6),
+          rng.uniform(-25.0, 25.0, (6, 9)), floris_own=False)
+    assert sorted(checked) == list(range(9))
