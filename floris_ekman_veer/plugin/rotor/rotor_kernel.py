@@ -336,7 +336,6 @@ def near_pairs(f, j, x, table, points, rotor, y_i, hub_height, negligible, overl
     return keep[:count], pair[:count]
 
 
-
 #: No rotor left out by the rotor's bound (the kernel evaluates the bound itself).
 _NO_REACH = (np.zeros(0, dtype=np.bool_), np.zeros(0))
 
@@ -463,14 +462,15 @@ def _cumulative_step(bounds, sums, edge_column, edge_factor, kernel, first, stri
     # (``sums``, upstream_wakes.centres_and_deficits), the overlap edge from C_n at the rows
     # (``edge_column`` of the kernel's pair table, -1: none), the kernel (``kernel``). Each
     # rotor's work reads what its own share wrote before.
-    if bounds[11].size:
+    (pair, _, _, _, _, _, _, row_chord, _, _, _, may_reach, _) = bounds
+    if may_reach.size:
         _may_reach(*bounds, first, stride)
     centres_and_deficits(*sums, first, stride)
     if edge_column >= 0:
-        pair, row_deficit, rows = bounds[0], sums[-1], bounds[7].size
+        row_deficit = sums[-1]
         for k in range(pair.shape[0]):
             if in_share(k, first, stride):
-                pair[k, edge_column] = edge_factor * _row_mean(row_deficit[k], rows)
+                pair[k, edge_column] = edge_factor * _row_mean(row_deficit[k], row_chord.size)
     _integrate(*kernel, first, stride)
 
 
