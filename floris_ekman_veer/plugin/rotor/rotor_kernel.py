@@ -363,7 +363,7 @@ def rotor_row_bounds(per_condition, rotor, slots, split):
 
 
 def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
-                   every_row=False, row_scale=None, split=False):
+                   every_row=False, split=False):
     """One wake superposed on the rotor rows it reaches. Returns (pairs, n^2) the moment removed
     in each cell, sum_{s in k} w_s (u_before^m - u_after^m), (pairs,) the overlap (the area
     fraction of the disk where the wake's velocity exceeds the pair's ``overlap_edge``; 0
@@ -380,14 +380,13 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
     :class:`~floris_ekman_veer.plugin.rotor.rotor_wakes.RotorWakes`, whose stored combination is
     updated in place. The centre the kernel evaluates is exact at every row of the rotors
     reached with ``every_row``; without, at their first and last rows and those it reaches (0
-    at the rows a bound of the centre put out of reach). ``row_scale`` (pairs, rows + 1) or
-    None: a factor of the pair's ``velocity_scale`` per row slot (the cumulative wake's C_n at
-    the row's height). ``split``: the strip a layer top cuts is integrated as its two parts
-    (``rotor.split``, plugin/rotor/strip_split.py; ``centre`` and ``row_scale`` then hold the
-    parts at the cut strip's row and the extra slot); else the shared strips.
+    at the rows a bound of the centre put out of reach). ``split``: the strip a layer top cuts
+    is integrated as its two parts (``rotor.split``, plugin/rotor/strip_split.py; ``centre``
+    then holds the parts at the cut strip's row and the extra slot); else the shared strips.
+    The cumulative wake scales the rows by C_n at their heights: :func:`cumulative_step`.
     """
     arguments, outputs = _kernel_arguments(wake, pair, per_condition, centre, flat, kind, rotor,
-                                           wakes, track, every_row, row_scale, split)
+                                           wakes, track, every_row, None, split)
     split_over_threads(_integrate, flat.size, *arguments)
     return outputs
 
@@ -395,7 +394,8 @@ def integrate_wake(wake, pair, per_condition, centre, flat, kind, rotor, wakes, 
 def _kernel_arguments(wake, pair, per_condition, centre, flat, kind, rotor, wakes, track,
                       every_row, row_scale, split, bounds=None, reach=_NO_REACH):
     """The kernel's arguments (but the share's) and its outputs (:func:`integrate_wake`);
-    ``bounds`` the step's :func:`rotor_row_bounds` where the caller has them; ``reach`` the
+    ``row_scale`` (pairs, row slots) or None: a factor of the pair's ``velocity_scale`` per row
+    slot (the cumulative wake's C_n at the row's height); ``bounds`` the step's :func:`rotor_row_bounds` where the caller has them; ``reach`` the
     rotors the rotor's bound leaves in reach and that bound, (pairs,) each, from
     ``_may_reach`` (empty: the kernel evaluates the bound; else the rotors left out are not
     visited: the same results)."""

@@ -313,7 +313,7 @@ class UpstreamWakes:
         the offsets are evaluated into ``offsets`` (k, K), C-contiguous, in the same pass (each
         thread its own wakes' first: one hand-over to the threads, not two). ``reach`` (k,): the
         new wakes that may reach a row of their rotor (plugin/rotor/rotor_kernel.py
-        ``may_reach``); the others get 0 (and 0 offsets where evaluated here); None: all may."""
+        ``_may_reach``, in ``cumulative_step``); the others get 0 (and 0 offsets where evaluated here); None: all may."""
         arguments, outputs = self.sum_arguments(
             rotor, width_squared, lateral, offsets, height, single, ambient, incoming, core,
             slot_row, slot_weights, centres, reach)

@@ -362,7 +362,7 @@ def test_the_sums_evaluate_the_centres_as_the_centres_pass(threads):
     np.testing.assert_array_equal(into, offsets)
     for value, reference in zip(got, expected):
         np.testing.assert_array_equal(value, reference)
-    # The wakes left out (rotor_kernel.may_reach: none of their rows reached) get 0, the others
+    # The wakes left out (rotor_kernel._may_reach: none of their rows reached) get 0, the others
     # the same bits, their neighbours' prefetched entries notwithstanding.
     reach = rng.random(rotors) < 0.6
     into = np.empty_like(offsets)
